@@ -1,0 +1,44 @@
+"""The rt70 exception hierarchy.
+
+Every error rt70 raises on bad input derives from :class:`Rt70Error`, so callers (and
+the command line, which turns them into exit code 2 and one readable line) can catch
+them in one place.
+"""
+
+from __future__ import annotations
+
+
+class Rt70Error(Exception):
+    """Base class of every error rt70 raises on bad input or an impossible request."""
+
+
+class UrdfError(Rt70Error):
+    """The URDF file is missing, unreadable or not well-formed XML, or breaks URDF rules."""
+
+
+class TopologyError(UrdfError):
+    """The kinematic tree is broken: unknown parent, two parents, a cycle, no root."""
+
+
+class JointTypeError(UrdfError):
+    """A joint type is unknown, or known but not supported by rt70."""
+
+
+class InertiaError(UrdfError):
+    """A body's inertia is physically impossible (mass, definiteness, triangle inequality)."""
+
+
+class NonFiniteError(UrdfError):
+    """A number in the model is NaN or infinite."""
+
+
+class ExtensionError(UrdfError):
+    """An rt70 extension element (spring, bushing, strut package, ...) is malformed."""
+
+
+class SingularConfigurationError(Rt70Error):
+    """The configuration is singular for the chosen coordinates (Euler gimbal lock)."""
+
+
+class SceneError(Rt70Error):
+    """A scene name is unknown."""

@@ -1,0 +1,102 @@
+"""Equations of motion ``A(q) q̈ + B(q, q̇) q̇ = Q`` by the book's matrix algorithm (§4.3).
+
+Every function takes the plain model, its work buffers and the state, in the manner of
+Pinocchio's ``crba(model, data, q)``. This is the dense, readable form of the book:
+L, S and Θ are assembled as full block matrices.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from rt70.errors import Rt70Error
+from rt70.textbook.data import Data
+from rt70.textbook.kinematics import check_finite, pair_motion_rate, update_structure
+from rt70.textbook.model import Model
+from rt70.textbook.spatial import crf
+
+
+def mass_matrix(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
+    """Mass matrix ``A = S Θ Sᵀ`` (4.79)."""
+    S = update_structure(model, data, q)
+    data.A = S @ data.Theta @ S.T
+    return data.A
+
+
+def body_velocities(model: Model, data: Data, qd: np.ndarray) -> np.ndarray:
+    """Absolute body velocities ``V⁰ = Sᵀ q̇`` (4.63), each in its own body frame."""
+    data.V = (data.S.T @ qd).reshape(model.nb, 6)
+    return data.V
+
+
+def structure_matrix_rate(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``Ṡ = [f]ᵀ (Ṁᵀ L + Mᵀ L̇)`` (4.81), with ``L̇_k^j = L_k^j Φ(V_j^{k,j})`` (§4.2).
+
+    ``V_j^{k,j} = V_j⁰ − (L_k^j)ᵀ V_k⁰`` is the velocity of body j relative to body k,
+    in j's frame. Requires :func:`body_velocities` to have been called for (q, q̇).
+    """
+    L, V = data.L, data.V
+    S_dot = np.zeros_like(data.S)
+    for k in range(model.nb):
+        rows = model.coords(k)
+        if rows.stop == rows.start:
+            continue
+        mf = data.Mf[k]
+        dmf = pair_motion_rate(model, k, q[rows], qd[rows])
+        for j in range(model.nb):
+            L_kj = L[6 * k : 6 * k + 6, 6 * j : 6 * j + 6]
+            if not L_kj.any():
+                continue
+            v_rel = V[j] - L_kj.T @ V[k]
+            L_kj_dot = L_kj @ crf(v_rel)
+            S_dot[rows, 6 * j : 6 * j + 6] = dmf.T @ L_kj + mf.T @ L_kj_dot
+    return S_dot
+
+
+def bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """Matrix ``B = S Θ Ṡᵀ + S Φ⁰ Θ Sᵀ`` (4.80), ``Φ⁰ = diag(Φ(V_k⁰))``."""
+    q = check_finite("q", q, model.nv)
+    qd = check_finite("qd", qd, model.nv)
+    S = update_structure(model, data, q)
+    V = body_velocities(model, data, qd)
+    S_dot = structure_matrix_rate(model, data, q, qd)
+    Phi0 = np.zeros_like(data.Theta)
+    for k in range(model.nb):
+        Phi0[6 * k : 6 * k + 6, 6 * k : 6 * k + 6] = crf(V[k])
+    return S @ data.Theta @ S_dot.T + S @ Phi0 @ data.Theta @ S.T
+
+
+def bias_force(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """Velocity-product force ``B(q, q̇) q̇`` (4.78)–(4.81)."""
+    return bias_matrix(model, data, q, qd) @ qd
+
+
+def gravity_force(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
+    """Generalised gravity force ``Q_g = S G`` (4.113)–(4.128).
+
+    ``G_k = [m_k g_k; <p_cm,k> m_k g_k] = Θ_k [g_k; 0]``, ``g_k = c_{0k}ᵀ g0``.
+    """
+    S = update_structure(model, data, q)
+    accel = np.zeros((model.nb, 6))
+    accel[:, :3] = np.einsum("kji,j->ki", data.R, model.gravity)
+    G = np.einsum("kij,kj->ki", model.Theta, accel).ravel()
+    return S @ G
+
+
+def forward_dynamics(
+    model: Model, data: Data, q: np.ndarray, qd: np.ndarray, Q: np.ndarray
+) -> np.ndarray:
+    """``q̈ = A⁻¹ (Q_g + Q − B q̇)`` with Q the other generalised forces (springs, inputs).
+
+    A is factorised by Cholesky (it is symmetric positive definite for a well-posed
+    model); a singular A raises :class:`~rt70.errors.Rt70Error`.
+    """
+    Q = check_finite("Q", Q, model.nv)
+    rhs = Q + gravity_force(model, data, q) - bias_force(model, data, q, qd)
+    A = data.S @ data.Theta @ data.S.T
+    try:
+        factor = scipy.linalg.cho_factor(A)
+    except np.linalg.LinAlgError:
+        raise Rt70Error("mass matrix A is not positive definite at this configuration") from None
+    return scipy.linalg.cho_solve(factor, rhs)

@@ -1,0 +1,222 @@
+"""The textbook model: a tree of pairs as plain data (book §4.1).
+
+Each pair j joins body j to its parent body ``parent[j]`` (−1 is the ground, body 0 of
+the book). Its construction frame ``E_jc`` is placed in the parent's frame by the
+constant ``r_c[j]``, ``c_c[j]``; the pair's own motion is one of
+
+``euler6``
+    the book's free elastic pair, ``q_j = [x, y, z, β, θ, α]`` (4.8), ``f_j = 1₆``;
+``revolute`` / ``prismatic``
+    one coordinate about / along the unit ``axis[j]`` (``f_j = [0; a]`` / ``[a; 0]``);
+``fixed``
+    no coordinate (``f_j`` has no columns).
+
+A URDF chain of six joints (prismatic x, y, z, revolute x, y, z, zero origins after the
+first, massless links between) is read as one ``euler6`` pair, exactly the layout of
+formalism §5; every other joint is one pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rt70.textbook.spatial import body_inertia, rpy_matrix
+from rt70.urdf.description import Joint, RobotDescription
+
+PAIR_KINDS = ("euler6", "revolute", "prismatic", "fixed")
+_NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "fixed": 0}
+_EULER6_PATTERN = (
+    ("prismatic", (1.0, 0.0, 0.0)),
+    ("prismatic", (0.0, 1.0, 0.0)),
+    ("prismatic", (0.0, 0.0, 1.0)),
+    ("revolute", (1.0, 0.0, 0.0)),
+    ("revolute", (0.0, 1.0, 0.0)),
+    ("revolute", (0.0, 0.0, 1.0)),
+)
+
+
+@dataclass(frozen=True)
+class BushingModel:
+    """A 6-D spring/damper between frame 1 on ``body1`` and frame 2 on ``body2``.
+
+    Bodies are pair indices (−1 = ground); ``r``/``c`` place each frame in its body.
+    """
+
+    name: str
+    body1: int
+    r1: np.ndarray
+    c1: np.ndarray
+    body2: int
+    r2: np.ndarray
+    c2: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+
+@dataclass
+class Model:
+    """Plain model data of the textbook algorithm (no work buffers; see :class:`Data`).
+
+    Attributes
+    ----------
+    parent : numpy.ndarray
+        Parent pair of each pair, −1 for the ground; parents precede children.
+    kind : list of str
+        Pair kind, one of :data:`PAIR_KINDS`.
+    axis : numpy.ndarray
+        Joint axis of 1-DOF pairs, shape (nb, 3).
+    r_c, c_c : numpy.ndarray
+        Construction frame of each pair in its parent's frame, shapes (nb, 3), (nb, 3, 3).
+    Theta : numpy.ndarray
+        Inertia matrix Θ of each body about its frame origin (4.77), shape (nb, 6, 6).
+    mass, com : numpy.ndarray
+        Mass and centre of mass (body frame) of each body.
+    q_start, ndof : numpy.ndarray
+        First coordinate index and number of coordinates of each pair.
+    """
+
+    name: str
+    parent: np.ndarray
+    kind: list[str]
+    axis: np.ndarray
+    r_c: np.ndarray
+    c_c: np.ndarray
+    Theta: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    q_start: np.ndarray
+    ndof: np.ndarray
+    body_names: list[str]
+    coordinate_names: list[str]
+    gravity: np.ndarray
+    link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = field(default_factory=dict)
+    bushings: list[BushingModel] = field(default_factory=list)
+    spring_coords: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    spring_stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    spring_damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def nb(self) -> int:
+        """Number of pairs (bodies)."""
+        return len(self.kind)
+
+    @property
+    def nv(self) -> int:
+        """Number of generalised coordinates."""
+        return int(self.ndof.sum())
+
+    def coords(self, j: int) -> slice:
+        """Slice of pair j's coordinates in q."""
+        return slice(int(self.q_start[j]), int(self.q_start[j] + self.ndof[j]))
+
+    def ancestors(self, j: int) -> list[int]:
+        """Pairs on the path from the ground to j, j included, root first."""
+        path = []
+        while j >= 0:
+            path.append(j)
+            j = int(self.parent[j])
+        return path[::-1]
+
+
+def _euler6_chain(desc: RobotDescription, first: Joint, referenced: set[str]) -> list[Joint]:
+    """Return the six joints of an euler6 pair starting at ``first``, or [] if none."""
+    chain = []
+    joint = first
+    for step, (jtype, axis) in enumerate(_EULER6_PATTERN):
+        if joint.type != jtype or not np.array_equal(joint.axis, axis):
+            return []
+        if step > 0 and (np.any(joint.xyz != 0.0) or np.any(joint.rpy != 0.0)):
+            return []
+        chain.append(joint)
+        if step == 5:
+            return chain
+        link = desc.links[joint.child]
+        children = desc.child_joints(joint.child)
+        if link.inertial is not None or len(children) != 1 or link.name in referenced:
+            return []
+        joint = children[0]
+    return []
+
+
+def build_model(desc: RobotDescription) -> Model:
+    """Build the textbook :class:`Model` from a validated URDF description."""
+    referenced = {b.frame1.link for b in desc.bushings} | {b.frame2.link for b in desc.bushings}
+    referenced |= {p.link for p in desc.optical_points}
+    parent, kind, axis, r_c, c_c = [], [], [], [], []
+    thetas, masses, coms, ndof, body_names, coord_names = [], [], [], [], [], []
+    link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = {
+        desc.root: (-1, np.zeros(3), np.eye(3))
+    }
+    joint_coord: dict[str, int] = {}
+
+    def visit(link: str, body: int) -> None:
+        for joint in desc.child_joints(link):
+            chain = _euler6_chain(desc, joint, referenced)
+            if chain:
+                jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
+            else:
+                child, names = joint.child, [joint.name]
+                jkind = joint.type
+                if jkind == "fixed":
+                    names = []
+            j = len(kind)
+            parent.append(body)
+            kind.append(jkind)
+            axis.append(joint.axis)
+            r_c.append(joint.xyz)
+            c_c.append(rpy_matrix(joint.rpy))
+            inertial = desc.links[child].inertial
+            if inertial is None:
+                thetas.append(np.zeros((6, 6)))
+                masses.append(0.0)
+                coms.append(np.zeros(3))
+            else:
+                thetas.append(body_inertia(inertial.mass, inertial.com, inertial.inertia))
+                masses.append(inertial.mass)
+                coms.append(inertial.com)
+            for name in names:
+                joint_coord[name] = len(coord_names)
+                coord_names.append(name)
+            ndof.append(_NDOF[jkind])
+            body_names.append(child)
+            link_frames[child] = (j, np.zeros(3), np.eye(3))
+            visit(child, j)
+
+    visit(desc.root, -1)
+    ndof_arr = np.array(ndof, dtype=int)
+    model = Model(
+        name=desc.name,
+        parent=np.array(parent, dtype=int),
+        kind=kind,
+        axis=np.array(axis, dtype=float).reshape(-1, 3),
+        r_c=np.array(r_c, dtype=float).reshape(-1, 3),
+        c_c=np.array(c_c, dtype=float).reshape(-1, 3, 3),
+        Theta=np.array(thetas, dtype=float).reshape(-1, 6, 6),
+        mass=np.array(masses, dtype=float),
+        com=np.array(coms, dtype=float).reshape(-1, 3),
+        q_start=np.concatenate([[0], np.cumsum(ndof_arr)[:-1]]).astype(int),
+        ndof=ndof_arr,
+        body_names=body_names,
+        coordinate_names=coord_names,
+        gravity=np.array(desc.gravity, dtype=float),
+        link_frames=link_frames,
+    )
+    for b in desc.bushings:
+        body1, r1, c1 = _frame_on_body(model, b.frame1.link, b.frame1.xyz, b.frame1.rpy)
+        body2, r2, c2 = _frame_on_body(model, b.frame2.link, b.frame2.xyz, b.frame2.rpy)
+        model.bushings.append(
+            BushingModel(b.name, body1, r1, c1, body2, r2, c2, b.stiffness, b.damping)
+        )
+    model.spring_coords = np.array([joint_coord[s.joint] for s in desc.joint_springs], dtype=int)
+    model.spring_stiffness = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
+    model.spring_damping = np.array([s.damping for s in desc.joint_springs], dtype=float)
+    return model
+
+
+def _frame_on_body(
+    model: Model, link: str, xyz: np.ndarray, rpy: np.ndarray
+) -> tuple[int, np.ndarray, np.ndarray]:
+    body, r_link, c_link = model.link_frames[link]
+    return body, r_link + c_link @ xyz, c_link @ rpy_matrix(rpy)

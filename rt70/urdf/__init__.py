@@ -1,0 +1,33 @@
+"""rt70's own URDF reader: standard-library XML to a validated, plain description.
+
+Both sides of the cross-check read scenes through this package: the textbook side builds
+its model from the description; the reference side lets Pinocchio parse the same file
+for the dynamics and takes only the rt70 extension elements (springs, gravity, optical
+points) from here. Nothing in this package imports Pinocchio.
+"""
+
+from rt70.urdf.description import (
+    Bushing,
+    FrameRef,
+    Inertial,
+    Joint,
+    JointSpring,
+    Link,
+    OpticalPoint,
+    RobotDescription,
+)
+from rt70.urdf.reader import RT70_NS, read_urdf, read_urdf_string
+
+__all__ = [
+    "RT70_NS",
+    "Bushing",
+    "FrameRef",
+    "Inertial",
+    "Joint",
+    "JointSpring",
+    "Link",
+    "OpticalPoint",
+    "RobotDescription",
+    "read_urdf",
+    "read_urdf_string",
+]

@@ -1,0 +1,157 @@
+"""Plain, validated data read from a URDF scene (no algorithms here)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Joint types of the URDF standard.
+URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """Mass properties of a link, expressed in the link frame.
+
+    Attributes
+    ----------
+    mass : float
+        Mass, kg.
+    com : numpy.ndarray
+        Centre of mass in the link frame, m, shape (3,).
+    inertia : numpy.ndarray
+        Rotational inertia about the centre of mass, axes of the link frame, kg·m²,
+        shape (3, 3) (the URDF ``<inertial><origin rpy>`` rotation already applied).
+    """
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+
+
+@dataclass(frozen=True)
+class Link:
+    """A URDF link: a name and, if it has mass, its inertial."""
+
+    name: str
+    inertial: Inertial | None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A URDF joint.
+
+    Attributes
+    ----------
+    name, type, parent, child : str
+        As in URDF; ``parent``/``child`` are link names.
+    xyz, rpy : numpy.ndarray
+        Origin of the joint frame in the parent link frame (URDF convention).
+    axis : numpy.ndarray
+        Unit axis in the joint frame (meaningful for revolute, continuous, prismatic).
+    """
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: np.ndarray
+    rpy: np.ndarray
+    axis: np.ndarray
+
+
+@dataclass(frozen=True)
+class FrameRef:
+    """A frame rigidly attached to a link: placement ``(xyz, rpy)`` in the link frame."""
+
+    link: str
+    xyz: np.ndarray
+    rpy: np.ndarray
+
+
+@dataclass(frozen=True)
+class Bushing:
+    """A 6-D linear spring/damper between two frames (see docs/urdf-extensions.md).
+
+    Attributes
+    ----------
+    stiffness, damping : numpy.ndarray
+        Diagonals of C and D, order x, y, z, rx, ry, rz, shape (6,).
+    package : str or None
+        Name of the strut package this bushing is a strut of, if any.
+    """
+
+    name: str
+    frame1: FrameRef
+    frame2: FrameRef
+    stiffness: np.ndarray
+    damping: np.ndarray
+    package: str | None = None
+
+
+@dataclass(frozen=True)
+class JointSpring:
+    """A scalar spring and damper on the coordinate of one 1-DOF joint."""
+
+    name: str
+    joint: str
+    stiffness: float
+    damping: float
+
+
+@dataclass(frozen=True)
+class OpticalPoint:
+    """A named point of a link (mirror focus or vertex)."""
+
+    name: str
+    link: str
+    xyz: np.ndarray
+
+
+@dataclass(frozen=True)
+class RobotDescription:
+    """Everything rt70 reads from one URDF scene.
+
+    Attributes
+    ----------
+    name : str
+        The robot's name.
+    source : str
+        The file path (or ``"<string>"``) for error messages.
+    root : str
+        Name of the root link (the ground).
+    links : dict of str to Link
+        All links, in document order.
+    joints : list of Joint
+        All joints, in document order.
+    gravity : numpy.ndarray
+        Gravitational acceleration in the ground frame, m/s².
+    bushings : list of Bushing
+        6-D elastic elements, strut packages expanded into their struts.
+    joint_springs : list of JointSpring
+        Scalar springs on joint coordinates.
+    optical_points : list of OpticalPoint
+        Named output points.
+    """
+
+    name: str
+    source: str
+    root: str
+    links: dict[str, Link]
+    joints: list[Joint]
+    gravity: np.ndarray
+    bushings: list[Bushing] = field(default_factory=list)
+    joint_springs: list[JointSpring] = field(default_factory=list)
+    optical_points: list[OpticalPoint] = field(default_factory=list)
+
+    def joint(self, name: str) -> Joint:
+        """Return the joint called ``name`` (KeyError if there is none)."""
+        for joint in self.joints:
+            if joint.name == name:
+                return joint
+        raise KeyError(name)
+
+    def child_joints(self, link: str) -> list[Joint]:
+        """Return the joints whose parent is ``link``, in document order."""
+        return [j for j in self.joints if j.parent == link]

@@ -1,0 +1,370 @@
+"""Read and validate a URDF scene with the standard library's XML parser.
+
+Every defect is reported as an :class:`~rt70.errors.UrdfError` subclass whose message
+starts with the source file, so the command line can print it as one readable line.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from rt70.errors import (
+    ExtensionError,
+    InertiaError,
+    JointTypeError,
+    NonFiniteError,
+    TopologyError,
+    UrdfError,
+)
+from rt70.textbook.spatial import rpy_matrix
+from rt70.urdf.description import (
+    URDF_JOINT_TYPES,
+    Bushing,
+    FrameRef,
+    Inertial,
+    Joint,
+    JointSpring,
+    Link,
+    OpticalPoint,
+    RobotDescription,
+)
+
+#: XML namespace of the rt70 extension elements (docs/urdf-extensions.md).
+RT70_NS = "urn:rt70:urdf-extensions:1"
+
+#: Joint types rt70 models on both sides (the others are rejected with a clear error).
+SUPPORTED_JOINT_TYPES = ("revolute", "prismatic", "fixed")
+
+_EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point")
+_ZERO3 = np.zeros(3)
+
+
+def read_urdf(path: str | Path) -> RobotDescription:
+    """Read a URDF file into a validated :class:`RobotDescription`.
+
+    Raises
+    ------
+    UrdfError
+        (or a subclass) if the file is missing, malformed, or describes an impossible
+        or unsupported model; the message names the file and the offending element.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UrdfError(f"{path}: file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UrdfError(f"{path}: cannot read file ({exc})") from None
+    return read_urdf_string(text, source=str(path))
+
+
+def read_urdf_string(text: str, source: str = "<string>") -> RobotDescription:
+    """Read URDF text into a validated :class:`RobotDescription` (see :func:`read_urdf`)."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise UrdfError(f"{source}: malformed XML: {exc}") from None
+    return _Reader(source).robot(root)
+
+
+class _Reader:
+    """One pass over the XML tree, with the source name for messages."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    # --- small helpers -------------------------------------------------------------
+    def fail(self, cls: type[UrdfError], what: str) -> UrdfError:
+        return cls(f"{self.source}: {what}")
+
+    def numbers(self, elem: ET.Element, attr: str, count: int, default=None) -> np.ndarray:
+        raw = elem.get(attr)
+        tag = _tag(elem)
+        if raw is None:
+            if default is None:
+                raise self.fail(UrdfError, f"<{tag}> lacks attribute '{attr}'")
+            return np.array(default, dtype=float)
+        try:
+            values = np.array([float(tok) for tok in raw.split()], dtype=float)
+        except ValueError:
+            raise self.fail(
+                UrdfError, f"<{tag} {attr}=\"{raw}\">: not a list of numbers"
+            ) from None
+        if values.size != count:
+            raise self.fail(
+                UrdfError, f"<{tag} {attr}=\"{raw}\">: expected {count} numbers, got {values.size}"
+            )
+        if not np.all(np.isfinite(values)):
+            raise self.fail(NonFiniteError, f"<{tag} {attr}=\"{raw}\">: NaN or infinite value")
+        return values
+
+    def number(self, elem: ET.Element, attr: str, default: float | None = None) -> float:
+        return float(self.numbers(elem, attr, 1, None if default is None else [default])[0])
+
+    def name_of(self, elem: ET.Element) -> str:
+        name = elem.get("name")
+        if not name:
+            raise self.fail(UrdfError, f"<{_tag(elem)}> without a name")
+        return name
+
+    def origin(self, elem: ET.Element) -> tuple[np.ndarray, np.ndarray]:
+        o = elem.find("origin")
+        if o is None:
+            return _ZERO3.copy(), _ZERO3.copy()
+        return self.numbers(o, "xyz", 3, _ZERO3), self.numbers(o, "rpy", 3, _ZERO3)
+
+    # --- the document --------------------------------------------------------------
+    def robot(self, root: ET.Element) -> RobotDescription:
+        if root.tag != "robot":
+            raise self.fail(UrdfError, f"root element is <{root.tag}>, expected <robot>")
+        links: dict[str, Link] = {}
+        for elem in root.findall("link"):
+            link = self.link(elem)
+            if link.name in links:
+                raise self.fail(UrdfError, f"two links named '{link.name}'")
+            links[link.name] = link
+        if not links:
+            raise self.fail(UrdfError, "no <link> elements")
+        joints = [self.joint(elem) for elem in root.findall("joint")]
+        root_link = self.check_tree(links, joints)
+        desc = RobotDescription(
+            name=root.get("name", ""),
+            source=self.source,
+            root=root_link,
+            links=links,
+            joints=joints,
+            gravity=np.array([0.0, 0.0, -9.81]),
+        )
+        self.extensions(root, desc)
+        return desc
+
+    def link(self, elem: ET.Element) -> Link:
+        name = self.name_of(elem)
+        inertial = elem.find("inertial")
+        return Link(name, None if inertial is None else self.inertial(name, inertial))
+
+    def inertial(self, link: str, elem: ET.Element) -> Inertial | None:
+        xyz, rpy = self.origin(elem)
+        mass_elem = elem.find("mass")
+        mass = 0.0 if mass_elem is None else self.number(mass_elem, "value")
+        ie = elem.find("inertia")
+        if ie is None:
+            tensor = np.zeros((3, 3))
+        else:
+            ixx, ixy, ixz, iyy, iyz, izz = (
+                self.number(ie, key, 0.0) for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+            )
+            tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        where = f"link '{link}'"
+        if mass < 0.0:
+            raise self.fail(InertiaError, f"{where}: negative mass {mass:g} kg")
+        if mass == 0.0:
+            if np.any(tensor != 0.0):
+                raise self.fail(InertiaError, f"{where}: zero mass but non-zero inertia tensor")
+            return None
+        moments = np.linalg.eigvalsh(tensor)
+        scale = max(float(np.max(np.abs(moments))), np.finfo(float).tiny)
+        if moments[0] <= 0.0:
+            raise self.fail(
+                InertiaError,
+                f"{where}: inertia tensor not positive definite "
+                f"(principal moments {', '.join(f'{m:.6g}' for m in moments)})",
+            )
+        if moments[2] > moments[0] + moments[1] + 1e-9 * scale:
+            raise self.fail(
+                InertiaError,
+                f"{where}: principal moment {moments[2]:.6g} exceeds the sum of the other "
+                f"two ({moments[0]:.6g} + {moments[1]:.6g}): triangle inequality violated",
+            )
+        rot = rpy_matrix(rpy)
+        return Inertial(mass=mass, com=xyz, inertia=rot @ tensor @ rot.T)
+
+    def joint(self, elem: ET.Element) -> Joint:
+        name = self.name_of(elem)
+        jtype = elem.get("type")
+        if jtype is None:
+            raise self.fail(UrdfError, f"joint '{name}' has no type")
+        if jtype not in URDF_JOINT_TYPES:
+            raise self.fail(JointTypeError, f"joint '{name}': unknown joint type '{jtype}'")
+        if jtype not in SUPPORTED_JOINT_TYPES:
+            raise self.fail(
+                JointTypeError,
+                f"joint '{name}': joint type '{jtype}' is not supported "
+                f"(supported: {', '.join(SUPPORTED_JOINT_TYPES)})",
+            )
+        if elem.find("mimic") is not None:
+            raise self.fail(JointTypeError, f"joint '{name}': <mimic> joints are not supported")
+        ends = {}
+        for end in ("parent", "child"):
+            sub = elem.find(end)
+            if sub is None or not sub.get("link"):
+                raise self.fail(UrdfError, f"joint '{name}' lacks <{end} link=...>")
+            ends[end] = sub.get("link")
+        xyz, rpy = self.origin(elem)
+        axis_elem = elem.find("axis")
+        axis = np.array([1.0, 0.0, 0.0])
+        if axis_elem is not None:
+            axis = self.numbers(axis_elem, "xyz", 3)
+        norm = float(np.linalg.norm(axis))
+        if jtype != "fixed" and norm < 1e-12:
+            raise self.fail(UrdfError, f"joint '{name}': zero-length axis")
+        return Joint(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis / max(norm, 1e-300))
+
+    def check_tree(self, links: dict[str, Link], joints: list[Joint]) -> str:
+        names: set[str] = set()
+        parent_of: dict[str, str] = {}
+        for j in joints:
+            if j.name in names:
+                raise self.fail(UrdfError, f"two joints named '{j.name}'")
+            names.add(j.name)
+            for end, link in (("parent", j.parent), ("child", j.child)):
+                if link not in links:
+                    raise self.fail(
+                        TopologyError, f"joint '{j.name}': {end} link '{link}' does not exist"
+                    )
+            if j.child in parent_of:
+                raise self.fail(
+                    TopologyError,
+                    f"link '{j.child}' has two parents ('{parent_of[j.child]}' and '{j.parent}')",
+                )
+            parent_of[j.child] = j.parent
+        for start in parent_of:  # follow parents: a cycle never reaches a root
+            seen = [start]
+            link = start
+            while link in parent_of:
+                link = parent_of[link]
+                if link in seen:
+                    cycle = " -> ".join([*seen[seen.index(link):], link])
+                    raise self.fail(TopologyError, f"kinematic cycle: {cycle}")
+                seen.append(link)
+        roots = [name for name in links if name not in parent_of]
+        if len(roots) != 1:
+            raise self.fail(
+                TopologyError,
+                f"expected one root link, found {len(roots)}: {', '.join(roots[:5])}",
+            )
+        return roots[0]
+
+    # --- rt70 extension elements ---------------------------------------------------
+    def extensions(self, root: ET.Element, desc: RobotDescription) -> None:
+        ns = "{" + RT70_NS + "}"
+        gravity_seen = False
+        for elem in root:
+            if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
+                continue
+            kind = elem.tag[len(ns):]
+            if kind not in _EXTENSIONS:
+                raise self.fail(ExtensionError, f"unknown rt70 element <rt70:{kind}>")
+            if kind == "gravity":
+                if gravity_seen:
+                    raise self.fail(ExtensionError, "more than one <rt70:gravity>")
+                gravity_seen = True
+                desc.gravity[:] = self.numbers(elem, "xyz", 3)
+            elif kind == "joint_spring":
+                desc.joint_springs.append(self.joint_spring(elem, desc))
+            elif kind == "bushing":
+                desc.bushings.append(self.bushing(elem, desc))
+            elif kind == "strut_package":
+                desc.bushings.extend(self.strut_package(elem, desc))
+            else:
+                name = self.name_of(elem)
+                link = self.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
+                desc.optical_points.append(OpticalPoint(name, link, self.numbers(elem, "xyz", 3)))
+
+    def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
+        link = elem.get(attr)
+        if not link:
+            raise self.fail(ExtensionError, f"{where} lacks attribute '{attr}'")
+        if link not in desc.links:
+            raise self.fail(ExtensionError, f"{where}: link '{link}' does not exist")
+        return link
+
+    def gains(self, elem: ET.Element, count: int, where: str) -> tuple[np.ndarray, np.ndarray]:
+        out = []
+        for attr in ("stiffness", "damping"):
+            values = self.numbers(elem, attr, count, np.zeros(count))
+            if np.any(values < 0.0):
+                raise self.fail(ExtensionError, f"{where}: negative {attr}")
+            out.append(values)
+        return out[0], out[1]
+
+    def joint_spring(self, elem: ET.Element, desc: RobotDescription) -> JointSpring:
+        name = self.name_of(elem)
+        where = f"<rt70:joint_spring name='{name}'>"
+        jname = elem.get("joint")
+        if not jname:
+            raise self.fail(ExtensionError, f"{where} lacks attribute 'joint'")
+        try:
+            joint = desc.joint(jname)
+        except KeyError:
+            raise self.fail(ExtensionError, f"{where}: joint '{jname}' does not exist") from None
+        if joint.type not in ("revolute", "prismatic"):
+            raise self.fail(
+                ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"
+            )
+        k, d = self.gains(elem, 1, where)
+        return JointSpring(name, jname, float(k[0]), float(d[0]))
+
+    def frame(self, elem: ET.Element, tag: str, desc: RobotDescription, where: str) -> FrameRef:
+        sub = elem.find(f"{{{RT70_NS}}}{tag}")
+        if sub is None:
+            raise self.fail(ExtensionError, f"{where} lacks <rt70:{tag}>")
+        link = self.link_ref(sub, "link", desc, f"{where} <rt70:{tag}>")
+        return FrameRef(link, self.numbers(sub, "xyz", 3, _ZERO3), self.numbers(sub, "rpy", 3, _ZERO3))
+
+    def bushing(self, elem: ET.Element, desc: RobotDescription) -> Bushing:
+        name = self.name_of(elem)
+        where = f"<rt70:bushing name='{name}'>"
+        f1 = self.frame(elem, "frame1", desc, where)
+        f2 = self.frame(elem, "frame2", desc, where)
+        k, d = self.gains(elem, 6, where)
+        return Bushing(name, f1, f2, k, d)
+
+    def strut_package(self, elem: ET.Element, desc: RobotDescription) -> list[Bushing]:
+        name = self.name_of(elem)
+        where = f"<rt70:strut_package name='{name}'>"
+        parent = self.link_ref(elem, "parent", desc, where)
+        child = self.link_ref(elem, "child", desc, where)
+        origin_xyz = self.numbers(elem, "xyz", 3, _ZERO3)
+        origin_rot = rpy_matrix(self.numbers(elem, "rpy", 3, _ZERO3))
+        struts = []
+        for sub in elem.findall(f"{{{RT70_NS}}}strut"):
+            sname = self.name_of(sub)
+            r_s = self.numbers(sub, "xyz", 3, _ZERO3)
+            rpy_s = self.numbers(sub, "rpy", 3, _ZERO3)
+            k, d = self.gains(sub, 6, f"{where} <rt70:strut name='{sname}'>")
+            # frame 1 = package origin ∘ (r_s, c_s), expressed in the parent link
+            f1_xyz = origin_xyz + origin_rot @ r_s
+            f1_rpy = _matrix_to_rpy(origin_rot @ rpy_matrix(rpy_s))
+            struts.append(
+                Bushing(
+                    f"{name}/{sname}",
+                    FrameRef(parent, f1_xyz, f1_rpy),
+                    FrameRef(child, r_s, rpy_s),
+                    k,
+                    d,
+                    package=name,
+                )
+            )
+        if not struts:
+            raise self.fail(ExtensionError, f"{where} has no <rt70:strut>")
+        return struts
+
+
+def _tag(elem: ET.Element) -> str:
+    tag = elem.tag
+    if tag.startswith("{" + RT70_NS + "}"):
+        return "rt70:" + tag[len(RT70_NS) + 2:]
+    return tag
+
+
+def _matrix_to_rpy(rot: np.ndarray) -> np.ndarray:
+    """URDF ``rpy`` of a rotation ``Rz(y) Ry(p) Rx(r)`` (inverse of ``rpy_matrix``)."""
+    pitch = math.atan2(-rot[2, 0], math.hypot(rot[0, 0], rot[1, 0]))
+    roll = math.atan2(rot[2, 1], rot[2, 2])
+    yaw = math.atan2(rot[1, 0], rot[0, 0])
+    return np.array([roll, pitch, yaw])
