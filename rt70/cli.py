@@ -44,8 +44,12 @@ def build_parser() -> argparse.ArgumentParser:
         description="Compare mass matrix, bias, gravity, spring/damper forces, forward "
         "dynamics and energies of the textbook algorithm and Pinocchio on random states.",
     )
-    val.add_argument("targets", nargs="*", metavar="TARGET", help="scene name or URDF path "
-                     "(default: every scene in urdf/)")
+    val.add_argument(
+        "targets",
+        nargs="*",
+        metavar="TARGET",
+        help="scene name or URDF path (default: every scene in urdf/)",
+    )
     val.add_argument("--samples", type=int, default=10, help="random states per target")
     val.add_argument("--seed", type=int, default=0, help="random seed")
     val.add_argument("--tolerance", type=float, default=1e-10, help="relative tolerance")

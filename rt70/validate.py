@@ -111,9 +111,7 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     }
 
 
-def cross_check(
-    scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3
-) -> list[Record]:
+def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3) -> list[Record]:
     """Compare every quantity of :data:`QUANTITIES` on ``samples`` random states.
 
     Each evaluation is timed as the mean of ``repeat`` calls after a warm-up call.

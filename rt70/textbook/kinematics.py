@@ -48,9 +48,9 @@ def pair_motion(model: Model, j: int, qj: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 def pair_motion_rate(model: Model, j: int, qj: np.ndarray, qdj: np.ndarray) -> np.ndarray:
-    """``Ṁ_j f_j`` (6 × k_j): zero except for the euler6 pair, where (4.82)
+    """``Ṁ_j f_j`` (6 × k_j): zero except for the euler6 pair (4.82).
 
-    ``Ṁ_j = diag(ċ_jᵀ, ε̇_j)``, ``ċ = c <ω_rel>``, ``ω_rel = ε φ̇``, so ``ċᵀ = −<ω_rel> cᵀ``.
+    For it ``Ṁ_j = diag(ċ_jᵀ, ε̇_j)``, ``ċ = c <ω_rel>``, ``ω_rel = ε φ̇``, so ``ċᵀ = −<ω_rel> cᵀ``.
     """
     if model.kind[j] != "euler6":
         return np.zeros((6, int(model.ndof[j])))
@@ -97,8 +97,8 @@ def configuration_matrix(model: Model, data: Data) -> np.ndarray:
         L[6 * j : 6 * j + 6, 6 * j : 6 * j + 6] = np.eye(6)
         i = model.parent[j]
         for k in model.ancestors(i) if i >= 0 else []:
-            L[6 * k : 6 * k + 6, 6 * j : 6 * j + 6] = L[6 * k : 6 * k + 6, 6 * i : 6 * i + 6] @ (
-                data.L_pair[j]
+            L[6 * k : 6 * k + 6, 6 * j : 6 * j + 6] = (
+                L[6 * k : 6 * k + 6, 6 * i : 6 * i + 6] @ (data.L_pair[j])
             )
     return L
 
@@ -135,7 +135,9 @@ def frame_jacobian(data: Data, body: int, r: np.ndarray, c: np.ndarray) -> np.nd
     return placement(r, c).T @ data.S[:, 6 * body : 6 * body + 6].T
 
 
-def frame_pose(data: Data, body: int, r: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def frame_pose(
+    data: Data, body: int, r: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Absolute orientation and origin of a frame fixed to ``body`` at ``(r, c)``."""
     if body < 0:
         return c, r

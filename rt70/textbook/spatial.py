@@ -103,9 +103,7 @@ def euler_matrix_inverse(phi: np.ndarray) -> np.ndarray:
             f"{GIMBAL_LOCK_COS:g} of ±π/2 (gimbal lock)"
         )
     ca, sa = np.cos(alpha), np.sin(alpha)
-    return np.array(
-        [[ca / ct, -sa / ct, 0.0], [sa, ca, 0.0], [-st * ca / ct, st * sa / ct, 1.0]]
-    )
+    return np.array([[ca / ct, -sa / ct, 0.0], [sa, ca, 0.0], [-st * ca / ct, st * sa / ct, 1.0]])
 
 
 def translation(r: np.ndarray) -> np.ndarray:

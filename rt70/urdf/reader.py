@@ -91,15 +91,13 @@ class _Reader:
         try:
             values = np.array([float(tok) for tok in raw.split()], dtype=float)
         except ValueError:
-            raise self.fail(
-                UrdfError, f"<{tag} {attr}=\"{raw}\">: not a list of numbers"
-            ) from None
+            raise self.fail(UrdfError, f'<{tag} {attr}="{raw}">: not a list of numbers') from None
         if values.size != count:
             raise self.fail(
-                UrdfError, f"<{tag} {attr}=\"{raw}\">: expected {count} numbers, got {values.size}"
+                UrdfError, f'<{tag} {attr}="{raw}">: expected {count} numbers, got {values.size}'
             )
         if not np.all(np.isfinite(values)):
-            raise self.fail(NonFiniteError, f"<{tag} {attr}=\"{raw}\">: NaN or infinite value")
+            raise self.fail(NonFiniteError, f'<{tag} {attr}="{raw}">: NaN or infinite value')
         return values
 
     def number(self, elem: ET.Element, attr: str, default: float | None = None) -> float:
@@ -238,7 +236,7 @@ class _Reader:
             while link in parent_of:
                 link = parent_of[link]
                 if link in seen:
-                    cycle = " -> ".join([*seen[seen.index(link):], link])
+                    cycle = " -> ".join([*seen[seen.index(link) :], link])
                     raise self.fail(TopologyError, f"kinematic cycle: {cycle}")
                 seen.append(link)
         roots = [name for name in links if name not in parent_of]
@@ -256,7 +254,7 @@ class _Reader:
         for elem in root:
             if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
                 continue
-            kind = elem.tag[len(ns):]
+            kind = elem.tag[len(ns) :]
             if kind not in _EXTENSIONS:
                 raise self.fail(ExtensionError, f"unknown rt70 element <rt70:{kind}>")
             if kind == "gravity":
@@ -314,7 +312,9 @@ class _Reader:
         if sub is None:
             raise self.fail(ExtensionError, f"{where} lacks <rt70:{tag}>")
         link = self.link_ref(sub, "link", desc, f"{where} <rt70:{tag}>")
-        return FrameRef(link, self.numbers(sub, "xyz", 3, _ZERO3), self.numbers(sub, "rpy", 3, _ZERO3))
+        return FrameRef(
+            link, self.numbers(sub, "xyz", 3, _ZERO3), self.numbers(sub, "rpy", 3, _ZERO3)
+        )
 
     def bushing(self, elem: ET.Element, desc: RobotDescription) -> Bushing:
         name = self.name_of(elem)
@@ -358,7 +358,7 @@ class _Reader:
 def _tag(elem: ET.Element) -> str:
     tag = elem.tag
     if tag.startswith("{" + RT70_NS + "}"):
-        return "rt70:" + tag[len(RT70_NS) + 2:]
+        return "rt70:" + tag[len(RT70_NS) + 2 :]
     return tag
 
 

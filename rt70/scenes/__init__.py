@@ -1,0 +1,25 @@
+"""Scene generators: the book's tables as Python data, written out as rt70 URDF files.
+
+The data live in :mod:`rt70.scenes.rt70_data` (the RT-70 listing of §4.2.3 and the
+chapter-2 tables) and :mod:`rt70.scenes.mechanisms` (small test mechanisms);
+:mod:`rt70.scenes.generate` turns them into the URDF files under ``urdf/``
+(``python -m rt70.scenes.generate [DIR]``).
+
+``SCENES`` and ``write_all`` are re-exported lazily, so that running the generator
+with ``python -m`` does not import it twice.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["SCENES", "write_all"]
+
+
+def __getattr__(name: str) -> Any:
+    """Import ``SCENES`` and ``write_all`` from :mod:`rt70.scenes.generate` on first use."""
+    if name in __all__:
+        from rt70.scenes import generate
+
+        return getattr(generate, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,0 +1,720 @@
+"""Build the rt70 scene URDF files from the book's data.
+
+Every scene is a function returning the URDF text; :data:`SCENES` maps scene names to
+them and :func:`write_all` writes ``<name>.urdf`` files. The output is deterministic:
+fixed element and attribute order, two-space indentation, numbers written as the
+shortest text that reads back as the same float (``repr``, with a trailing ``.0``
+dropped), and a final newline. The extension elements follow
+``docs/urdf-extensions.md``.
+
+Run ``python -m rt70.scenes.generate [DIR]`` to regenerate the files (default: the
+repository's ``urdf/`` directory).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import re
+import sys
+import tempfile
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
+
+from rt70.scenes import mechanisms, rt70_data
+
+#: Namespace of the rt70 URDF extension elements.
+RT70_NS = "urn:rt70:urdf-extensions:1"
+
+#: Default output directory: ``urdf/`` at the repository root.
+DEFAULT_DIRECTORY = Path(__file__).resolve().parents[2] / "urdf"
+
+#: Name of the root (ground) link of every scene.
+ROOT_LINK = "world"
+
+# Wide joint limits: pinocchio's URDF parser requires <limit> on revolute and prismatic
+# joints; these never bind.
+_LIMIT = (("lower", -1.0e3), ("upper", 1.0e3), ("effort", 1.0e12), ("velocity", 1.0e6))
+
+# The six 1-DOF joints of an elastic pair, in the book's coordinate order [x, y, z, β, θ, α].
+_PAIR_JOINTS = (
+    ("x", "prismatic", (1, 0, 0)),
+    ("y", "prismatic", (0, 1, 0)),
+    ("z", "prismatic", (0, 0, 1)),
+    ("rx", "revolute", (1, 0, 0)),
+    ("ry", "revolute", (0, 1, 0)),
+    ("rz", "revolute", (0, 0, 1)),
+)
+
+_ZERO3 = (0.0, 0.0, 0.0)
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+# ---------------------------------------------------------------------------------------
+# Formatting
+# ---------------------------------------------------------------------------------------
+
+
+def fmt(value: float) -> str:
+    """Format a number exactly and deterministically.
+
+    Parameters
+    ----------
+    value : float
+        A finite number.
+
+    Returns
+    -------
+    str
+        The shortest decimal text that reads back as the same float: for
+        1e-4 ≤ |x| < 1e6 Python's ``repr`` without a trailing ``.0`` (``25``,
+        ``13.45``), otherwise scientific notation with the fewest digits
+        (``5e+10``, ``5.35e+11``, ``1e-06``); zero (also ``-0.0``) is written ``0``.
+
+    Raises
+    ------
+    ValueError
+        If the value is NaN or infinite.
+    """
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"non-finite number {x!r} in a scene")
+    if x == 0.0:
+        return "0"
+    if 1e-4 <= abs(x) < 1e6:
+        text = repr(x)
+        return text[:-2] if text.endswith(".0") else text
+    for digits in range(17):
+        text = format(x, f".{digits}e")
+        if float(text) == x:
+            return text
+    return repr(x)  # pragma: no cover - 17 significant digits always round-trip
+
+
+def fmt_vec(values: Iterable[float]) -> str:
+    """Format a sequence of numbers as a space-separated attribute value.
+
+    Parameters
+    ----------
+    values : iterable of float
+        The numbers.
+
+    Returns
+    -------
+    str
+        The numbers formatted by :func:`fmt`, separated by single spaces.
+    """
+    return " ".join(fmt(v) for v in values)
+
+
+def _name(name: str) -> str:
+    if not _NAME.match(name):
+        raise ValueError(f"invalid name {name!r} in a scene")
+    return name
+
+
+class _Writer:
+    """Line-oriented XML writer with fixed attribute order and 2-space indentation."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.depth = 0
+
+    @staticmethod
+    def _attrs(attrs: Sequence[tuple[str, str]]) -> str:
+        for _, value in attrs:
+            if any(c in value for c in '<>&"'):
+                raise ValueError(f"attribute value {value!r} needs escaping")
+        return "".join(f' {key}="{value}"' for key, value in attrs)
+
+    def empty(self, tag: str, *attrs: tuple[str, str]) -> None:
+        self.lines.append("  " * self.depth + f"<{tag}{self._attrs(attrs)}/>")
+
+    def open(self, tag: str, *attrs: tuple[str, str]) -> None:
+        self.lines.append("  " * self.depth + f"<{tag}{self._attrs(attrs)}>")
+        self.depth += 1
+
+    def close(self, tag: str) -> None:
+        self.depth -= 1
+        self.lines.append("  " * self.depth + f"</{tag}>")
+
+    def comment(self, text: str) -> None:
+        if "--" in text:
+            raise ValueError("'--' is not allowed in an XML comment")
+        self.lines.append("  " * self.depth + f"<!-- {text} -->")
+
+    def blank(self) -> None:
+        self.lines.append("")
+
+    def text(self) -> str:
+        if self.depth != 0:
+            raise RuntimeError("unbalanced XML elements")
+        return "\n".join(self.lines) + "\n"
+
+
+# ---------------------------------------------------------------------------------------
+# Building blocks
+# ---------------------------------------------------------------------------------------
+
+
+def _check_inertia(link: str, mass: float, moments: Sequence[float]) -> None:
+    if not mass > 0.0:
+        raise ValueError(f"link {link!r}: mass must be positive, got {mass!r}")
+    if any(not m > 0.0 for m in moments):
+        raise ValueError(f"link {link!r}: principal moments must be positive, got {moments}")
+    if 2.0 * max(moments) > sum(moments):
+        raise ValueError(
+            f"link {link!r}: principal moments {moments} violate the triangle inequality"
+        )
+
+
+def _begin(w: _Writer, name: str, description: str) -> None:
+    w.lines.append('<?xml version="1.0"?>')
+    w.comment(f"{description}")
+    w.comment("Generated by rt70.scenes.generate; do not edit by hand.")
+    w.open("robot", ("name", _name(name)), ("xmlns:rt70", RT70_NS))
+    w.empty("link", ("name", ROOT_LINK))
+
+
+def _end(w: _Writer) -> str:
+    w.close("robot")
+    return w.text()
+
+
+def _joint(
+    w: _Writer,
+    name: str,
+    jtype: str,
+    parent: str,
+    child: str,
+    xyz: Sequence[float] = _ZERO3,
+    rpy: Sequence[float] = _ZERO3,
+    axis: Sequence[int] = (0, 0, 1),
+) -> None:
+    if jtype not in ("revolute", "prismatic", "fixed"):
+        raise ValueError(f"joint type {jtype!r} is not used in rt70 scenes")
+    w.open("joint", ("name", _name(name)), ("type", jtype))
+    w.empty("parent", ("link", _name(parent)))
+    w.empty("child", ("link", _name(child)))
+    w.empty("origin", ("xyz", fmt_vec(xyz)), ("rpy", fmt_vec(rpy)))
+    if jtype != "fixed":
+        w.empty("axis", ("xyz", " ".join(str(int(a)) for a in axis)))
+        w.empty("limit", *((key, fmt(value)) for key, value in _LIMIT))
+    w.close("joint")
+
+
+def _massless_link(w: _Writer, name: str) -> None:
+    w.empty("link", ("name", _name(name)))
+
+
+def _massive_link(
+    w: _Writer,
+    name: str,
+    mass: float,
+    moments: Sequence[float],
+    com: Sequence[float] = _ZERO3,
+    rpy: Sequence[float] = _ZERO3,
+) -> None:
+    """Write a link whose inertia has principal ``moments`` on axes rotated by ``rpy``."""
+    _check_inertia(name, mass, moments)
+    ixx, iyy, izz = moments
+    w.open("link", ("name", _name(name)))
+    w.open("inertial")
+    w.empty("origin", ("xyz", fmt_vec(com)), ("rpy", fmt_vec(rpy)))
+    w.empty("mass", ("value", fmt(mass)))
+    w.empty(
+        "inertia",
+        ("ixx", fmt(ixx)),
+        ("ixy", "0"),
+        ("ixz", "0"),
+        ("iyy", fmt(iyy)),
+        ("iyz", "0"),
+        ("izz", fmt(izz)),
+    )
+    w.close("inertial")
+    w.close("link")
+
+
+def pair_joint_names(body: str) -> list[str]:
+    """Return the names of the six joints of a body's elastic pair.
+
+    Parameters
+    ----------
+    body : str
+        The body (child link) name.
+
+    Returns
+    -------
+    list of str
+        ``<body>_x, <body>_y, <body>_z, <body>_rx, <body>_ry, <body>_rz``: the book's
+        pair coordinates ``[x, y, z, β, θ, α]`` in order.
+    """
+    return [f"{body}_{axis}" for axis, _, _ in _PAIR_JOINTS]
+
+
+def _six_dof_body(
+    w: _Writer,
+    body: str,
+    parent: str,
+    offset: Sequence[float],
+    mass: float,
+    moments: Sequence[float],
+    com: Sequence[float] = _ZERO3,
+    inertia_rpy: Sequence[float] = _ZERO3,
+) -> None:
+    """Write a body joined to ``parent`` by six 1-DOF joints in series (a 6-DOF pair).
+
+    The first joint's origin is the construction offset; the other five have zero
+    origin. Intermediate links are massless; the body's inertia sits on the last link,
+    named after the body.
+    """
+    w.comment(f"{body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}]")
+    previous = parent
+    for k, (axis, jtype, direction) in enumerate(_PAIR_JOINTS):
+        last = k == len(_PAIR_JOINTS) - 1
+        child = body if last else f"{body}_{axis}_link"
+        _joint(
+            w,
+            f"{body}_{axis}",
+            jtype,
+            previous,
+            child,
+            xyz=offset if k == 0 else _ZERO3,
+            axis=direction,
+        )
+        if last:
+            _massive_link(w, child, mass, moments, com, inertia_rpy)
+        else:
+            _massless_link(w, child)
+        previous = child
+
+
+def _gravity(w: _Writer, g: Sequence[float]) -> None:
+    w.empty("rt70:gravity", ("xyz", fmt_vec(g)))
+
+
+def _bushing(
+    w: _Writer,
+    name: str,
+    stiffness: Sequence[float],
+    damping: Sequence[float],
+    link1: str,
+    link2: str,
+    xyz1: Sequence[float] = _ZERO3,
+    rpy1: Sequence[float] = _ZERO3,
+    xyz2: Sequence[float] = _ZERO3,
+    rpy2: Sequence[float] = _ZERO3,
+) -> None:
+    if len(stiffness) != 6 or len(damping) != 6:
+        raise ValueError(f"bushing {name!r} needs six stiffness and six damping values")
+    w.open(
+        "rt70:bushing",
+        ("name", _name(name)),
+        ("stiffness", fmt_vec(stiffness)),
+        ("damping", fmt_vec(damping)),
+    )
+    w.empty("rt70:frame1", ("link", _name(link1)), ("xyz", fmt_vec(xyz1)), ("rpy", fmt_vec(rpy1)))
+    w.empty("rt70:frame2", ("link", _name(link2)), ("xyz", fmt_vec(xyz2)), ("rpy", fmt_vec(rpy2)))
+    w.close("rt70:bushing")
+
+
+def _gamma_ends(row: Sequence[int], what: str) -> tuple[int | None, int]:
+    """Return (i, j) of a topology-matrix row: −1 at i (None for the ground), +1 at j."""
+    minus = [k for k, v in enumerate(row) if v == -1]
+    plus = [k for k, v in enumerate(row) if v == 1]
+    if len(plus) != 1 or len(minus) > 1 or len(minus) + len(plus) != sum(v != 0 for v in row):
+        raise ValueError(f"{what}: topology row {row} is not one link")
+    return (minus[0] if minus else None), plus[0]
+
+
+# ---------------------------------------------------------------------------------------
+# Scenes
+# ---------------------------------------------------------------------------------------
+
+
+def rt70_scene() -> str:
+    """Build the 42-DOF nonlinear RT-70 of the §4.2.3 listing.
+
+    Returns
+    -------
+    str
+        URDF text: seven bodies, each on a 6-DOF pair (six 1-DOF joints) in pair order
+        1..7, direct elastic pairs as bushings, the two strut packages, gravity and the
+        optical points.
+    """
+    d = rt70_data
+    bodies = {b["name"]: b for b in d.LISTING_BODIES}
+    w = _Writer()
+    _begin(
+        w,
+        "rt70",
+        "RT-70 radio telescope, 42-DOF nonlinear model (Dubarenko 2007, "
+        "listing of section 4.2.3, errata in docs/rt70-errata.md)",
+    )
+    for body in d.LISTING_BODIES:
+        _six_dof_body(
+            w,
+            body["name"],
+            body["parent"],
+            body["offset"],
+            body["mass"],
+            body["moments"],
+            body["com"],
+        )
+    w.blank()
+    w.comment("Gravity (erratum 2: z up)")
+    _gravity(w, d.LISTING_GRAVITY)
+    w.comment("Direct elastic pairs: frame 1 = construction frame, frame 2 = body frame")
+    for pair in d.LISTING_DIRECT_PAIRS:
+        child = bodies[pair["child"]]
+        _bushing(
+            w,
+            pair["name"],
+            pair["stiffness"],
+            pair["damping"],
+            child["parent"],
+            child["name"],
+            xyz1=child["offset"],
+        )
+    w.comment("Strut packages (erratum 7: mirrored attachment points, same inclination)")
+    for package in d.LISTING_STRUT_PACKAGES:
+        child = bodies[package["child"]]
+        w.open(
+            "rt70:strut_package",
+            ("name", _name(package["name"])),
+            ("parent", _name(child["parent"])),
+            ("child", _name(child["name"])),
+            ("xyz", fmt_vec(child["offset"])),
+            ("rpy", fmt_vec(_ZERO3)),
+        )
+        for strut in package["struts"]:
+            w.empty(
+                "rt70:strut",
+                ("name", _name(strut["name"])),
+                ("xyz", fmt_vec(strut["xyz"])),
+                ("rpy", fmt_vec(strut["rpy"])),
+                ("stiffness", fmt_vec(strut["stiffness"])),
+                ("damping", fmt_vec(strut["damping"])),
+            )
+        w.close("rt70:strut_package")
+    w.comment("Optical points (section 4.1.8)")
+    for point in d.LISTING_OPTICAL_POINTS:
+        w.empty(
+            "rt70:optical_point",
+            ("name", _name(point["name"])),
+            ("link", _name(point["link"])),
+            ("xyz", fmt_vec(point["xyz"])),
+        )
+    return _end(w)
+
+
+def _torsional_scene(
+    name: str,
+    description: str,
+    nodes: Sequence[tuple[str, float]],
+    links: Sequence[tuple[str, float]],
+    gamma: Sequence[Sequence[int]],
+) -> str:
+    """Coaxial nodes rotating about z, joined by torsion springs (chapter 2).
+
+    ``nodes`` are (name, I in kgf·s²·m), ``links`` (name, C in kgf·m/rad), one per row
+    of ``gamma``; both are converted to SI here.
+    """
+    if len(links) != len(gamma) or any(len(row) != len(nodes) for row in gamma):
+        raise ValueError(f"{name}: topology matrix does not match the tables")
+    w = _Writer()
+    _begin(w, name, description)
+    for k, (node, inertia) in enumerate(nodes, start=1):
+        izz = inertia * rt70_data.KGF
+        _joint(w, f"node{k}", "revolute", ROOT_LINK, node, axis=(0, 0, 1))
+        _massive_link(w, node, rt70_data.CHAPTER2_NODE_MASS, (izz, izz, izz))
+    w.blank()
+    _gravity(w, (0.0, 0.0, -9.81))
+    w.comment("Torsion springs about z, one per row of the topology matrix")
+    for (link, stiffness), row in zip(links, gamma, strict=True):
+        i, j = _gamma_ends(row, f"{name} link {link}")
+        first = ROOT_LINK if i is None else nodes[i][0]
+        second = nodes[j][0]
+        if link != f"{first}_{second}":
+            raise ValueError(f"{name}: link {link!r} does not join {first!r} and {second!r}")
+        _bushing(w, link, (0.0,) * 5 + (stiffness * rt70_data.KGF,), (0.0,) * 6, first, second)
+    return _end(w)
+
+
+def rt70_elevation_scene() -> str:
+    """Build the chapter-2 elevation model (§2.4, 6 masses, Γβ).
+
+    Returns
+    -------
+    str
+        URDF text: six coaxial nodes, each on a revolute joint about z, and five torsion
+        springs (Tables 2.3, 2.4 converted to SI).
+    """
+    d = rt70_data
+    return _torsional_scene(
+        "rt70_elevation",
+        "RT-70 elevation model, 6 masses (Dubarenko 2007, section 2.4, Tables 2.3-2.4)",
+        [(n["name"], n["I"]) for n in d.ELEVATION_NODES],
+        [(c["name"], c["C"]) for c in d.ELEVATION_LINKS],
+        d.GAMMA_BETA,
+    )
+
+
+def rt70_azimuth_scene() -> str:
+    """Build the chapter-2 azimuth model at elevation 0° (§2.3, 7 masses, Γα).
+
+    Returns
+    -------
+    str
+        URDF text: seven coaxial nodes and six torsion springs (Tables 2.1, 2.2,
+        elevation-0° columns, converted to SI); no spring to the ground.
+    """
+    d = rt70_data
+    return _torsional_scene(
+        "rt70_azimuth",
+        "RT-70 azimuth model at elevation 0 deg, 7 masses (Dubarenko 2007, section 2.3, "
+        "Tables 2.1-2.2)",
+        [(n["name"], n["I_el0"]) for n in d.AZIMUTH_NODES],
+        [(c["name"], c["C_el0"]) for c in d.AZIMUTH_LINKS],
+        d.GAMMA_ALPHA,
+    )
+
+
+def rt70_azimuth_el90_scene() -> str:
+    """Build the chapter-2 azimuth model at elevation 90° (§2.3, 7 masses, Γα).
+
+    Returns
+    -------
+    str
+        URDF text as :func:`rt70_azimuth_scene`, with the elevation-90° columns.
+    """
+    d = rt70_data
+    return _torsional_scene(
+        "rt70_azimuth_el90",
+        "RT-70 azimuth model at elevation 90 deg, 7 masses (Dubarenko 2007, section 2.3, "
+        "Tables 2.1-2.2)",
+        [(n["name"], n["I_el90"]) for n in d.AZIMUTH_NODES],
+        [(c["name"], c["C_el90"]) for c in d.AZIMUTH_LINKS],
+        d.GAMMA_ALPHA,
+    )
+
+
+def double_pendulum_scene() -> str:
+    """Build the planar 2R arm (companion sources, test mechanism 1).
+
+    Returns
+    -------
+    str
+        URDF text: two uniform rods on revolute joints about z, the second joint at the
+        end of the first rod, gravity along −y.
+    """
+    d = mechanisms.DOUBLE_PENDULUM
+    w = _Writer()
+    _begin(
+        w, "double_pendulum", "Planar 2R arm (double pendulum) in the x-y plane, gravity along -y"
+    )
+    parent, offset = ROOT_LINK, _ZERO3
+    for link in d["links"]:
+        m, length = link["mass"], link["length"]
+        i_c = m * length**2 / 12.0
+        _joint(w, link["joint"], "revolute", parent, link["name"], xyz=offset, axis=(0, 0, 1))
+        _massive_link(w, link["name"], m, (d["I_axial"], i_c, i_c), com=(length / 2.0, 0.0, 0.0))
+        parent, offset = link["name"], (length, 0.0, 0.0)
+    w.blank()
+    _gravity(w, d["gravity"])
+    return _end(w)
+
+
+def three_masses_scene() -> str:
+    """Build the §2.1 system of three point masses with elastic links (along x).
+
+    Returns
+    -------
+    str
+        URDF text: three point masses on prismatic joints along x at their rest
+        positions, and one x-only spring/damper per row of the topology matrix (2.3).
+    """
+    d = mechanisms.THREE_MASSES
+    masses = d["masses"]
+    w = _Writer()
+    _begin(
+        w,
+        "three_masses",
+        "Three point masses with elastic links (Dubarenko 2007, "
+        "section 2.1, Fig. 2.1, eq. 2.3), motion along x",
+    )
+    for mass in masses:
+        _joint(
+            w, mass["joint"], "prismatic", ROOT_LINK, mass["name"], xyz=mass["rest"], axis=(1, 0, 0)
+        )
+        moment = d["point_moment"]
+        _massive_link(w, mass["name"], mass["mass"], (moment, moment, moment))
+    w.blank()
+    _gravity(w, d["gravity"])
+    w.comment("Springs along x; frame 1 sits at the rest position of the second end")
+    for row, stiffness in zip(d["gamma"], d["stiffness"], strict=True):
+        i, j = _gamma_ends(row, "three_masses")
+        second = masses[j]
+        if i is None:
+            first_link, name = ROOT_LINK, f"ground_{second['name']}"
+            xyz1 = second["rest"]
+        else:
+            first = masses[i]
+            first_link, name = first["name"], f"{first['name']}_{second['name']}"
+            xyz1 = tuple(b - a for a, b in zip(first["rest"], second["rest"], strict=True))
+        damping = d["damping_ratio"] * stiffness
+        _bushing(
+            w,
+            name,
+            (stiffness,) + (0.0,) * 5,
+            (damping,) + (0.0,) * 5,
+            first_link,
+            second["name"],
+            xyz1=xyz1,
+        )
+    return _end(w)
+
+
+def two_body_gravity_scene() -> str:
+    """Build the two 6-DOF bodies of §4.2.3, exercises 1–2.
+
+    Returns
+    -------
+    str
+        URDF text: body 1 on world and body 2 on body 1, each by six 1-DOF joints;
+        joint springs on body 1's six coordinates, a bushing between the bodies,
+        non-zero centre-of-mass offsets and a rotated inertia on body 2, gravity along −z.
+    """
+    d = mechanisms.TWO_BODY_GRAVITY
+    bodies = {b["name"]: b for b in d["bodies"]}
+    ratio = d["damping_ratio"]
+    w = _Writer()
+    _begin(
+        w,
+        "two_body_gravity",
+        "Two 6-DOF bodies with springs in gravity (Dubarenko 2007, section 4.2.3, exercises 1-2)",
+    )
+    for body in d["bodies"]:
+        _six_dof_body(
+            w,
+            body["name"],
+            body["parent"],
+            body["offset"],
+            body["mass"],
+            body["moments"],
+            body["com"],
+            body["inertia_rpy"],
+        )
+    w.blank()
+    _gravity(w, d["gravity"])
+    w.comment("C01, D01: springs on body 1's pair coordinates")
+    ground = d["ground_springs"]
+    for joint, stiffness in zip(pair_joint_names(ground["body"]), ground["stiffness"], strict=True):
+        w.empty(
+            "rt70:joint_spring",
+            ("name", f"{joint}_spring"),
+            ("joint", joint),
+            ("stiffness", fmt(stiffness)),
+            ("damping", fmt(ratio * stiffness)),
+        )
+    w.comment("C12, D12: bushing between body 1 and body 2")
+    bushing = d["bushing"]
+    child = bodies[bushing["child"]]
+    _bushing(
+        w,
+        bushing["name"],
+        bushing["stiffness"],
+        [ratio * c for c in bushing["stiffness"]],
+        child["parent"],
+        child["name"],
+        xyz1=child["offset"],
+    )
+    return _end(w)
+
+
+#: Scene name → function returning the scene's URDF text.
+SCENES: dict[str, Callable[[], str]] = {
+    "rt70": rt70_scene,
+    "rt70_elevation": rt70_elevation_scene,
+    "rt70_azimuth": rt70_azimuth_scene,
+    "rt70_azimuth_el90": rt70_azimuth_el90_scene,
+    "double_pendulum": double_pendulum_scene,
+    "three_masses": three_masses_scene,
+    "two_body_gravity": two_body_gravity_scene,
+}
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_all(directory: Path) -> list[Path]:
+    """Write every scene as ``<name>.urdf`` into ``directory``.
+
+    Each file is written to a temporary file in the same directory and moved into place
+    with :func:`os.replace`, so a reader never sees a partial file.
+
+    Parameters
+    ----------
+    directory : Path
+        Output directory; created if missing.
+
+    Returns
+    -------
+    list of Path
+        The written files, in the order of :data:`SCENES`.
+    """
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, build in SCENES.items():
+        path = directory / f"{name}.urdf"
+        _write_atomic(path, build())
+        written.append(path)
+    return written
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Regenerate the scene files (command-line entry point).
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments; default ``sys.argv[1:]``. One optional positional argument: the
+        output directory (default :data:`DEFAULT_DIRECTORY`).
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
+    parser = argparse.ArgumentParser(
+        prog="python -m rt70.scenes.generate",
+        description="Regenerate the rt70 scene URDF files from the book's data.",
+    )
+    parser.add_argument(
+        "directory",
+        nargs="?",
+        type=Path,
+        default=DEFAULT_DIRECTORY,
+        help=f"output directory (default: {DEFAULT_DIRECTORY})",
+    )
+    args = parser.parse_args(argv)
+    for path in write_all(args.directory):
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,132 @@
+"""The textbook algorithm agrees with Pinocchio on every scene."""
+
+import json
+
+import numpy as np
+import pytest
+
+from rt70.cli import main
+from rt70.scene import URDF_DIR, load_scene, scene_names
+from rt70.textbook import dynamics, forces
+from rt70.validate import QUANTITIES, cross_check
+
+TOL = 1e-10
+
+
+def test_every_scene_is_covered():
+    assert {
+        "rt70",
+        "rt70_azimuth",
+        "rt70_elevation",
+        "double_pendulum",
+        "three_masses",
+        "two_body_gravity",
+    } <= set(scene_names())
+
+
+@pytest.mark.parametrize("name", scene_names())
+def test_scene_agrees_with_pinocchio(name):
+    records = cross_check(load_scene(name), samples=5, seed=123, repeat=1)
+    assert [r.quantity for r in records] == list(QUANTITIES)
+    for r in records:
+        assert r.max_rel_err <= TOL, f"{name} {r.quantity}: {r.max_rel_err:.3g}"
+
+
+def test_double_pendulum_reference_values():
+    """Companion sources, test mechanism 1: q = (0.3, −0.5), q̇ = (1, 2), gravity −y."""
+    scene = load_scene("double_pendulum")
+    tm, td = scene.textbook, scene.textbook_data
+    q, qd = np.array([0.3, -0.5]), np.array([1.0, 2.0])
+    A = dynamics.mass_matrix(tm, td, q)
+    assert np.allclose(A, [[2.54424923, 0.77212461], [0.77212461, 0.33333333]], atol=1e-8)
+    assert np.allclose(dynamics.bias_force(tm, td, q, qd), [1.91770215, -0.23971277], atol=1e-8)
+    # the companion source prints g(q) on the left-hand side; Q_g = −g(q)
+    assert np.allclose(-dynamics.gravity_force(tm, td, q), [18.865003, 4.80722656], atol=1e-6)
+    # closed forms of the same source
+    l1, lc, m, inertia = 1.0, 0.5, 1.0, 1.0 / 12.0
+    c2 = np.cos(q[1])
+    assert np.isclose(A[0, 0], 2 * inertia + m * lc**2 + m * (l1**2 + lc**2 + 2 * l1 * lc * c2))
+    assert np.isclose(A[0, 1], inertia + m * (lc**2 + l1 * lc * c2))
+    assert np.isclose(A[1, 1], inertia + m * lc**2)
+
+
+def test_rt70_mass_matrix_spd_and_equal_to_crba():
+    scene = load_scene("rt70")
+    tm, td, ref = scene.textbook, scene.textbook_data, scene.reference
+    assert tm.nv == 42 and tm.nb == 7 and set(tm.kind) == {"euler6"}
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q = rng.uniform(-0.5, 0.5, tm.nv)
+        A = dynamics.mass_matrix(tm, td, q)
+        assert np.array_equal(A, A.T) or np.abs(A - A.T).max() <= 1e-15 * np.abs(A).max()
+        assert np.linalg.eigvalsh(A).min() > 0.0
+        A_ref = ref.mass_matrix(scene.to_reference(q))[np.ix_(scene.perm, scene.perm)]
+        assert np.abs(A - A_ref).max() <= TOL * np.abs(A_ref).max()
+
+
+@pytest.mark.parametrize("name", ["rt70", "two_body_gravity", "double_pendulum"])
+def test_energies_match_pinocchio(name):
+    scene = load_scene(name)
+    tm, td, ref = scene.textbook, scene.textbook_data, scene.reference
+    rng = np.random.default_rng(9)
+    q, qd = rng.uniform(-0.5, 0.5, tm.nv), rng.uniform(-1, 1, tm.nv)
+    qp, vp = scene.to_reference(q), scene.to_reference(qd)
+    T = forces.kinetic_energy(tm, td, q, qd)
+    assert T > 0.0
+    assert abs(T - ref.kinetic_energy(qp, vp)) <= 1e-12 * T
+    Ug = forces.gravity_potential(tm, td, q)
+    assert abs(Ug - ref.gravity_potential(qp)) <= 1e-12 * max(abs(Ug), 1.0)
+    Us = forces.spring_potential(tm, td, q)
+    assert abs(Us - ref.spring_potential(qp)) <= 1e-12 * max(Us, 1.0)
+
+
+def test_power_balance_of_equations_of_motion():
+    """d/dt (T + U) = q̇ᵀ Q_d along q̈ from the textbook equations (energy audit, (1.73))."""
+    scene = load_scene("two_body_gravity")
+    tm, td = scene.textbook, scene.textbook_data
+    rng = np.random.default_rng(2)
+    q, qd = rng.uniform(-0.3, 0.3, tm.nv), rng.uniform(-1, 1, tm.nv)
+
+    def energy(q, qd):
+        return (
+            forces.kinetic_energy(tm, td, q, qd)
+            + forces.gravity_potential(tm, td, q)
+            + forces.spring_potential(tm, td, q)
+        )
+
+    Qc, Qd = forces.spring_damper_force(tm, td, q, qd)
+    qdd = dynamics.forward_dynamics(tm, td, q, qd, Qc + Qd)
+    h = 1e-6
+    dE = (energy(q + h * qd, qd + h * qdd) - energy(q - h * qd, qd - h * qdd)) / (2 * h)
+    assert np.isclose(dE, qd @ Qd, rtol=1e-6)
+
+
+def test_cli_validate_all_scenes_exit_0(capsys):
+    assert main(["validate", "--samples", "2"]) == 0
+    out = capsys.readouterr().out
+    for name in scene_names():
+        assert name in out
+
+
+def test_cli_validate_json(capsys):
+    assert main(["validate", "--json", "--samples", "2", str(URDF_DIR / "rt70.urdf")]) == 0
+    records = json.loads(capsys.readouterr().out)
+    assert len(records) == len(QUANTITIES)
+    keys = {
+        "target",
+        "nv",
+        "quantity",
+        "max_abs_err",
+        "max_rel_err",
+        "t_textbook_s",
+        "t_reference_s",
+    }
+    for r in records:
+        assert set(r) == keys
+        assert r["target"] == "rt70" and r["nv"] == 42
+        assert r["max_rel_err"] <= TOL
+
+
+def test_cli_validate_reports_disagreement(capsys):
+    """A tolerance no floating-point computation can meet makes the check fail (exit 1)."""
+    assert main(["validate", "--samples", "1", "--tolerance", "0", "rt70"]) == 1

@@ -1,0 +1,115 @@
+"""Spring and damper forces: conservative, and the book's strut-package matrix at q = 0."""
+
+import numpy as np
+import pytest
+
+from rt70.scene import load_scene
+from rt70.textbook import forces
+from rt70.textbook.spatial import placement, rpy_matrix
+
+
+@pytest.fixture(scope="module")
+def rt70_scene():
+    return load_scene("rt70")
+
+
+def package_matrix(struts, attr):
+    """The book's package matrix Σ_s L_s C_s L_sᵀ, L_s = T(r_s)[c_s] (4.85)–(4.92)."""
+    total = np.zeros((6, 6))
+    for b in struts:
+        L_s = placement(b.frame2.xyz, rpy_matrix(b.frame2.rpy))
+        total += L_s @ np.diag(getattr(b, attr)) @ L_s.T
+    return total
+
+
+@pytest.mark.parametrize("package, body", [("platform_base", "base"), ("base_rigel", "rigel")])
+def test_strut_package_linearises_to_book_matrix(rt70_scene, package, body):
+    """At q = 0, −∂Q_c/∂q_j and −∂Q_d/∂q̇_j of a package equal Σ L_s C_s L_sᵀ, Σ L_s D_s L_sᵀ."""
+    tm, td = rt70_scene.textbook, rt70_scene.textbook_data
+    struts = [b for b in rt70_scene.description.bushings if b.package == package]
+    assert len(struts) in (2, 4)
+    j = tm.body_names.index(body)
+    cols = tm.coords(j)
+    q0 = np.zeros(tm.nv)
+    from rt70.textbook.kinematics import update_structure
+
+    update_structure(tm, td, q0)
+    K = np.zeros((6, 6))
+    Dm = np.zeros((6, 6))
+    for bm in tm.bushings:
+        if bm.name.startswith(package + "/"):
+            d = forces.bushing_deformation(td, bm)
+            assert np.allclose(d.delta, 0.0, atol=1e-15)
+            J = d.jacobian[:, cols]
+            K += J.T @ np.diag(bm.stiffness) @ J
+            Dm += J.T @ np.diag(bm.damping) @ J
+    for mine, attr in ((K, "stiffness"), (Dm, "damping")):
+        book = package_matrix(struts, attr)
+        assert np.allclose(mine, book, rtol=1e-14, atol=1e-14 * np.abs(book).max())
+    # and the force itself has that slope (central differences, only the package's pair moves)
+    h = 1e-7
+    slope = np.zeros((6, 6))
+    for c in range(6):
+        dq = np.zeros(tm.nv)
+        dq[cols.start + c] = h
+        qc_plus, _ = forces.spring_damper_force(tm, td, dq, np.zeros(tm.nv))
+        qc_minus, _ = forces.spring_damper_force(tm, td, -dq, np.zeros(tm.nv))
+        slope[:, c] = (qc_plus - qc_minus)[cols] / (2 * h)
+    other = np.zeros((6, 6))  # the stiffness of the other elements acting on this pair
+    for bm in tm.bushings:
+        if not bm.name.startswith(package + "/"):
+            d = forces.bushing_deformation(td, bm)
+            J = d.jacobian[:, cols]
+            other += J.T @ np.diag(bm.stiffness) @ J
+    book = package_matrix(struts, "stiffness")
+    assert np.allclose(-slope - other, book, rtol=1e-6, atol=1e-6 * np.abs(book).max())
+
+
+@pytest.mark.parametrize("name", ["rt70", "two_body_gravity", "rt70_elevation", "three_masses"])
+def test_spring_force_is_minus_gradient_of_potential(name):
+    """Q_c = −∂U/∂q (springs are conservative, formalism §4.4), checked by central differences."""
+    scene = load_scene(name)
+    tm, td = scene.textbook, scene.textbook_data
+    rng = np.random.default_rng(7)
+    q = rng.uniform(-0.3, 0.3, tm.nv)
+    Qc, _ = forces.spring_damper_force(tm, td, q, np.zeros(tm.nv))
+    h = 1e-6
+    grad = np.empty(tm.nv)
+    for i in range(tm.nv):
+        e = np.zeros(tm.nv)
+        e[i] = h
+        grad[i] = (
+            forces.spring_potential(tm, td, q + e) - forces.spring_potential(tm, td, q - e)
+        ) / (2 * h)
+    scale = np.abs(Qc).max()
+    assert np.abs(Qc + grad).max() <= 1e-6 * scale
+
+
+def test_damper_power_is_dissipative():
+    """q̇ᵀ Q_d = −δ̇ᵀ D δ̇ ≤ 0 at any state."""
+    scene = load_scene("rt70")
+    tm, td = scene.textbook, scene.textbook_data
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q, qd = rng.uniform(-0.3, 0.3, tm.nv), rng.uniform(-1, 1, tm.nv)
+        _, Qd = forces.spring_damper_force(tm, td, q, qd)
+        assert qd @ Qd < 0.0
+
+
+def test_direct_pair_bushing_deformation_is_pair_coordinates(rt70_scene):
+    """A bushing between E_jc and E_j deforms by exactly q_j (the book's direct pair, (4.83))."""
+    tm, td = rt70_scene.textbook, rt70_scene.textbook_data
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-0.5, 0.5, tm.nv)
+    from rt70.textbook.kinematics import update_structure
+
+    update_structure(tm, td, q)
+    for bm in tm.bushings:
+        if "/" in bm.name:
+            continue
+        d = forces.bushing_deformation(td, bm)
+        j = bm.body2
+        assert np.allclose(d.delta, q[tm.coords(j)], atol=1e-13)
+        expected = np.zeros((6, tm.nv))
+        expected[:, tm.coords(j)] = np.eye(6)
+        assert np.allclose(d.jacobian, expected, atol=1e-12)
