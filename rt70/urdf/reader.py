@@ -81,39 +81,46 @@ class _Reader:
     def fail(self, cls: type[UrdfError], what: str) -> UrdfError:
         return cls(f"{self.source}: {what}")
 
-    def numbers(self, elem: ET.Element, attr: str, count: int, default=None) -> np.ndarray:
+    def numbers(
+        self, elem: ET.Element, attr: str, count: int, default=None, owner: str = ""
+    ) -> np.ndarray:
         raw = elem.get(attr)
-        tag = _tag(elem)
+        tag = f"{owner} <{_tag(elem)}" if owner else f"<{_tag(elem)}"
+        bad = ExtensionError if _tag(elem).startswith("rt70:") else UrdfError
         if raw is None:
             if default is None:
-                raise self.fail(UrdfError, f"<{tag}> lacks attribute '{attr}'")
+                raise self.fail(bad, f"{tag}> lacks attribute '{attr}'")
             return np.array(default, dtype=float)
         try:
             values = np.array([float(tok) for tok in raw.split()], dtype=float)
         except ValueError:
-            raise self.fail(UrdfError, f'<{tag} {attr}="{raw}">: not a list of numbers') from None
+            raise self.fail(bad, f'{tag} {attr}="{raw}">: not a list of numbers') from None
         if values.size != count:
             raise self.fail(
-                UrdfError, f'<{tag} {attr}="{raw}">: expected {count} numbers, got {values.size}'
+                bad, f'{tag} {attr}="{raw}">: expected {count} numbers, got {values.size}'
             )
         if not np.all(np.isfinite(values)):
-            raise self.fail(NonFiniteError, f'<{tag} {attr}="{raw}">: NaN or infinite value')
+            raise self.fail(NonFiniteError, f'{tag} {attr}="{raw}">: NaN or infinite value')
         return values
 
-    def number(self, elem: ET.Element, attr: str, default: float | None = None) -> float:
-        return float(self.numbers(elem, attr, 1, None if default is None else [default])[0])
+    def number(
+        self, elem: ET.Element, attr: str, default: float | None = None, owner: str = ""
+    ) -> float:
+        value = self.numbers(elem, attr, 1, None if default is None else [default], owner)
+        return float(value[0])
 
     def name_of(self, elem: ET.Element) -> str:
         name = elem.get("name")
         if not name:
-            raise self.fail(UrdfError, f"<{_tag(elem)}> without a name")
+            bad = ExtensionError if _tag(elem).startswith("rt70:") else UrdfError
+            raise self.fail(bad, f"<{_tag(elem)}> without a name")
         return name
 
-    def origin(self, elem: ET.Element) -> tuple[np.ndarray, np.ndarray]:
+    def origin(self, elem: ET.Element, owner: str) -> tuple[np.ndarray, np.ndarray]:
         o = elem.find("origin")
         if o is None:
             return _ZERO3.copy(), _ZERO3.copy()
-        return self.numbers(o, "xyz", 3, _ZERO3), self.numbers(o, "rpy", 3, _ZERO3)
+        return self.numbers(o, "xyz", 3, _ZERO3, owner), self.numbers(o, "rpy", 3, _ZERO3, owner)
 
     # --- the document --------------------------------------------------------------
     def robot(self, root: ET.Element) -> RobotDescription:
@@ -146,15 +153,17 @@ class _Reader:
         return Link(name, None if inertial is None else self.inertial(name, inertial))
 
     def inertial(self, link: str, elem: ET.Element) -> Inertial | None:
-        xyz, rpy = self.origin(elem)
+        owner = f"link '{link}' <inertial>"
+        xyz, rpy = self.origin(elem, owner)
         mass_elem = elem.find("mass")
-        mass = 0.0 if mass_elem is None else self.number(mass_elem, "value")
+        mass = 0.0 if mass_elem is None else self.number(mass_elem, "value", owner=owner)
         ie = elem.find("inertia")
         if ie is None:
             tensor = np.zeros((3, 3))
         else:
             ixx, ixy, ixz, iyy, iyz, izz = (
-                self.number(ie, key, 0.0) for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+                self.number(ie, key, 0.0, owner)
+                for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
             )
             tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
         where = f"link '{link}'"
@@ -202,11 +211,11 @@ class _Reader:
             if sub is None or not sub.get("link"):
                 raise self.fail(UrdfError, f"joint '{name}' lacks <{end} link=...>")
             ends[end] = sub.get("link")
-        xyz, rpy = self.origin(elem)
+        xyz, rpy = self.origin(elem, f"joint '{name}'")
         axis_elem = elem.find("axis")
         axis = np.array([1.0, 0.0, 0.0])
         if axis_elem is not None:
-            axis = self.numbers(axis_elem, "xyz", 3)
+            axis = self.numbers(axis_elem, "xyz", 3, owner=f"joint '{name}'")
         norm = float(np.linalg.norm(axis))
         if jtype != "fixed" and norm < 1e-12:
             raise self.fail(UrdfError, f"joint '{name}': zero-length axis")
