@@ -95,3 +95,9 @@ def load_scene(target: str | Path) -> Scene:
         raise UrdfError(f"{path}: cannot read file ({exc})") from None
     desc = read_urdf_string(text, source=str(path))
     return Scene(path.stem, path, text, desc)
+
+
+def scene_from_text(text: str, name: str = "<string>") -> Scene:
+    """Build a scene from URDF text (generated models, tests); ``name`` labels messages."""
+    desc = read_urdf_string(text, source=name)
+    return Scene(name, Path(name), text, desc)
