@@ -1,5 +1,14 @@
 """The reference side: Pinocchio's recursive algorithms on the same URDF scene.
 
+All methods take the state in the book's coordinates, in Pinocchio's joint order:
+one angle per revolute or continuous joint (Pinocchio stores cos/sin), one length per
+prismatic joint, ``[x, y, z, β, θ, α]`` for a floating joint (Pinocchio: position and
+quaternion, velocity ``v = M q̇`` with ``M = diag(cᵀ, ε)``), ``[x, y, α]`` for a planar
+joint; mimic joints are not coordinates (``q_m = k q_s + o``). The map to Pinocchio's
+``(q, v)`` and its Jacobian ``J`` (``v = J q̇``) are built here from Pinocchio's own
+quaternion and roll-pitch-yaw functions, and every result is transformed back:
+``A = Jᵀ A_pin J``, ``B q̇ = Jᵀ rnea(q, v, J̇ q̇)``, ``Q = Jᵀ τ`` (formalism §5).
+
 Pinocchio parses the URDF itself and provides CRBA, RNEA, ABA, gravity and energies.
 Pinocchio has no springs: their generalised forces are computed here from Pinocchio's
 own kinematics — frame placements and frame Jacobians of the attachment points,
@@ -31,6 +40,23 @@ class _Bushing:
     damping: np.ndarray
 
 
+@dataclass(frozen=True)
+class _Coordinate:
+    """One Pinocchio joint seen in book coordinates."""
+
+    joint: int
+    kind: str  # "1dof", "continuous", "floating", "planar", "mimic"
+    names: tuple[str, ...]
+    iq: int
+    iv: int
+    book: int  # first book coordinate (for "mimic": the source's book coordinate)
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+_SUFFIXES = {"floating": (":x", ":y", ":z", ":rx", ":ry", ":rz"), "planar": (":x", ":y", ":rz")}
+
+
 class ReferenceModel:
     """Pinocchio model, data and spring elements of one scene.
 
@@ -58,12 +84,9 @@ class ReferenceModel:
             )
             for b in desc.bushings
         ]
+        self._coordinates(desc)
         self.spring_v = np.array(
             [self.model.idx_vs[self.model.getJointId(s.joint)] for s in desc.joint_springs],
-            dtype=int,
-        )
-        self.spring_q = np.array(
-            [self.model.idx_qs[self.model.getJointId(s.joint)] for s in desc.joint_springs],
             dtype=int,
         )
         self.spring_k = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
@@ -73,6 +96,53 @@ class ReferenceModel:
         self.model_no_gravity.gravity.setZero()
         self.data_no_gravity = self.model_no_gravity.createData()
 
+    def _coordinates(self, desc: RobotDescription) -> None:
+        """Book coordinates of every Pinocchio joint, and whether the map is the identity."""
+        m = self.model
+        mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
+        coords: list[_Coordinate] = []
+        names: list[str] = []
+        book_of: dict[str, int] = {}
+        for i in range(1, m.njoints):
+            name, jm = m.names[i], m.joints[i]
+            short = jm.shortname()
+            if short == "JointModelFreeFlyer":
+                kind = "floating"
+            elif short == "JointModelPlanar":
+                kind = "planar"
+            elif jm.nq == 2 and jm.nv == 1:
+                kind = "continuous"
+            elif jm.nq == 1 and jm.nv == 1:
+                kind = "1dof"
+            else:
+                raise Rt70Error(
+                    f"{desc.source}: joint '{name}': Pinocchio joint {short} unsupported"
+                )
+            if name in mimics:
+                coords.append(_Coordinate(i, "mimic", (), jm.idx_q, jm.idx_v, -1))
+                continue
+            labels = tuple(name + sfx for sfx in _SUFFIXES.get(kind, ("",)))
+            book_of[name] = len(names)
+            coords.append(_Coordinate(i, kind, labels, jm.idx_q, jm.idx_v, len(names)))
+            names.extend(labels)
+        for n, c in enumerate(coords):  # resolve mimic sources
+            if c.kind == "mimic":
+                mimic = mimics[m.names[c.joint]]
+                is_continuous = m.joints[c.joint].nq == 2
+                coords[n] = _Coordinate(
+                    c.joint,
+                    "mimic-continuous" if is_continuous else "mimic",
+                    (),
+                    c.iq,
+                    c.iv,
+                    book_of[mimic.joint],
+                    mimic.multiplier,
+                    mimic.offset,
+                )
+        self.coords = coords
+        self.coordinate_names = names
+        self.identity_map = all(c.kind == "1dof" for c in coords)
+
     @classmethod
     def from_file(cls, desc: RobotDescription, path: str | Path) -> ReferenceModel:
         """Build from a URDF file already read into ``desc``."""
@@ -80,8 +150,8 @@ class ReferenceModel:
 
     @property
     def nv(self) -> int:
-        """Number of velocity coordinates."""
-        return self.model.nv
+        """Number of book coordinates (independent generalised coordinates)."""
+        return len(self.coordinate_names)
 
     def _add_frame(self, name: str, ref: FrameRef) -> int:
         body = self.model.getFrameId(ref.link, pin.BODY)
@@ -92,41 +162,126 @@ class ReferenceModel:
         frame = pin.Frame(name, parent.parentJoint, body, parent.placement * offset, pin.OP_FRAME)
         return self.model.addFrame(frame, False)
 
-    def coordinate_index(self, joint_names: list[str]) -> np.ndarray:
-        """Velocity index in Pinocchio of each named 1-DOF joint."""
-        return np.array([self.model.idx_vs[self.model.getJointId(n)] for n in joint_names])
+    def coordinate_index(self, names: list[str]) -> np.ndarray:
+        """Index among this model's book coordinates of each named coordinate."""
+        position = {n: i for i, n in enumerate(self.coordinate_names)}
+        return np.array([position[n] for n in names], dtype=int)
+
+    # --- book coordinates -> Pinocchio ---------------------------------------------
+    def to_pinocchio(self, q: np.ndarray, qd: np.ndarray | None = None):
+        """Pinocchio's ``(q, v)``, the Jacobian ``J`` (``v = J q̇``) and ``J̇ q̇``.
+
+        ``J`` is None when it is the identity (only 1-DOF joints, no mimic).
+        """
+        if self.identity_map:
+            return q, qd, None, None
+        m = self.model
+        qp = np.zeros(m.nq)
+        J = np.zeros((m.nv, self.nv))
+        Jdqd = np.zeros(m.nv)
+        qd_ = np.zeros(self.nv) if qd is None else qd
+        for c in self.coords:
+            b, iq, iv = c.book, c.iq, c.iv
+            if c.kind == "1dof":
+                qp[iq] = q[b]
+                J[iv, b] = 1.0
+            elif c.kind == "continuous":
+                qp[iq : iq + 2] = np.cos(q[b]), np.sin(q[b])
+                J[iv, b] = 1.0
+            elif c.kind in ("mimic", "mimic-continuous"):
+                angle = c.multiplier * q[b] + c.offset
+                if c.kind == "mimic":
+                    qp[iq] = angle
+                else:
+                    qp[iq : iq + 2] = np.cos(angle), np.sin(angle)
+                J[iv, b] = c.multiplier
+            elif c.kind == "floating":
+                x, phi, dx, dphi = (
+                    q[b : b + 3],
+                    q[b + 3 : b + 6],
+                    qd_[b : b + 3],
+                    qd_[b + 3 : b + 6],
+                )
+                # c = Rx(β) Ry(θ) Rz(α); its transpose has Pinocchio rpy ρ = −φ
+                rho = -phi
+                rot = pin.rpy.rpyToMatrix(rho).T
+                qp[iq : iq + 3] = x
+                qp[iq + 3 : iq + 7] = pin.Quaternion(rot).coeffs()
+                eps = pin.rpy.computeRpyJacobian(rho, pin.WORLD)
+                J[iv : iv + 3, b : b + 3] = rot.T
+                J[iv + 3 : iv + 6, b + 3 : b + 6] = eps
+                omega = eps @ dphi
+                eps_dot = pin.rpy.computeRpyJacobianTimeDerivative(rho, -dphi, pin.WORLD)
+                Jdqd[iv : iv + 3] = -np.cross(omega, rot.T @ dx)
+                Jdqd[iv + 3 : iv + 6] = eps_dot @ dphi
+            else:  # planar: [x, y, α], v = [c3ᵀ (ẋ, ẏ); α̇] in the moving frame
+                x, y, a = q[b : b + 3]
+                ca, sa = np.cos(a), np.sin(a)
+                qp[iq : iq + 4] = x, y, ca, sa
+                J[iv : iv + 2, b : b + 2] = [[ca, sa], [-sa, ca]]
+                J[iv + 2, b + 2] = 1.0
+                dx, dy, da = qd_[b : b + 3]
+                Jdqd[iv : iv + 2] = da * (-sa * dx + ca * dy), da * (-ca * dx - sa * dy)
+        vp = None if qd is None else J @ qd
+        return qp, vp, J, Jdqd
 
     # --- dynamics --------------------------------------------------------------------
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """``pin.crba``, symmetrised."""
-        A = pin.crba(self.model, self.data, q)
-        return np.triu(A) + np.triu(A, 1).T
+        """``Jᵀ crba J``, symmetrised."""
+        qp, _, J, _ = self.to_pinocchio(q)
+        A = pin.crba(self.model, self.data, qp)
+        A = np.triu(A) + np.triu(A, 1).T
+        return A if J is None else J.T @ A @ J
 
-    def bias_force(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``B(q, q̇) q̇ = rnea(q, q̇, 0)`` with gravity switched off."""
-        return pin.rnea(self.model_no_gravity, self.data_no_gravity, q, v, np.zeros(self.nv))
+    def bias_force(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """``B(q, q̇) q̇ = Jᵀ rnea(q, v, J̇ q̇)`` with gravity switched off."""
+        qp, vp, J, Jdqd = self.to_pinocchio(q, qd)
+        if J is None:
+            return pin.rnea(self.model_no_gravity, self.data_no_gravity, qp, vp, np.zeros(self.nv))
+        return J.T @ pin.rnea(self.model_no_gravity, self.data_no_gravity, qp, vp, Jdqd)
 
     def gravity_force(self, q: np.ndarray) -> np.ndarray:
-        """Generalised gravity force on the right-hand side: ``−g(q)``."""
-        return -pin.computeGeneralizedGravity(self.model, self.data, q)
+        """Generalised gravity force on the right-hand side: ``−Jᵀ g(q)``."""
+        qp, _, J, _ = self.to_pinocchio(q)
+        g = pin.computeGeneralizedGravity(self.model, self.data, qp)
+        return -g if J is None else -(J.T @ g)
 
-    def spring_damper_force(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def spring_damper_force(self, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Spring and damper generalised forces from Pinocchio's frame kinematics."""
-        Qc = np.zeros(self.nv)
-        Qd = np.zeros(self.nv)
-        np.subtract.at(Qc, self.spring_v, self.spring_k * q[self.spring_q])
-        np.subtract.at(Qd, self.spring_v, self.spring_d * v[self.spring_v])
+        qp, vp, J, _ = self.to_pinocchio(q, qd)
+        Qc, Qd = self._joint_space_forces(qp, vp, q, qd, J)
+        return (Qc, Qd) if J is None else (J.T @ Qc, J.T @ Qd)
+
+    def _joint_space_forces(self, qp, vp, q, qd, J) -> tuple[np.ndarray, np.ndarray]:
+        """Spring/damper forces as Pinocchio joint torques τ (velocity space)."""
+        nv = self.model.nv
+        Qc, Qd = np.zeros(nv), np.zeros(nv)
+        if self.spring_v.size:
+            angles = self._joint_angles(qp)
+            np.subtract.at(Qc, self.spring_v, self.spring_k * angles[self.spring_v])
+            np.subtract.at(Qd, self.spring_v, self.spring_d * vp[self.spring_v])
         if self.bushings:
-            pin.computeJointJacobians(self.model, self.data, q)
+            pin.computeJointJacobians(self.model, self.data, qp)
             pin.updateFramePlacements(self.model, self.data)
             for b in self.bushings:
                 delta, jac = self._deformation(b)
                 Qc -= jac.T @ (b.stiffness * delta)
-                Qd -= jac.T @ (b.damping * (jac @ v))
+                Qd -= jac.T @ (b.damping * (jac @ vp))
         return Qc, Qd
 
+    def _joint_angles(self, qp: np.ndarray) -> np.ndarray:
+        """Coordinate of every 1-DOF joint, indexed by velocity index (cos/sin → angle)."""
+        out = np.zeros(self.model.nv)
+        for i in range(1, self.model.njoints):
+            jm = self.model.joints[i]
+            if jm.nv == 1 and jm.nq == 1:
+                out[jm.idx_v] = qp[jm.idx_q]
+            elif jm.nv == 1 and jm.nq == 2:
+                out[jm.idx_v] = np.arctan2(qp[jm.idx_q + 1], qp[jm.idx_q])
+        return out
+
     def _deformation(self, b: _Bushing) -> tuple[np.ndarray, np.ndarray]:
-        """δ = [position of frame 2 in frame 1; 1–2–3 angles], and ∂δ/∂q."""
+        """δ = [position of frame 2 in frame 1; 1–2–3 angles], and ∂δ/∂v."""
         m, d = self.model, self.data
         M12 = d.oMf[b.frame1].actInv(d.oMf[b.frame2])
         c12 = M12.rotation
@@ -145,25 +300,45 @@ class ReferenceModel:
         jac[3:] = pin.rpy.computeRpyJacobianInverse(rho, pin.WORLD) @ J_rel[3:]
         return np.concatenate([M12.translation, -rho]), jac
 
-    def forward_dynamics(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``pin.aba`` with the spring and damper forces as ``tau``."""
-        Qc, Qd = self.spring_damper_force(q, v)
-        return pin.aba(self.model, self.data, q, v, Qc + Qd)
+    def forward_dynamics(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """``pin.aba`` with the spring and damper forces as ``tau``, in book coordinates.
+
+        With mimic joints (a constraint ABA cannot take) the reduced equations
+        ``Jᵀ A J q̈ = Jᵀ (τ − rnea(q, v, J̇ q̇))`` are solved with Pinocchio's CRBA and RNEA.
+        """
+        qp, vp, J, Jdqd = self.to_pinocchio(q, qd)
+        Qc, Qd = self._joint_space_forces(qp, vp, q, qd, J)
+        tau = Qc + Qd
+        if J is None:
+            return pin.aba(self.model, self.data, qp, vp, tau)
+        if J.shape[0] == J.shape[1]:
+            vdot = pin.aba(self.model, self.data, qp, vp, tau)
+            return np.linalg.solve(J, vdot - Jdqd)
+        A = pin.crba(self.model, self.data, qp)
+        A = np.triu(A) + np.triu(A, 1).T
+        rhs = J.T @ (tau - pin.rnea(self.model, self.data, qp, vp, Jdqd))
+        return np.linalg.solve(J.T @ A @ J, rhs)
 
     # --- energies --------------------------------------------------------------------
-    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float:
+    def kinetic_energy(self, q: np.ndarray, qd: np.ndarray) -> float:
         """``pin.computeKineticEnergy``."""
-        return float(pin.computeKineticEnergy(self.model, self.data, q, v))
+        qp, vp, _, _ = self.to_pinocchio(q, qd)
+        return float(pin.computeKineticEnergy(self.model, self.data, qp, vp))
 
     def gravity_potential(self, q: np.ndarray) -> float:
         """``pin.computePotentialEnergy`` (gravity only)."""
-        return float(pin.computePotentialEnergy(self.model, self.data, q))
+        qp, _, _, _ = self.to_pinocchio(q)
+        return float(pin.computePotentialEnergy(self.model, self.data, qp))
 
     def spring_potential(self, q: np.ndarray) -> float:
         """``Σ ½ δᵀ C δ`` with δ from Pinocchio's frame placements."""
-        U = 0.5 * float(np.sum(self.spring_k * q[self.spring_q] ** 2))
+        qp, _, _, _ = self.to_pinocchio(q)
+        U = 0.0
+        if self.spring_v.size:
+            angles = self._joint_angles(qp)
+            U += 0.5 * float(np.sum(self.spring_k * angles[self.spring_v] ** 2))
         if self.bushings:
-            pin.computeJointJacobians(self.model, self.data, q)
+            pin.computeJointJacobians(self.model, self.data, qp)
             pin.updateFramePlacements(self.model, self.data)
             for b in self.bushings:
                 delta, _ = self._deformation(b)

@@ -210,24 +210,56 @@ CASES = {
         JointTypeError,
         ("joint 'j1'", "unknown joint type 'banana'"),
     ),
-    **{
-        f"unsupported-joint-type-{jtype}": Case(
-            robot(WORLD, joint("j1", "world", "link1", jtype=jtype), link("link1")),
-            JointTypeError,
-            ("joint 'j1'", f"'{jtype}'", "not supported"),
-        )
-        for jtype in ("floating", "planar", "continuous")
-    },
-    "mimic-joint": Case(
+    "planar-joint-not-about-z": Case(
+        robot(WORLD, joint("j1", "world", "link1", jtype="planar", axis="1 0 0"), link("link1")),
+        JointTypeError,
+        ("joint 'j1'", "planar joint with axis", "only the plane normal to z"),
+    ),
+    "mimic-of-missing-joint": Case(
+        robot(
+            WORLD,
+            joint("j1", "world", "link1"),
+            link("link1"),
+            joint("j2", "link1", "link2", extra='<mimic joint="ghost" multiplier="2"/>'),
+            link("link2"),
+        ),
+        TopologyError,
+        ("joint 'j2'", "<mimic joint='ghost'>", "does not exist"),
+    ),
+    "mimic-of-a-mimic-joint": Case(
         robot(
             WORLD,
             joint("j1", "world", "link1"),
             link("link1"),
             joint("j2", "link1", "link2", extra='<mimic joint="j1" multiplier="2"/>'),
             link("link2"),
+            joint("j3", "link2", "link3", extra='<mimic joint="j2"/>'),
+            link("link3"),
         ),
         JointTypeError,
-        ("joint 'j2'", "<mimic>", "not supported"),
+        ("joint 'j3' mimics 'j2'", "not an independent 1-DOF joint"),
+    ),
+    "mimic-on-a-floating-joint": Case(
+        robot(
+            WORLD,
+            joint("j1", "world", "link1"),
+            link("link1"),
+            joint("j2", "link1", "link2", jtype="floating", extra='<mimic joint="j1"/>'),
+            link("link2"),
+        ),
+        JointTypeError,
+        ("joint 'j2'", "a floating joint cannot mimic"),
+    ),
+    "mimic-couples-revolute-and-prismatic": Case(
+        robot(
+            WORLD,
+            joint("j1", "world", "link1"),
+            link("link1"),
+            joint("j2", "link1", "link2", jtype="prismatic", extra='<mimic joint="j1"/>'),
+            link("link2"),
+        ),
+        JointTypeError,
+        ("joint 'j2' (prismatic) mimics 'j1' (revolute)", "cannot be coupled"),
     ),
     "spring-on-missing-joint": Case(
         robot(*CHAIN, '<rt70:joint_spring name="s1" joint="ghost" stiffness="10"/>'),

@@ -25,7 +25,10 @@ class Data:
     L : numpy.ndarray
         Configuration matrix (4.64), shape (6 nb, 6 nb).
     S : numpy.ndarray
-        Structure matrix ``S = [f]ᵀ Mᵀ L`` (4.66), shape (nv, 6 nb).
+        Structure matrix ``S = [f]ᵀ Mᵀ L`` (4.66), shape (nv, 6 nb); ``S_full`` before
+        the mimic reduction ``S = Gᵀ S_full``.
+    q_full : numpy.ndarray
+        Pair coordinates of the last configuration, ``G q + q_offset``.
     Theta : numpy.ndarray
         Block-diagonal inertia ``Θ = diag(Θ_k)``, shape (6 nb, 6 nb).
     V : numpy.ndarray
@@ -42,7 +45,9 @@ class Data:
         self.Mf: list[np.ndarray] = [np.zeros((6, int(k))) for k in model.ndof]
         self.dMf_qd = np.zeros((nb, 6))
         self.L = np.zeros((6 * nb, 6 * nb))
-        self.S = np.zeros((nv, 6 * nb))
+        self.S_full = np.zeros((model.n_full, 6 * nb))
+        self.S = self.S_full if model.G is None else np.zeros((nv, 6 * nb))
+        self.q_full = np.zeros(model.n_full)
         self.Theta = np.zeros((6 * nb, 6 * nb))
         for j in range(nb):
             self.Theta[6 * j : 6 * j + 6, 6 * j : 6 * j + 6] = model.Theta[j]

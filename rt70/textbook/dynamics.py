@@ -35,15 +35,17 @@ def structure_matrix_rate(model: Model, data: Data, q: np.ndarray, qd: np.ndarra
 
     ``V_j^{k,j} = V_j⁰ − (L_k^j)ᵀ V_k⁰`` is the velocity of body j relative to body k,
     in j's frame. Requires :func:`body_velocities` to have been called for (q, q̇).
+    With mimic constraints (constant G) ``Ṡ = Gᵀ Ṡ_full``.
     """
     L, V = data.L, data.V
-    S_dot = np.zeros_like(data.S)
+    q_full, qd_full = data.q_full, model.expand(qd, offset=False)
+    S_dot = np.zeros_like(data.S_full)
     for k in range(model.nb):
         rows = model.coords(k)
         if rows.stop == rows.start:
             continue
         mf = data.Mf[k]
-        dmf = pair_motion_rate(model, k, q[rows], qd[rows])
+        dmf = pair_motion_rate(model, k, q_full[rows], qd_full[rows])
         for j in range(model.nb):
             L_kj = L[6 * k : 6 * k + 6, 6 * j : 6 * j + 6]
             if not L_kj.any():
@@ -51,7 +53,7 @@ def structure_matrix_rate(model: Model, data: Data, q: np.ndarray, qd: np.ndarra
             v_rel = V[j] - L_kj.T @ V[k]
             L_kj_dot = L_kj @ crf(v_rel)
             S_dot[rows, 6 * j : 6 * j + 6] = dmf.T @ L_kj + mf.T @ L_kj_dot
-    return S_dot
+    return model.reduce(S_dot)
 
 
 def bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:

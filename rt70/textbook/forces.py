@@ -60,11 +60,13 @@ def spring_damper_force(
     q = check_finite("q", q, model.nv)
     qd = check_finite("qd", qd, model.nv)
     update_structure(model, data, q)
-    Qc = np.zeros(model.nv)
-    Qd = np.zeros(model.nv)
+    q_full, qd_full = data.q_full, model.expand(qd, offset=False)
     idx = model.spring_coords
-    np.subtract.at(Qc, idx, model.spring_stiffness * q[idx])
-    np.subtract.at(Qd, idx, model.spring_damping * qd[idx])
+    Qc = np.zeros(model.n_full)
+    Qd = np.zeros(model.n_full)
+    np.subtract.at(Qc, idx, model.spring_stiffness * q_full[idx])
+    np.subtract.at(Qd, idx, model.spring_damping * qd_full[idx])
+    Qc, Qd = model.reduce(Qc), model.reduce(Qd)
     for b in model.bushings:
         d = bushing_deformation(data, b)
         Qc -= d.jacobian.T @ (b.stiffness * d.delta)
@@ -77,7 +79,7 @@ def spring_potential(model: Model, data: Data, q: np.ndarray) -> float:
     q = check_finite("q", q, model.nv)
     update_structure(model, data, q)
     idx = model.spring_coords
-    U = 0.5 * float(np.sum(model.spring_stiffness * q[idx] ** 2))
+    U = 0.5 * float(np.sum(model.spring_stiffness * data.q_full[idx] ** 2))
     for b in model.bushings:
         delta = bushing_deformation(data, b).delta
         U += 0.5 * float(delta @ (b.stiffness * delta))

@@ -9,6 +9,7 @@ from rt70.textbook.data import Data
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import (
     axis_rotation,
+    c3,
     euler123,
     euler_matrix,
     placement,
@@ -39,6 +40,12 @@ def pair_motion(model: Model, j: int, qj: np.ndarray) -> tuple[np.ndarray, np.nd
         mf[:3, :3] = c.T
         mf[3:, 3:] = euler_matrix(qj[3:])
         return qj[:3].copy(), c, mf
+    if kind == "planar":
+        c = c3(qj[2])
+        mf = np.zeros((6, 3))
+        mf[:3, :2] = c.T[:, :2]
+        mf[5, 2] = 1.0
+        return np.array([qj[0], qj[1], 0.0]), c, mf
     a = model.axis[j]
     if kind == "revolute":
         return np.zeros(3), axis_rotation(a, qj[0]), np.concatenate([np.zeros(3), a])[:, None]
@@ -52,6 +59,10 @@ def pair_motion_rate(model: Model, j: int, qj: np.ndarray, qdj: np.ndarray) -> n
 
     For it ``Ṁ_j = diag(ċ_jᵀ, ε̇_j)``, ``ċ = c <ω_rel>``, ``ω_rel = ε φ̇``, so ``ċᵀ = −<ω_rel> cᵀ``.
     """
+    if model.kind[j] == "planar":
+        out = np.zeros((6, 3))
+        out[:3, :2] = (-skew(np.array([0.0, 0.0, qdj[2]])) @ c3(qj[2]).T)[:, :2]
+        return out
     if model.kind[j] != "euler6":
         return np.zeros((6, int(model.ndof[j])))
     phi, dphi = qj[3:], qdj[3:]
@@ -106,20 +117,23 @@ def configuration_matrix(model: Model, data: Data) -> np.ndarray:
 def structure_matrix(model: Model, data: Data) -> np.ndarray:
     """Structure matrix ``S = [f]ᵀ Mᵀ L`` (4.66); ``V⁰ = Sᵀ q̇`` (4.63).
 
-    Row block k (pair k's coordinates), column block j: ``(M_k f_k)ᵀ L_k^j``.
+    Row block k (pair k's coordinates), column block j: ``(M_k f_k)ᵀ L_k^j``. With mimic
+    constraints the rows are reduced to the independent coordinates, ``S = Gᵀ S_full``.
     """
-    S = data.S
+    S = data.S_full
     L = data.L
     for k in range(model.nb):
         rows = model.coords(k)
         S[rows, :] = data.Mf[k].T @ L[6 * k : 6 * k + 6, :]
-    return S
+    data.S = model.reduce(S)
+    return data.S
 
 
 def update_structure(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
     """Run forward kinematics and fill L and S for configuration q; return S."""
     q = check_finite("q", q, model.nv)
-    forward_kinematics(model, data, q)
+    data.q_full = model.expand(q)
+    forward_kinematics(model, data, data.q_full)
     configuration_matrix(model, data)
     return structure_matrix(model, data)
 

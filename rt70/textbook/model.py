@@ -8,12 +8,21 @@ constant ``r_c[j]``, ``c_c[j]``; the pair's own motion is one of
     the book's free elastic pair, ``q_j = [x, y, z, β, θ, α]`` (4.8), ``f_j = 1₆``;
 ``revolute`` / ``prismatic``
     one coordinate about / along the unit ``axis[j]`` (``f_j = [0; a]`` / ``[a; 0]``);
+    URDF ``continuous`` joints are revolute pairs (the angle is the coordinate);
+``planar``
+    ``q_j = [x, y, α]``: translation in the construction frame's x–y plane, then rotation
+    α about its z axis;
 ``fixed``
     no coordinate (``f_j`` has no columns).
 
 A URDF chain of six joints (prismatic x, y, z, revolute x, y, z, zero origins after the
 first, massless links between) is read as one ``euler6`` pair, exactly the layout of
-formalism §5; every other joint is one pair.
+formalism §5, and so is a URDF ``floating`` joint; every other joint is one pair.
+
+URDF ``<mimic>`` joints are holonomic constraints ``q_m = k q_s + o`` (chapter 3): the
+pairs keep their full coordinates ``q_full = G q + q_offset``, and the structure matrix
+is reduced to the independent coordinates, ``S = Gᵀ S_full`` — the book's ``S = fᵀ L``
+elimination with the constraint matrix G in place of the 0/1 mobility f.
 """
 
 from __future__ import annotations
@@ -25,8 +34,17 @@ import numpy as np
 from rt70.textbook.spatial import body_inertia, rpy_matrix
 from rt70.urdf.description import Joint, RobotDescription
 
-PAIR_KINDS = ("euler6", "revolute", "prismatic", "fixed")
-_NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "fixed": 0}
+PAIR_KINDS = ("euler6", "revolute", "prismatic", "planar", "fixed")
+_NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "planar": 3, "fixed": 0}
+_URDF_KIND = {
+    "revolute": "revolute",
+    "continuous": "revolute",
+    "prismatic": "prismatic",
+    "planar": "planar",
+    "floating": "euler6",
+    "fixed": "fixed",
+}
+_SUFFIXES = {"euler6": (":x", ":y", ":z", ":rx", ":ry", ":rz"), "planar": (":x", ":y", ":rz")}
 _EULER6_PATTERN = (
     ("prismatic", (1.0, 0.0, 0.0)),
     ("prismatic", (0.0, 1.0, 0.0)),
@@ -74,7 +92,13 @@ class Model:
     mass, com : numpy.ndarray
         Mass and centre of mass (body frame) of each body.
     q_start, ndof : numpy.ndarray
-        First coordinate index and number of coordinates of each pair.
+        First index and number of each pair's coordinates in ``q_full``.
+    coordinate_names : list of str
+        Name of each independent coordinate (joint name; ``joint:x`` … for multi-DOF
+        URDF joints).
+    G, q_offset : numpy.ndarray or None
+        Mimic constraints ``q_full = G q + q_offset``; None when there are none
+        (``q_full = q``).
     """
 
     name: str
@@ -91,11 +115,14 @@ class Model:
     body_names: list[str]
     coordinate_names: list[str]
     gravity: np.ndarray
+    full_coordinate_names: list[str] = field(default_factory=list)
     link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = field(default_factory=dict)
     bushings: list[BushingModel] = field(default_factory=list)
     spring_coords: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     spring_stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
     spring_damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    G: np.ndarray | None = None
+    q_offset: np.ndarray | None = None
 
     @property
     def nb(self) -> int:
@@ -103,9 +130,24 @@ class Model:
         return len(self.kind)
 
     @property
-    def nv(self) -> int:
-        """Number of generalised coordinates."""
+    def n_full(self) -> int:
+        """Number of pair coordinates, mimic joints included."""
         return int(self.ndof.sum())
+
+    @property
+    def nv(self) -> int:
+        """Number of independent generalised coordinates."""
+        return self.n_full if self.G is None else self.G.shape[1]
+
+    def expand(self, q: np.ndarray, offset: bool = True) -> np.ndarray:
+        """``q_full = G q + q_offset`` (without the offset for velocities)."""
+        if self.G is None:
+            return q
+        return self.G @ q + self.q_offset if offset else self.G @ q
+
+    def reduce(self, Q_full: np.ndarray) -> np.ndarray:
+        """Generalised force on the independent coordinates, ``Gᵀ Q_full``."""
+        return Q_full if self.G is None else self.G.T @ Q_full
 
     def coords(self, j: int) -> slice:
         """Slice of pair j's coordinates in q."""
@@ -157,10 +199,9 @@ def build_model(desc: RobotDescription) -> Model:
             if chain:
                 jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
             else:
-                child, names = joint.child, [joint.name]
-                jkind = joint.type
-                if jkind == "fixed":
-                    names = []
+                child, jkind = joint.child, _URDF_KIND[joint.type]
+                suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
+                names = [joint.name + suffix for suffix in suffixes]
             j = len(kind)
             parent.append(body)
             kind.append(jkind)
@@ -209,10 +250,33 @@ def build_model(desc: RobotDescription) -> Model:
         model.bushings.append(
             BushingModel(b.name, body1, r1, c1, body2, r2, c2, b.stiffness, b.damping)
         )
+    model.full_coordinate_names = list(coord_names)
+    _add_mimic_constraints(model, desc)
     model.spring_coords = np.array([joint_coord[s.joint] for s in desc.joint_springs], dtype=int)
     model.spring_stiffness = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
     model.spring_damping = np.array([s.damping for s in desc.joint_springs], dtype=float)
     return model
+
+
+def _add_mimic_constraints(model: Model, desc: RobotDescription) -> None:
+    """Build ``q_full = G q + q_offset`` from the URDF ``<mimic>`` elements (chapter 3)."""
+    mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
+    if not mimics:
+        return
+    full_names = list(model.coordinate_names)
+    independent = [n for n in full_names if n not in mimics]
+    column = {name: c for c, name in enumerate(independent)}
+    G = np.zeros((len(full_names), len(independent)))
+    offset = np.zeros(len(full_names))
+    for row, name in enumerate(full_names):
+        if name in mimics:
+            m = mimics[name]
+            G[row, column[m.joint]] = m.multiplier
+            offset[row] = m.offset
+        else:
+            G[row, column[name]] = 1.0
+    model.G, model.q_offset = G, offset
+    model.coordinate_names = independent
 
 
 def _frame_on_body(

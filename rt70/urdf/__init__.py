@@ -13,6 +13,7 @@ from rt70.urdf.description import (
     Joint,
     JointSpring,
     Link,
+    Mimic,
     OpticalPoint,
     RobotDescription,
 )
@@ -26,6 +27,7 @@ __all__ = [
     "Joint",
     "JointSpring",
     "Link",
+    "Mimic",
     "OpticalPoint",
     "RobotDescription",
     "read_urdf",

@@ -39,6 +39,15 @@ class Link:
 
 
 @dataclass(frozen=True)
+class Mimic:
+    """URDF ``<mimic>``: ``q = multiplier · q_joint + offset`` (a holonomic constraint)."""
+
+    joint: str
+    multiplier: float
+    offset: float
+
+
+@dataclass(frozen=True)
 class Joint:
     """A URDF joint.
 
@@ -50,6 +59,8 @@ class Joint:
         Origin of the joint frame in the parent link frame (URDF convention).
     axis : numpy.ndarray
         Unit axis in the joint frame (meaningful for revolute, continuous, prismatic).
+    mimic : Mimic or None
+        The joint's ``<mimic>`` coupling, if any.
     """
 
     name: str
@@ -59,6 +70,7 @@ class Joint:
     xyz: np.ndarray
     rpy: np.ndarray
     axis: np.ndarray
+    mimic: Mimic | None = None
 
 
 @dataclass(frozen=True)

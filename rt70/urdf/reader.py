@@ -29,6 +29,7 @@ from rt70.urdf.description import (
     Joint,
     JointSpring,
     Link,
+    Mimic,
     OpticalPoint,
     RobotDescription,
 )
@@ -37,7 +38,10 @@ from rt70.urdf.description import (
 RT70_NS = "urn:rt70:urdf-extensions:1"
 
 #: Joint types rt70 models on both sides (the others are rejected with a clear error).
-SUPPORTED_JOINT_TYPES = ("revolute", "prismatic", "fixed")
+SUPPORTED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+#: Joint types with one coordinate (the only ones a ``<mimic>`` or a joint spring may use).
+ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
 
 _EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point")
 _ZERO3 = np.zeros(3)
@@ -136,6 +140,7 @@ class _Reader:
             raise self.fail(UrdfError, "no <link> elements")
         joints = [self.joint(elem) for elem in root.findall("joint")]
         root_link = self.check_tree(links, joints)
+        self.check_mimics(joints)
         desc = RobotDescription(
             name=root.get("name", ""),
             source=self.source,
@@ -203,8 +208,6 @@ class _Reader:
                 f"joint '{name}': joint type '{jtype}' is not supported "
                 f"(supported: {', '.join(SUPPORTED_JOINT_TYPES)})",
             )
-        if elem.find("mimic") is not None:
-            raise self.fail(JointTypeError, f"joint '{name}': <mimic> joints are not supported")
         ends = {}
         for end in ("parent", "child"):
             sub = elem.find(end)
@@ -219,7 +222,52 @@ class _Reader:
         norm = float(np.linalg.norm(axis))
         if jtype != "fixed" and norm < 1e-12:
             raise self.fail(UrdfError, f"joint '{name}': zero-length axis")
-        return Joint(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis / max(norm, 1e-300))
+        axis = axis / max(norm, 1e-300)
+        if jtype == "planar" and not np.array_equal(axis, [0.0, 0.0, 1.0]):
+            raise self.fail(
+                JointTypeError,
+                f"joint '{name}': planar joint with axis {axis.tolist()}: only the plane normal "
+                "to z (axis 0 0 1) is supported (Pinocchio's planar joint)",
+            )
+        mimic = None
+        mimic_elem = elem.find("mimic")
+        if mimic_elem is not None:
+            owner = f"joint '{name}'"
+            source = mimic_elem.get("joint")
+            if not source:
+                raise self.fail(UrdfError, f"{owner}: <mimic> lacks attribute 'joint'")
+            if jtype not in ONE_DOF_JOINT_TYPES:
+                raise self.fail(JointTypeError, f"{owner}: a {jtype} joint cannot mimic")
+            mimic = Mimic(
+                source,
+                self.number(mimic_elem, "multiplier", 1.0, owner),
+                self.number(mimic_elem, "offset", 0.0, owner),
+            )
+        return Joint(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic)
+
+    def check_mimics(self, joints: list[Joint]) -> None:
+        by_name = {j.name: j for j in joints}
+        for j in joints:
+            if j.mimic is None:
+                continue
+            source = by_name.get(j.mimic.joint)
+            if source is None:
+                raise self.fail(
+                    TopologyError,
+                    f"joint '{j.name}': <mimic joint='{j.mimic.joint}'> does not exist",
+                )
+            if source.type not in ONE_DOF_JOINT_TYPES or source.mimic is not None:
+                raise self.fail(
+                    JointTypeError,
+                    f"joint '{j.name}' mimics '{source.name}', which is not an independent "
+                    "1-DOF joint",
+                )
+            if (j.type == "prismatic") != (source.type == "prismatic"):
+                raise self.fail(
+                    JointTypeError,
+                    f"joint '{j.name}' ({j.type}) mimics '{source.name}' ({source.type}): "
+                    "a revolute and a prismatic coordinate cannot be coupled",
+                )
 
     def check_tree(self, links: dict[str, Link], joints: list[Joint]) -> str:
         names: set[str] = set()
@@ -309,7 +357,7 @@ class _Reader:
             joint = desc.joint(jname)
         except KeyError:
             raise self.fail(ExtensionError, f"{where}: joint '{jname}' does not exist") from None
-        if joint.type not in ("revolute", "prismatic"):
+        if joint.type not in ONE_DOF_JOINT_TYPES:
             raise self.fail(
                 ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"
             )
