@@ -1,0 +1,340 @@
+"""Structure-exploiting, batched form of the book's ``A = S Θ Sᵀ`` and ``B q̇`` (§4.3).
+
+The dense form (:mod:`rt70.textbook.dynamics`) assembles the configuration matrix L
+block by block. Here the chain property ``L_k^j = (L_0^k)⁻¹ L_0^j`` factorises every
+block of L through the ground frame E0, which turns ``S Θ Sᵀ`` into sums over the
+ancestor relation of the tree:
+
+- ``σ_k = (L_0^k)⁻ᵀ M_k f_k`` — pair k's mobility axes seen from E0 (6 × k_k);
+- ``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` — body j's inertia about E0;
+- ``Θᶜ_k = Σ_{j ⪰ k} Θ⁰_j`` — the composite inertia of the subtree of k;
+- ``A_kl = σ_kᵀ Θᶜ_{k} σ_l`` when l ⪯ k (and symmetric), 0 across branches.
+
+Likewise ``V⁰_j = Σ_{k ⪯ j} σ_k q̇_k``, ``Ṡᵀ q̇`` becomes ``a⁰_j = Σ_{k ⪯ j} σ̇_k q̇_k``
+with ``σ̇_k = V⁰_k × σ_k + (L_0^k)⁻ᵀ Ṁ_k f_k``, and
+``B q̇ = S (Θ Ṡᵀ q̇ + Φ⁰ Θ Sᵀ q̇)`` is ``σ_kᵀ Σ_{j ⪰ k} (Θ⁰_j a⁰_j + Φ(V⁰_j) Θ⁰_j V⁰_j)``.
+Sums over the ancestor relation are products with the 0/1 ancestor matrix, so each
+algorithm is a short sequence of numpy operations, vectorised over the bodies and over
+a batch of K configurations; only the forward pass of the absolute placements loops,
+over the depth of the tree.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rt70.errors import NonFiniteError
+from rt70.textbook.model import Model
+
+_E3 = np.eye(3)
+
+
+@dataclass(frozen=True)
+class Topology:
+    """Index arrays derived once from a model's parent array (plain data)."""
+
+    levels: tuple[np.ndarray, ...]  # bodies at depth 0, 1, ...
+    level_parents: tuple[np.ndarray, ...]  # their parents (−1 at depth 0)
+    anc: np.ndarray  # anc[k, j] = 1.0 if k is j or an ancestor of j
+    dof_body: np.ndarray  # body of each full coordinate
+    anc_strict: np.ndarray  # 1.0 where body(l) is a strict ancestor of body(a)
+    same_body: np.ndarray  # 1.0 where body(l) = body(a)
+    incidence: np.ndarray  # incidence[k, a] = 1.0 if coordinate a belongs to pair k
+    m_const: np.ndarray  # body-frame mobility column of each 1-DOF coordinate (n_full, 6)
+    kinds: dict[str, np.ndarray]  # bodies of each pair kind
+    kind_dofs: dict[str, np.ndarray]  # their coordinates, shape (n_kind, ndof)
+
+
+def _build_topology(model: Model) -> Topology:
+    nb, n = model.nb, model.n_full
+    depth = np.zeros(nb, dtype=int)
+    for j in range(nb):
+        depth[j] = 0 if model.parent[j] < 0 else depth[model.parent[j]] + 1
+    levels = tuple(np.flatnonzero(depth == d) for d in range(depth.max() + 1 if nb else 0))
+    anc = np.zeros((nb, nb))
+    for j in range(nb):
+        anc[model.ancestors(j), j] = 1.0
+    dof_body = np.repeat(np.arange(nb), model.ndof)
+    same = (dof_body[:, None] == dof_body[None, :]).astype(float)
+    incidence = np.zeros((nb, n))
+    incidence[dof_body, np.arange(n)] = 1.0
+    m_const = np.zeros((n, 6))
+    kinds, kind_dofs = {}, {}
+    for kind in ("euler6", "revolute", "prismatic", "planar"):
+        bodies = np.array([j for j in range(nb) if model.kind[j] == kind], dtype=int)
+        kinds[kind] = bodies
+        width = {"euler6": 6, "planar": 3}.get(kind, 1)
+        kind_dofs[kind] = (model.q_start[bodies][:, None] + np.arange(width)).astype(int)
+    for j in kinds["revolute"]:
+        m_const[model.q_start[j], 3:] = model.axis[j]
+    for j in kinds["prismatic"]:
+        m_const[model.q_start[j], :3] = model.axis[j]
+    return Topology(
+        levels=levels,
+        level_parents=tuple(model.parent[lv] for lv in levels),
+        anc=anc,
+        dof_body=dof_body,
+        anc_strict=anc[np.ix_(dof_body, dof_body)] - same,
+        same_body=same,
+        incidence=incidence,
+        m_const=m_const,
+        kinds=kinds,
+        kind_dofs=kind_dofs,
+    )
+
+
+def topology(model: Model) -> Topology:
+    """The :class:`Topology` of ``model`` (computed once, kept on the model object)."""
+    topo = model.__dict__.get("_topology")
+    if topo is None:
+        topo = model.__dict__["_topology"] = _build_topology(model)
+    return topo
+
+
+def _skew_batch(x: np.ndarray) -> np.ndarray:
+    """``<x>`` for an array of 3-vectors, shape (..., 3) → (..., 3, 3)."""
+    out = np.zeros(x.shape + (3,))
+    out[..., 0, 1], out[..., 0, 2] = -x[..., 2], x[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = x[..., 2], -x[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -x[..., 1], x[..., 0]
+    return out
+
+
+def _euler123_batch(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``c = c1(β) c2(θ) c3(α)`` (1.23) and the Euler matrix ε (1.38), batched."""
+    sb, cb = np.sin(phi[..., 0]), np.cos(phi[..., 0])
+    st, ct = np.sin(phi[..., 1]), np.cos(phi[..., 1])
+    sa, ca = np.sin(phi[..., 2]), np.cos(phi[..., 2])
+    c = np.empty(phi.shape[:-1] + (3, 3))
+    c[..., 0, 0], c[..., 0, 1], c[..., 0, 2] = ct * ca, -ct * sa, st
+    c[..., 1, 0] = cb * sa + sb * st * ca
+    c[..., 1, 1] = cb * ca - sb * st * sa
+    c[..., 1, 2] = -sb * ct
+    c[..., 2, 0] = sb * sa - cb * st * ca
+    c[..., 2, 1] = sb * ca + cb * st * sa
+    c[..., 2, 2] = cb * ct
+    eps = np.zeros_like(c)
+    eps[..., 0, 0], eps[..., 0, 1] = ct * ca, sa
+    eps[..., 1, 0], eps[..., 1, 1] = -ct * sa, ca
+    eps[..., 2, 0], eps[..., 2, 2] = st, 1.0
+    return c, eps
+
+
+def _rotations_about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rodrigues' formula for rotations about unit ``axes`` (n, 3) by ``angles`` (K, n)."""
+    k = _skew_batch(axes)
+    k2 = k @ k
+    s, c = np.sin(angles)[..., None, None], np.cos(angles)[..., None, None]
+    return _E3 + s * k + (1.0 - c) * k2
+
+
+@dataclass
+class Kinematics:
+    """Batched forward kinematics in the book's 6×6 form."""
+
+    L0: np.ndarray  # (K, nb, 6, 6) L_0^j = T(p)[c]: placement of body j in E0 (4.5)–(4.7)
+    m: np.ndarray  # (K, n_full, 6) body-frame mobility columns of M_j f_j (4.13)
+    sigma: np.ndarray  # (K, n_full, 6) σ = (L_0^j)⁻ᵀ M_j f_j: mobility axes seen from E0
+
+
+def _placement_batch(P: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """``T(P)[C] = [[C, 0], [<P> C, C]]`` (4.3) for arrays of translations and rotations."""
+    out = np.zeros(C.shape[:-2] + (6, 6))
+    out[..., :3, :3] = C
+    out[..., 3:, 3:] = C
+    out[..., 3:, :3] = _skew_batch(P) @ C
+    return out
+
+
+def _inverse_transpose(L0: np.ndarray) -> np.ndarray:
+    """``(T(p)[c])⁻ᵀ = [[c, <p>c], [0, c]]``: moves a body-frame motion to E0."""
+    out = np.zeros_like(L0)
+    out[..., :3, :3] = L0[..., :3, :3]
+    out[..., 3:, 3:] = L0[..., 3:, 3:]
+    out[..., :3, 3:] = L0[..., 3:, :3]
+    return out
+
+
+def forward_kinematics_batch(model: Model, Qf: np.ndarray) -> Kinematics:
+    """``L_0^j`` of every body and the axes ``σ`` for K configurations ``Qf`` (K, n_full).
+
+    Forward pass over the depth of the tree with the chain property
+    ``L_0^j = L_0^i L_i^j`` (§4.2), each level one batched matrix product.
+    """
+    topo = topology(model)
+    K, nb = Qf.shape[0], model.nb
+    c_rel = np.broadcast_to(_E3, (K, nb, 3, 3)).copy()
+    r_rel = np.zeros((K, nb, 3))
+    m = np.broadcast_to(topo.m_const, (K,) + topo.m_const.shape).copy()
+    bodies, dofs = topo.kinds["revolute"], topo.kind_dofs["revolute"]
+    if bodies.size:
+        c_rel[:, bodies] = _rotations_about_axes(model.axis[bodies], Qf[:, dofs[:, 0]])
+    bodies, dofs = topo.kinds["prismatic"], topo.kind_dofs["prismatic"]
+    if bodies.size:
+        r_rel[:, bodies] = Qf[:, dofs[:, 0], None] * model.axis[bodies]
+    bodies, dofs = topo.kinds["euler6"], topo.kind_dofs["euler6"]
+    if bodies.size:
+        q6 = Qf[:, dofs]  # (K, n6, 6)
+        c, eps = _euler123_batch(q6[..., 3:])
+        c_rel[:, bodies] = c
+        r_rel[:, bodies] = q6[..., :3]
+        rows = np.zeros(c.shape[:-2] + (6, 6))  # row a = column a of M_j = diag(cᵀ, ε)
+        rows[..., :3, :3] = c
+        rows[..., 3:, 3:] = np.swapaxes(eps, -1, -2)
+        m[:, dofs] = rows
+    bodies, dofs = topo.kinds["planar"], topo.kind_dofs["planar"]
+    if bodies.size:
+        q3 = Qf[:, dofs]
+        ca, sa = np.cos(q3[..., 2]), np.sin(q3[..., 2])
+        c_rel[:, bodies, 0, 0], c_rel[:, bodies, 0, 1] = ca, -sa
+        c_rel[:, bodies, 1, 0], c_rel[:, bodies, 1, 1] = sa, ca
+        r_rel[:, bodies, :2] = q3[..., :2]
+        rows = np.zeros(q3.shape[:-1] + (3, 6))
+        rows[..., 0, 0], rows[..., 0, 1] = ca, -sa  # cᵀ e_x
+        rows[..., 1, 0], rows[..., 1, 1] = sa, ca  # cᵀ e_y
+        rows[..., 2, 5] = 1.0
+        m[:, dofs] = rows
+    # L_i^j = T(r_c)[c_c] T(r_j)[c_j] = T(r_c + c_c r_j)[c_c c_j] (4.5)–(4.7)
+    P = model.r_c + (model.c_c @ r_rel[..., None])[..., 0]
+    L_pair = _placement_batch(P, model.c_c @ c_rel)
+    L0 = np.empty_like(L_pair)
+    for level, parents in zip(topo.levels, topo.level_parents, strict=True):
+        if parents[0] < 0:  # depth 0: children of the ground
+            L0[:, level] = L_pair[:, level]
+        else:
+            L0[:, level] = L0[:, parents] @ L_pair[:, level]
+    X = _inverse_transpose(L0)[:, topo.dof_body]
+    sigma = (X @ m[..., None])[..., 0]
+    return Kinematics(L0, m, sigma)
+
+
+def ground_inertias(model: Model, kin: Kinematics) -> np.ndarray:
+    """``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` for every body, shape (K, nb, 6, 6) (4.77)."""
+    return kin.L0 @ model.Theta @ np.swapaxes(kin.L0, -1, -2)
+
+
+def _reduce_matrix(model: Model, A_full: np.ndarray) -> np.ndarray:
+    if model.G is None:
+        return A_full
+    return np.swapaxes(model.G, 0, 1) @ A_full @ model.G
+
+
+def _expand_batch(model: Model, Q: np.ndarray, offset: bool = True) -> np.ndarray:
+    if model.G is None:
+        return Q
+    out = Q @ model.G.T
+    return out + model.q_offset if offset else out
+
+
+def _check_batch(name: str, Q: np.ndarray, nv: int) -> np.ndarray:
+    Q = np.asarray(Q, dtype=float)
+    if Q.ndim != 2 or Q.shape[1] != nv:
+        raise ValueError(f"{name} must have shape (K, {nv}), got {Q.shape}")
+    if not np.all(np.isfinite(Q)):
+        raise NonFiniteError(f"{name} contains NaN or infinite values")
+    return Q
+
+
+def mass_matrix_batch(model: Model, Q: np.ndarray) -> np.ndarray:
+    """``A = S Θ Sᵀ`` for K configurations at once, shape (K, nv, nv).
+
+    ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` (the composite form of
+    (4.79) described in the module docstring).
+    """
+    Q = _check_batch("Q", Q, model.nv)
+    topo = topology(model)
+    kin = forward_kinematics_batch(model, _expand_batch(model, Q))
+    theta0 = ground_inertias(model, kin)
+    K, nb = theta0.shape[:2]
+    theta_c = (topo.anc @ theta0.reshape(K, nb, 36)).reshape(K, nb, 6, 6)  # Σ_{j ⪰ k} Θ⁰_j
+    F = (theta_c[:, topo.dof_body] @ kin.sigma[..., None])[..., 0]
+    Gm = kin.sigma @ np.swapaxes(F, -1, -2)  # Gm[l, a] = σ_lᵀ Θᶜ_body(a) σ_a
+    upper = Gm * topo.anc_strict  # body(l) a strict ancestor of body(a)
+    A = upper + np.swapaxes(upper, -1, -2) + Gm * topo.same_body
+    return _reduce_matrix(model, A)
+
+
+def mass_matrix(model: Model, q: np.ndarray) -> np.ndarray:
+    """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form)."""
+    return mass_matrix_batch(model, np.asarray(q, dtype=float)[None, :])[0]
+
+
+def _crm_batch(v: np.ndarray) -> np.ndarray:
+    """Motion cross product matrices ``V×`` (linear-first), ``−Φ(V)ᵀ`` of (1.55); batched."""
+    out = np.zeros(v.shape[:-1] + (6, 6))
+    w = _skew_batch(v[..., 3:])
+    out[..., :3, :3] = w
+    out[..., 3:, 3:] = w
+    out[..., :3, 3:] = _skew_batch(v[..., :3])
+    return out
+
+
+def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray, m: np.ndarray):
+    """``Ṁ_j f_j q̇_j`` in body frames, shape (K, nb, 6) (4.82).
+
+    euler6: ``[ċᵀ ẋ; ε̇ φ̇]`` with ``ċᵀ = −<ω> cᵀ``, ``ω = ε φ̇``; planar likewise with
+    ``ω = α̇ e_z``; zero for 1-DOF pairs (their axes are constant in the body frame).
+    """
+    K = Qf.shape[0]
+    out = np.zeros((K, model.nb, 6))
+    bodies, dofs = topo.kinds["euler6"], topo.kind_dofs["euler6"]
+    if bodies.size:
+        q6, v6 = Qf[:, dofs], Vf[:, dofs]
+        rows = m[:, dofs]  # row a = column a of M_j
+        omega = (v6[..., None, 3:] @ rows[..., 3:, 3:])[..., 0, :]  # ε φ̇
+        ct_x = (v6[..., None, :3] @ rows[..., :3, :3])[..., 0, :]  # cᵀ ẋ
+        out[:, bodies, :3] = -(_skew_batch(omega) @ ct_x[..., None])[..., 0]
+        st, ct = np.sin(q6[..., 4]), np.cos(q6[..., 4])
+        sa, ca = np.sin(q6[..., 5]), np.cos(q6[..., 5])
+        db, dt, da = v6[..., 3], v6[..., 4], v6[..., 5]
+        # ε̇ φ̇ with ε̇ = θ̇ ∂ε/∂θ + α̇ ∂ε/∂α
+        out[:, bodies, 3] = db * (-st * ca * dt - ct * sa * da) + da * ca * dt
+        out[:, bodies, 4] = db * (st * sa * dt - ct * ca * da) - da * sa * dt
+        out[:, bodies, 5] = db * ct * dt
+    bodies, dofs = topo.kinds["planar"], topo.kind_dofs["planar"]
+    if bodies.size:
+        v3 = Vf[:, dofs]
+        ct_x = (v3[..., None, :2] @ m[:, dofs[:, :2], :3])[..., 0, :]
+        out[:, bodies, 0] = v3[..., 2] * ct_x[..., 1]  # −<α̇ e_z> cᵀ ẋ
+        out[:, bodies, 1] = -v3[..., 2] * ct_x[..., 0]
+    return out
+
+
+def bias_force_batch(model: Model, Q: np.ndarray, Qd: np.ndarray) -> np.ndarray:
+    """``B(q, q̇) q̇`` (4.80) for K states, shape (K, nv) (composite form, module docstring)."""
+    Q = _check_batch("Q", Q, model.nv)
+    Qd = _check_batch("Qd", Qd, model.nv)
+    topo = topology(model)
+    Qf, Vf = _expand_batch(model, Q), _expand_batch(model, Qd, offset=False)
+    kin = forward_kinematics_batch(model, Qf)
+    u = topo.incidence @ (kin.sigma * Vf[..., None])  # Σ_a σ_a q̇_a per pair, (K, nb, 6)
+    V = topo.anc.T @ u  # V⁰_j = Σ_{k ⪯ j} u_k
+    rate = _inverse_transpose(kin.L0) @ _mobility_rate(model, topo, Qf, Vf, kin.m)[..., None]
+    a = topo.anc.T @ ((_crm_batch(V) @ u[..., None])[..., 0] + rate[..., 0])  # Ṡᵀ q̇
+    theta0 = ground_inertias(model, kin)
+    h = (theta0 @ V[..., None])[..., 0]
+    f = (theta0 @ a[..., None])[..., 0] - (np.swapaxes(_crm_batch(V), -1, -2) @ h[..., None])[
+        ..., 0
+    ]
+    f_c = topo.anc @ f  # Σ_{j ⪰ k} f_j
+    tau = np.sum(kin.sigma * f_c[:, topo.dof_body], axis=-1)
+    return tau if model.G is None else tau @ model.G
+
+
+def bias_force(model: Model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``B(q, q̇) q̇`` at one state (structure-exploiting form)."""
+    q, qd = np.asarray(q, dtype=float)[None, :], np.asarray(qd, dtype=float)[None, :]
+    return bias_force_batch(model, q, qd)[0]
+
+
+def gravity_force_batch(model: Model, Q: np.ndarray) -> np.ndarray:
+    """``Q_g = S G`` (4.113)–(4.128) for K configurations: ``σ_aᵀ Θᶜ_body(a) [g0; 0]``."""
+    Q = _check_batch("Q", Q, model.nv)
+    topo = topology(model)
+    kin = forward_kinematics_batch(model, _expand_batch(model, Q))
+    theta0 = ground_inertias(model, kin)
+    w = topo.anc @ (theta0[..., :, :3] @ model.gravity)  # Σ_{j ⪰ k} Θ⁰_j [g0; 0]
+    tau = np.sum(kin.sigma * w[:, topo.dof_body], axis=-1)
+    return tau if model.G is None else tau @ model.G
