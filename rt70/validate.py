@@ -143,14 +143,14 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
 def format_table(records: Iterable[Record], tolerance: float = DEFAULT_TOLERANCE) -> str:
     """The error-against-run-time table as plain text."""
     header = (
-        f"{'target':<22} {'nv':>4} {'quantity':<17} {'max abs err':>11} {'max rel err':>11} "
+        f"{'target':<26} {'nv':>4} {'quantity':<17} {'max abs err':>11} {'max rel err':>11} "
         f"{'textbook µs':>12} {'pinocchio µs':>12} {'ratio':>7}  ok"
     )
     lines = [header, "-" * len(header)]
     for r in records:
         ratio = r.t_textbook_s / r.t_reference_s if r.t_reference_s > 0 else float("inf")
         lines.append(
-            f"{r.target:<22} {r.nv:>4} {r.quantity:<17} {r.max_abs_err:>11.2e} "
+            f"{r.target:<26} {r.nv:>4} {r.quantity:<17} {r.max_abs_err:>11.2e} "
             f"{r.max_rel_err:>11.2e} {r.t_textbook_s * 1e6:>12.1f} {r.t_reference_s * 1e6:>12.1f} "
             f"{ratio:>7.1f}  {'yes' if r.passed(tolerance) else 'NO'}"
         )

@@ -87,10 +87,15 @@ def spring_potential(model: Model, data: Data, q: np.ndarray) -> float:
 
 
 def gravity_potential(model: Model, data: Data, q: np.ndarray) -> float:
-    """Gravity potential ``−Σ m_k g0 · (p_k + c_{0k} p_cm,k)``."""
+    """Gravity potential ``−Σ m_k g0 · (p_k + c_{0k} p_cm,k)`` of the moving bodies.
+
+    Bodies welded to the ground through fixed joints only are part of E0: their
+    potential is a constant and is left out (Pinocchio's convention too).
+    """
     update_structure(model, data, q)
     com_world = data.p + np.einsum("kij,kj->ki", data.R, model.com)
-    return -float(model.mass @ (com_world @ model.gravity))
+    moving = np.array([model.ndof[model.ancestors(j)].sum() > 0 for j in range(model.nb)])
+    return -float((model.mass * moving) @ (com_world @ model.gravity))
 
 
 def kinetic_energy(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> float:

@@ -16,7 +16,11 @@ with ``σ̇_k = V⁰_k × σ_k + (L_0^k)⁻ᵀ Ṁ_k f_k``, and
 Sums over the ancestor relation are products with the 0/1 ancestor matrix, so each
 algorithm is a short sequence of numpy operations, vectorised over the bodies and over
 a batch of K configurations; only the forward pass of the absolute placements loops,
-over the depth of the tree.
+over the depth of the tree. Pairs are grouped by their number of coordinates (1, 3 or
+6), so the 6×6 work is done once per pair, not once per coordinate.
+
+Work buffers live in :class:`BatchData` (as Pinocchio's ``Data``): reuse one for
+repeated calls — fresh multi-megabyte temporaries cost more than the arithmetic.
 """
 
 from __future__ import annotations
@@ -32,6 +36,15 @@ _E3 = np.eye(3)
 
 
 @dataclass(frozen=True)
+class Group:
+    """Pairs with the same number ``width`` of coordinates (1, 3 or 6)."""
+
+    width: int
+    bodies: np.ndarray  # (n_g,)
+    dofs: np.ndarray  # (n_g, width) full-coordinate indices
+
+
+@dataclass(frozen=True)
 class Topology:
     """Index arrays derived once from a model's parent array (plain data)."""
 
@@ -39,12 +52,13 @@ class Topology:
     level_parents: tuple[np.ndarray, ...]  # their parents (−1 at depth 0)
     anc: np.ndarray  # anc[k, j] = 1.0 if k is j or an ancestor of j
     dof_body: np.ndarray  # body of each full coordinate
-    anc_strict: np.ndarray  # 1.0 where body(l) is a strict ancestor of body(a)
-    same_body: np.ndarray  # 1.0 where body(l) = body(a)
+    weight: np.ndarray  # 1 where body(l) ⊀ body(a) strictly, ½ on a body's own block
+    weight_t: np.ndarray  # its transpose (contiguous)
     incidence: np.ndarray  # incidence[k, a] = 1.0 if coordinate a belongs to pair k
-    m_const: np.ndarray  # body-frame mobility column of each 1-DOF coordinate (n_full, 6)
+    groups: tuple[Group, ...]
     kinds: dict[str, np.ndarray]  # bodies of each pair kind
     kind_dofs: dict[str, np.ndarray]  # their coordinates, shape (n_kind, ndof)
+    rows_1dof: np.ndarray  # body-frame axis [a; 0] or [0; a] of each 1-DOF pair (n1, 1, 6)
 
 
 def _build_topology(model: Model) -> Topology:
@@ -58,30 +72,37 @@ def _build_topology(model: Model) -> Topology:
         anc[model.ancestors(j), j] = 1.0
     dof_body = np.repeat(np.arange(nb), model.ndof)
     same = (dof_body[:, None] == dof_body[None, :]).astype(float)
+    weight = anc[np.ix_(dof_body, dof_body)] - 0.5 * same
     incidence = np.zeros((nb, n))
     incidence[dof_body, np.arange(n)] = 1.0
-    m_const = np.zeros((n, 6))
+    groups = []
+    for width in (1, 3, 6):
+        bodies = np.flatnonzero(model.ndof == width)
+        if bodies.size:
+            dofs = model.q_start[bodies][:, None] + np.arange(width)
+            groups.append(Group(width, bodies, dofs.astype(int)))
     kinds, kind_dofs = {}, {}
-    for kind in ("euler6", "revolute", "prismatic", "planar"):
+    for kind, width in (("euler6", 6), ("revolute", 1), ("prismatic", 1), ("planar", 3)):
         bodies = np.array([j for j in range(nb) if model.kind[j] == kind], dtype=int)
         kinds[kind] = bodies
-        width = {"euler6": 6, "planar": 3}.get(kind, 1)
         kind_dofs[kind] = (model.q_start[bodies][:, None] + np.arange(width)).astype(int)
-    for j in kinds["revolute"]:
-        m_const[model.q_start[j], 3:] = model.axis[j]
-    for j in kinds["prismatic"]:
-        m_const[model.q_start[j], :3] = model.axis[j]
+    one = np.flatnonzero(model.ndof == 1)
+    rows_1dof = np.zeros((one.size, 1, 6))
+    for i, j in enumerate(one):
+        rows_1dof[i, 0, 3:] = model.axis[j] if model.kind[j] == "revolute" else 0.0
+        rows_1dof[i, 0, :3] = model.axis[j] if model.kind[j] == "prismatic" else 0.0
     return Topology(
         levels=levels,
         level_parents=tuple(model.parent[lv] for lv in levels),
         anc=anc,
         dof_body=dof_body,
-        anc_strict=anc[np.ix_(dof_body, dof_body)] - same,
-        same_body=same,
+        weight=weight,
+        weight_t=np.ascontiguousarray(weight.T),
         incidence=incidence,
-        m_const=m_const,
+        groups=tuple(groups),
         kinds=kinds,
         kind_dofs=kind_dofs,
+        rows_1dof=rows_1dof,
     )
 
 
@@ -91,6 +112,45 @@ def topology(model: Model) -> Topology:
     if topo is None:
         topo = model.__dict__["_topology"] = _build_topology(model)
     return topo
+
+
+class BatchData:
+    """Work buffers of the structured algorithms for K configurations of one model.
+
+    Attributes
+    ----------
+    L0 : numpy.ndarray
+        ``L_0^j`` of every body, (K, nb, 6, 6).
+    sigma : numpy.ndarray
+        Mobility axes seen from E0, one row per full coordinate, (K, n_full, 6).
+    A : numpy.ndarray
+        The last mass matrices computed, (K, nv, nv).
+    """
+
+    def __init__(self, model: Model, K: int) -> None:
+        nb, n = model.nb, model.n_full
+        topo = topology(model)
+        self.K = K
+        self.c_rel = np.empty((K, nb, 3, 3))
+        self.r_rel = np.empty((K, nb, 3))
+        self.L_pair = np.zeros((K, nb, 6, 6))
+        self.L0 = np.empty((K, nb, 6, 6))
+        self.X = np.zeros((K, nb, 6, 6))
+        self.rows = {g.width: np.zeros((K, g.bodies.size, g.width, 6)) for g in topo.groups}
+        self.sigma = np.empty((K, n, 6))
+        self.F = np.empty((K, n, 6))
+        self.theta0 = np.empty((K, nb, 6, 6))
+        self.theta_c = np.empty((K, nb, 6, 6))
+        self.Gm = np.empty((K, n, n))
+        self.GmT = np.empty((K, n, n))
+        self.A_full = np.empty((K, n, n))
+        self.A = self.A_full if model.G is None else np.empty((K, model.nv, model.nv))
+
+
+def _data_for(model: Model, K: int, data: BatchData | None) -> BatchData:
+    if data is None or data.K != K:
+        return BatchData(model, K)
+    return data
 
 
 def _skew_batch(x: np.ndarray) -> np.ndarray:
@@ -130,44 +190,17 @@ def _rotations_about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return _E3 + s * k + (1.0 - c) * k2
 
 
-@dataclass
-class Kinematics:
-    """Batched forward kinematics in the book's 6×6 form."""
+def forward_kinematics_batch(model: Model, data: BatchData, Qf: np.ndarray) -> None:
+    """Fill ``data.L0`` (``L_0^j`` of every body) and ``data.sigma`` for K configurations.
 
-    L0: np.ndarray  # (K, nb, 6, 6) L_0^j = T(p)[c]: placement of body j in E0 (4.5)–(4.7)
-    m: np.ndarray  # (K, n_full, 6) body-frame mobility columns of M_j f_j (4.13)
-    sigma: np.ndarray  # (K, n_full, 6) σ = (L_0^j)⁻ᵀ M_j f_j: mobility axes seen from E0
-
-
-def _placement_batch(P: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """``T(P)[C] = [[C, 0], [<P> C, C]]`` (4.3) for arrays of translations and rotations."""
-    out = np.zeros(C.shape[:-2] + (6, 6))
-    out[..., :3, :3] = C
-    out[..., 3:, 3:] = C
-    out[..., 3:, :3] = _skew_batch(P) @ C
-    return out
-
-
-def _inverse_transpose(L0: np.ndarray) -> np.ndarray:
-    """``(T(p)[c])⁻ᵀ = [[c, <p>c], [0, c]]``: moves a body-frame motion to E0."""
-    out = np.zeros_like(L0)
-    out[..., :3, :3] = L0[..., :3, :3]
-    out[..., 3:, 3:] = L0[..., 3:, 3:]
-    out[..., :3, 3:] = L0[..., 3:, :3]
-    return out
-
-
-def forward_kinematics_batch(model: Model, Qf: np.ndarray) -> Kinematics:
-    """``L_0^j`` of every body and the axes ``σ`` for K configurations ``Qf`` (K, n_full).
-
-    Forward pass over the depth of the tree with the chain property
-    ``L_0^j = L_0^i L_i^j`` (§4.2), each level one batched matrix product.
+    ``L_i^j = T(r_c + c_c r_j)[c_c c_j]`` (4.5)–(4.7); forward pass over the depth of
+    the tree with the chain property ``L_0^j = L_0^i L_i^j`` (§4.2), one batched
+    product per level; then ``σ = (L_0^j)⁻ᵀ M_j f_j`` per group of equal-width pairs.
     """
     topo = topology(model)
-    K, nb = Qf.shape[0], model.nb
-    c_rel = np.broadcast_to(_E3, (K, nb, 3, 3)).copy()
-    r_rel = np.zeros((K, nb, 3))
-    m = np.broadcast_to(topo.m_const, (K,) + topo.m_const.shape).copy()
+    c_rel, r_rel = data.c_rel, data.r_rel
+    c_rel[:] = _E3
+    r_rel[:] = 0.0
     bodies, dofs = topo.kinds["revolute"], topo.kind_dofs["revolute"]
     if bodies.size:
         c_rel[:, bodies] = _rotations_about_axes(model.axis[bodies], Qf[:, dofs[:, 0]])
@@ -180,10 +213,9 @@ def forward_kinematics_batch(model: Model, Qf: np.ndarray) -> Kinematics:
         c, eps = _euler123_batch(q6[..., 3:])
         c_rel[:, bodies] = c
         r_rel[:, bodies] = q6[..., :3]
-        rows = np.zeros(c.shape[:-2] + (6, 6))  # row a = column a of M_j = diag(cᵀ, ε)
+        rows = data.rows[6]  # row a = column a of M_j = diag(cᵀ, ε)
         rows[..., :3, :3] = c
         rows[..., 3:, 3:] = np.swapaxes(eps, -1, -2)
-        m[:, dofs] = rows
     bodies, dofs = topo.kinds["planar"], topo.kind_dofs["planar"]
     if bodies.size:
         q3 = Qf[:, dofs]
@@ -191,34 +223,36 @@ def forward_kinematics_batch(model: Model, Qf: np.ndarray) -> Kinematics:
         c_rel[:, bodies, 0, 0], c_rel[:, bodies, 0, 1] = ca, -sa
         c_rel[:, bodies, 1, 0], c_rel[:, bodies, 1, 1] = sa, ca
         r_rel[:, bodies, :2] = q3[..., :2]
-        rows = np.zeros(q3.shape[:-1] + (3, 6))
+        rows = data.rows[3]
         rows[..., 0, 0], rows[..., 0, 1] = ca, -sa  # cᵀ e_x
         rows[..., 1, 0], rows[..., 1, 1] = sa, ca  # cᵀ e_y
         rows[..., 2, 5] = 1.0
-        m[:, dofs] = rows
-    # L_i^j = T(r_c)[c_c] T(r_j)[c_j] = T(r_c + c_c r_j)[c_c c_j] (4.5)–(4.7)
+    C = model.c_c @ c_rel
     P = model.r_c + (model.c_c @ r_rel[..., None])[..., 0]
-    L_pair = _placement_batch(P, model.c_c @ c_rel)
-    L0 = np.empty_like(L_pair)
+    L_pair = data.L_pair  # T(P)[C] = [[C, 0], [<P> C, C]] (4.3)
+    L_pair[..., :3, :3] = C
+    L_pair[..., 3:, 3:] = C
+    np.matmul(_skew_batch(P), C, out=L_pair[..., 3:, :3])
+    L0 = data.L0
     for level, parents in zip(topo.levels, topo.level_parents, strict=True):
         if parents[0] < 0:  # depth 0: children of the ground
             L0[:, level] = L_pair[:, level]
         else:
             L0[:, level] = L0[:, parents] @ L_pair[:, level]
-    X = _inverse_transpose(L0)[:, topo.dof_body]
-    sigma = (X @ m[..., None])[..., 0]
-    return Kinematics(L0, m, sigma)
+    X = data.X  # (L_0^j)⁻ᵀ = [[c, <p>c], [0, c]]
+    X[..., :3, :3] = L0[..., :3, :3]
+    X[..., 3:, 3:] = L0[..., 3:, 3:]
+    X[..., :3, 3:] = L0[..., 3:, :3]
+    Xt = np.swapaxes(X, -1, -2)
+    for g in topo.groups:
+        rows = topo.rows_1dof if g.width == 1 else data.rows[g.width]
+        data.sigma[:, g.dofs] = rows @ Xt[:, g.bodies]
 
 
-def ground_inertias(model: Model, kin: Kinematics) -> np.ndarray:
-    """``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` for every body, shape (K, nb, 6, 6) (4.77)."""
-    return kin.L0 @ model.Theta @ np.swapaxes(kin.L0, -1, -2)
-
-
-def _reduce_matrix(model: Model, A_full: np.ndarray) -> np.ndarray:
-    if model.G is None:
-        return A_full
-    return np.swapaxes(model.G, 0, 1) @ A_full @ model.G
+def ground_inertias(model: Model, data: BatchData) -> np.ndarray:
+    """``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` for every body, into ``data.theta0`` (4.77)."""
+    np.matmul(data.L0 @ model.Theta, np.swapaxes(data.L0, -1, -2), out=data.theta0)
+    return data.theta0
 
 
 def _expand_batch(model: Model, Q: np.ndarray, offset: bool = True) -> np.ndarray:
@@ -237,28 +271,35 @@ def _check_batch(name: str, Q: np.ndarray, nv: int) -> np.ndarray:
     return Q
 
 
-def mass_matrix_batch(model: Model, Q: np.ndarray) -> np.ndarray:
-    """``A = S Θ Sᵀ`` for K configurations at once, shape (K, nv, nv).
+def mass_matrix_batch(model: Model, Q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
+    """``A = S Θ Sᵀ`` for K configurations ``Q`` (K, nv) at once; returns ``data.A``.
 
-    ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` (the composite form of
-    (4.79) described in the module docstring).
+    ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` and its transpose (the
+    composite form of (4.79), module docstring). The returned array is ``data.A`` and is
+    overwritten by the next call with the same ``data``.
     """
     Q = _check_batch("Q", Q, model.nv)
+    data = _data_for(model, Q.shape[0], data)
     topo = topology(model)
-    kin = forward_kinematics_batch(model, _expand_batch(model, Q))
-    theta0 = ground_inertias(model, kin)
+    forward_kinematics_batch(model, data, _expand_batch(model, Q))
+    theta0 = ground_inertias(model, data)
     K, nb = theta0.shape[:2]
-    theta_c = (topo.anc @ theta0.reshape(K, nb, 36)).reshape(K, nb, 6, 6)  # Σ_{j ⪰ k} Θ⁰_j
-    F = (theta_c[:, topo.dof_body] @ kin.sigma[..., None])[..., 0]
-    Gm = kin.sigma @ np.swapaxes(F, -1, -2)  # Gm[l, a] = σ_lᵀ Θᶜ_body(a) σ_a
-    upper = Gm * topo.anc_strict  # body(l) a strict ancestor of body(a)
-    A = upper + np.swapaxes(upper, -1, -2) + Gm * topo.same_body
-    return _reduce_matrix(model, A)
+    np.matmul(topo.anc, theta0.reshape(K, nb, 36), out=data.theta_c.reshape(K, nb, 36))
+    for g in topo.groups:  # F_a = Θᶜ_body(a) σ_a (Θᶜ symmetric)
+        data.F[:, g.dofs] = data.sigma[:, g.dofs] @ data.theta_c[:, g.bodies]
+    np.matmul(data.sigma, np.swapaxes(data.F, -1, -2), out=data.Gm)  # σ_lᵀ Θᶜ_body(a) σ_a
+    np.matmul(data.F, np.swapaxes(data.sigma, -1, -2), out=data.GmT)  # its transpose
+    np.multiply(data.Gm, topo.weight, out=data.A_full)
+    data.GmT *= topo.weight_t
+    data.A_full += data.GmT
+    if model.G is not None:
+        np.matmul(model.G.T @ data.A_full, model.G, out=data.A)
+    return data.A
 
 
-def mass_matrix(model: Model, q: np.ndarray) -> np.ndarray:
-    """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form)."""
-    return mass_matrix_batch(model, np.asarray(q, dtype=float)[None, :])[0]
+def mass_matrix(model: Model, q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
+    """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form), a new array."""
+    return mass_matrix_batch(model, np.asarray(q, dtype=float)[None, :], data)[0].copy()
 
 
 def _crm_batch(v: np.ndarray) -> np.ndarray:
@@ -271,7 +312,7 @@ def _crm_batch(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray, m: np.ndarray):
+def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray, data: BatchData):
     """``Ṁ_j f_j q̇_j`` in body frames, shape (K, nb, 6) (4.82).
 
     euler6: ``[ċᵀ ẋ; ε̇ φ̇]`` with ``ċᵀ = −<ω> cᵀ``, ``ω = ε φ̇``; planar likewise with
@@ -282,7 +323,7 @@ def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray,
     bodies, dofs = topo.kinds["euler6"], topo.kind_dofs["euler6"]
     if bodies.size:
         q6, v6 = Qf[:, dofs], Vf[:, dofs]
-        rows = m[:, dofs]  # row a = column a of M_j
+        rows = data.rows[6]  # row a = column a of M_j (from forward_kinematics_batch)
         omega = (v6[..., None, 3:] @ rows[..., 3:, 3:])[..., 0, :]  # ε φ̇
         ct_x = (v6[..., None, :3] @ rows[..., :3, :3])[..., 0, :]  # cᵀ ẋ
         out[:, bodies, :3] = -(_skew_batch(omega) @ ct_x[..., None])[..., 0]
@@ -296,45 +337,50 @@ def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray,
     bodies, dofs = topo.kinds["planar"], topo.kind_dofs["planar"]
     if bodies.size:
         v3 = Vf[:, dofs]
-        ct_x = (v3[..., None, :2] @ m[:, dofs[:, :2], :3])[..., 0, :]
+        ct_x = (v3[..., None, :2] @ data.rows[3][..., :2, :3])[..., 0, :]
         out[:, bodies, 0] = v3[..., 2] * ct_x[..., 1]  # −<α̇ e_z> cᵀ ẋ
         out[:, bodies, 1] = -v3[..., 2] * ct_x[..., 0]
     return out
 
 
-def bias_force_batch(model: Model, Q: np.ndarray, Qd: np.ndarray) -> np.ndarray:
+def bias_force_batch(
+    model: Model, Q: np.ndarray, Qd: np.ndarray, data: BatchData | None = None
+) -> np.ndarray:
     """``B(q, q̇) q̇`` (4.80) for K states, shape (K, nv) (composite form, module docstring)."""
     Q = _check_batch("Q", Q, model.nv)
     Qd = _check_batch("Qd", Qd, model.nv)
     topo = topology(model)
     Qf, Vf = _expand_batch(model, Q), _expand_batch(model, Qd, offset=False)
-    kin = forward_kinematics_batch(model, Qf)
-    u = topo.incidence @ (kin.sigma * Vf[..., None])  # Σ_a σ_a q̇_a per pair, (K, nb, 6)
+    data = _data_for(model, Q.shape[0], data)
+    forward_kinematics_batch(model, data, Qf)
+    u = topo.incidence @ (data.sigma * Vf[..., None])  # Σ_a σ_a q̇_a per pair, (K, nb, 6)
     V = topo.anc.T @ u  # V⁰_j = Σ_{k ⪯ j} u_k
-    rate = _inverse_transpose(kin.L0) @ _mobility_rate(model, topo, Qf, Vf, kin.m)[..., None]
-    a = topo.anc.T @ ((_crm_batch(V) @ u[..., None])[..., 0] + rate[..., 0])  # Ṡᵀ q̇
-    theta0 = ground_inertias(model, kin)
-    h = (theta0 @ V[..., None])[..., 0]
-    f = (theta0 @ a[..., None])[..., 0] - (np.swapaxes(_crm_batch(V), -1, -2) @ h[..., None])[
-        ..., 0
-    ]
+    rate = (data.X @ _mobility_rate(model, topo, Qf, Vf, data)[..., None])[..., 0]
+    crm = _crm_batch(V)
+    a = topo.anc.T @ ((crm @ u[..., None])[..., 0] + rate)  # a⁰ = Ṡᵀ q̇ seen from E0
+    theta0 = ground_inertias(model, data)
+    h = theta0 @ V[..., None]  # momenta Θ⁰ V⁰
+    f = (theta0 @ a[..., None] - np.swapaxes(crm, -1, -2) @ h)[..., 0]  # Θa + Φ(V) Θ V
     f_c = topo.anc @ f  # Σ_{j ⪰ k} f_j
-    tau = np.sum(kin.sigma * f_c[:, topo.dof_body], axis=-1)
+    tau = np.sum(data.sigma * f_c[:, topo.dof_body], axis=-1)
     return tau if model.G is None else tau @ model.G
 
 
-def bias_force(model: Model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+def bias_force(
+    model: Model, q: np.ndarray, qd: np.ndarray, data: BatchData | None = None
+) -> np.ndarray:
     """``B(q, q̇) q̇`` at one state (structure-exploiting form)."""
     q, qd = np.asarray(q, dtype=float)[None, :], np.asarray(qd, dtype=float)[None, :]
-    return bias_force_batch(model, q, qd)[0]
+    return bias_force_batch(model, q, qd, data)[0]
 
 
-def gravity_force_batch(model: Model, Q: np.ndarray) -> np.ndarray:
+def gravity_force_batch(model: Model, Q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
     """``Q_g = S G`` (4.113)–(4.128) for K configurations: ``σ_aᵀ Θᶜ_body(a) [g0; 0]``."""
     Q = _check_batch("Q", Q, model.nv)
     topo = topology(model)
-    kin = forward_kinematics_batch(model, _expand_batch(model, Q))
-    theta0 = ground_inertias(model, kin)
+    data = _data_for(model, Q.shape[0], data)
+    forward_kinematics_batch(model, data, _expand_batch(model, Q))
+    theta0 = ground_inertias(model, data)
     w = topo.anc @ (theta0[..., :, :3] @ model.gravity)  # Σ_{j ⪰ k} Θ⁰_j [g0; 0]
-    tau = np.sum(kin.sigma * w[:, topo.dof_body], axis=-1)
+    tau = np.sum(data.sigma * w[:, topo.dof_body], axis=-1)
     return tau if model.G is None else tau @ model.G

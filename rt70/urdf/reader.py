@@ -178,6 +178,8 @@ class _Reader:
             if np.any(tensor != 0.0):
                 raise self.fail(InertiaError, f"{where}: zero mass but non-zero inertia tensor")
             return None
+        if not np.any(tensor):  # a point mass (book §2.1): no rotational inertia at all
+            return Inertial(mass=mass, com=xyz, inertia=np.zeros((3, 3)))
         moments = np.linalg.eigvalsh(tensor)
         scale = max(float(np.max(np.abs(moments))), np.finfo(float).tiny)
         if moments[0] <= 0.0:
@@ -231,7 +233,9 @@ class _Reader:
             )
         mimic = None
         mimic_elem = elem.find("mimic")
-        if mimic_elem is not None:
+        # A fixed joint has no coordinate to couple: its <mimic> (left over when a model is
+        # reduced by fixing joints) is ignored, as Pinocchio does; the joint stays fixed.
+        if mimic_elem is not None and jtype != "fixed":
             owner = f"joint '{name}'"
             source = mimic_elem.get("joint")
             if not source:
