@@ -46,6 +46,25 @@ def _validate(args: argparse.Namespace) -> int:
     return 0 if all(r.passed(args.tolerance) for r in records) and not bug else 1
 
 
+def _bench(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from rt70 import bench
+
+    sizes = (10, 20, 50) if args.quick else (10, 20, 50, 100, 200, 400)
+    rounds = 3 if args.quick else 7
+    rows = bench.run(
+        sizes=sizes,
+        K=args.K,
+        rounds=rounds,
+        progress=lambda msg: print(f"  {msg}", file=sys.stderr, flush=True),
+    )
+    print(bench.format_report(rows))
+    for path in bench.write_results(rows, Path(args.out)):
+        print(f"wrote {path}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``rt70`` command."""
     parser = argparse.ArgumentParser(
@@ -70,6 +89,17 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument("--tolerance", type=float, default=1e-10, help="relative tolerance")
     val.add_argument("--json", action="store_true", help="print the records as JSON")
     val.set_defaults(func=_validate)
+    ben = sub.add_parser(
+        "bench",
+        help="benchmark the textbook mass matrix against pin.crba (ratios, one run)",
+        description="Per-call and batched textbook A(q) against pin.crba on rt70, ur5, panda "
+        "and talos_full, and the growth of its cost on serial chains and balanced trees; "
+        "writes CSV and a log-log plot.",
+    )
+    ben.add_argument("--K", type=int, default=1000, help="batch size")
+    ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")
+    ben.add_argument("--out", default="validation/results", help="directory for CSV and PNG output")
+    ben.set_defaults(func=_bench)
     return parser
 
 

@@ -290,8 +290,8 @@ class ReferenceModel:
         rho = pin.rpy.matrixToRpy(c12.T)
         if abs(np.cos(rho[1])) < GIMBAL_LOCK_COS:
             raise SingularConfigurationError("bushing at Euler-angle gimbal lock (θ = ±π/2)")
-        J1 = pin.getFrameJacobian(m, d, b.frame1, pin.LOCAL)
-        J2 = pin.getFrameJacobian(m, d, b.frame2, pin.LOCAL)
+        J1 = pin.getFrameJacobian(m, d, b.frame1, pin.LOCAL).reshape(6, m.nv)
+        J2 = pin.getFrameJacobian(m, d, b.frame2, pin.LOCAL).reshape(6, m.nv)
         J_rel = J2 - M12.inverse().toActionMatrix() @ J1
         jac = np.empty_like(J_rel)
         jac[:3] = c12 @ J_rel[:3]

@@ -12,8 +12,8 @@ constant ``r_c[j]``, ``c_c[j]``; the pair's own motion is one of
 ``planar``
     ``q_j = [x, y, α]``: translation in the construction frame's x–y plane, then rotation
     α about its z axis;
-``fixed``
-    no coordinate (``f_j`` has no columns).
+URDF ``fixed`` joints are no pairs: the child link's inertia is merged into the body
+it is welded to (as Pinocchio does), and its frame is kept as a placement on that body.
 
 A URDF chain of six joints (prismatic x, y, z, revolute x, y, z, zero origins after the
 first, massless links between) is read as one ``euler6`` pair, exactly the layout of
@@ -31,18 +31,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rt70.textbook.spatial import body_inertia, rpy_matrix
+from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
 from rt70.urdf.description import Joint, RobotDescription
 
-PAIR_KINDS = ("euler6", "revolute", "prismatic", "planar", "fixed")
-_NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "planar": 3, "fixed": 0}
+PAIR_KINDS = ("euler6", "revolute", "prismatic", "planar")
+_NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "planar": 3}
 _URDF_KIND = {
     "revolute": "revolute",
     "continuous": "revolute",
     "prismatic": "prismatic",
     "planar": "planar",
     "floating": "euler6",
-    "fixed": "fixed",
 }
 _SUFFIXES = {"euler6": (":x", ":y", ":z", ":rx", ":ry", ":rz"), "planar": (":x", ":y", ":rz")}
 _EULER6_PATTERN = (
@@ -187,17 +186,30 @@ def build_model(desc: RobotDescription) -> Model:
     referenced = {b.frame1.link for b in desc.bushings} | {b.frame2.link for b in desc.bushings}
     referenced |= {p.link for p in desc.optical_points}
     parent, kind, axis, r_c, c_c = [], [], [], [], []
-    thetas, masses, coms, ndof, body_names, coord_names = [], [], [], [], [], []
+    thetas, ndof, body_names, coord_names = [], [], [], []
     link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = {
         desc.root: (-1, np.zeros(3), np.eye(3))
     }
     joint_coord: dict[str, int] = {}
 
-    def visit(link: str, body: int) -> None:
+    def visit(link: str, body: int, r_link: np.ndarray, c_link: np.ndarray) -> None:
+        """Add the pairs below ``link``, which sits at ``(r_link, c_link)`` in ``body``."""
         for joint in desc.child_joints(link):
+            r_joint = r_link + c_link @ joint.xyz
+            c_joint = c_link @ rpy_matrix(joint.rpy)
+            inertial = desc.links[joint.child].inertial
+            if joint.type == "fixed":  # merged into the parent body, as Pinocchio does
+                if inertial is not None and body >= 0:
+                    theta = body_inertia(inertial.mass, inertial.com, inertial.inertia)
+                    X = placement(r_joint, c_joint)
+                    thetas[body] = thetas[body] + X @ theta @ X.T
+                link_frames[joint.child] = (body, r_joint, c_joint)
+                visit(joint.child, body, r_joint, c_joint)
+                continue
             chain = _euler6_chain(desc, joint, referenced)
             if chain:
                 jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
+                inertial = desc.links[child].inertial
             else:
                 child, jkind = joint.child, _URDF_KIND[joint.type]
                 suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
@@ -206,26 +218,26 @@ def build_model(desc: RobotDescription) -> Model:
             parent.append(body)
             kind.append(jkind)
             axis.append(joint.axis)
-            r_c.append(joint.xyz)
-            c_c.append(rpy_matrix(joint.rpy))
-            inertial = desc.links[child].inertial
+            r_c.append(r_joint)
+            c_c.append(c_joint)
             if inertial is None:
                 thetas.append(np.zeros((6, 6)))
-                masses.append(0.0)
-                coms.append(np.zeros(3))
             else:
                 thetas.append(body_inertia(inertial.mass, inertial.com, inertial.inertia))
-                masses.append(inertial.mass)
-                coms.append(inertial.com)
             for name in names:
                 joint_coord[name] = len(coord_names)
                 coord_names.append(name)
             ndof.append(_NDOF[jkind])
             body_names.append(child)
             link_frames[child] = (j, np.zeros(3), np.eye(3))
-            visit(child, j)
+            visit(child, j, np.zeros(3), np.eye(3))
 
-    visit(desc.root, -1)
+    visit(desc.root, -1, np.zeros(3), np.eye(3))
+    masses = [float(t[0, 0]) for t in thetas]  # Θ = [[m 1, −m<p>], [m<p>, …]] (4.77)
+    coms = [
+        _unskew(t[3:, :3]) / m if m > 0 else np.zeros(3)
+        for t, m in zip(thetas, masses, strict=True)
+    ]
     ndof_arr = np.array(ndof, dtype=int)
     model = Model(
         name=desc.name,
@@ -277,6 +289,11 @@ def _add_mimic_constraints(model: Model, desc: RobotDescription) -> None:
             G[row, column[name]] = 1.0
     model.G, model.q_offset = G, offset
     model.coordinate_names = independent
+
+
+def _unskew(m: np.ndarray) -> np.ndarray:
+    """The vector x of a skew matrix ``<x>``."""
+    return np.array([m[2, 1], m[0, 2], m[1, 0]])
 
 
 def _frame_on_body(

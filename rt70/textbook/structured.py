@@ -40,16 +40,24 @@ class Group:
     """Pairs with the same number ``width`` of coordinates (1, 3 or 6)."""
 
     width: int
-    bodies: np.ndarray  # (n_g,)
-    dofs: np.ndarray  # (n_g, width) full-coordinate indices
+    bodies: np.ndarray | slice  # (n_g,) pair indices, a slice when they are contiguous
+    dofs: np.ndarray | slice  # (n_g, width) coordinates, a slice when contiguous
+    count: int  # n_g
+
+    def rows_of(self, x: np.ndarray) -> np.ndarray:
+        """Per-coordinate rows ``x[:, dofs]`` as (K, n_g, width, 6); a view when contiguous."""
+        if isinstance(self.dofs, slice):
+            return x[:, self.dofs].reshape(x.shape[0], self.count, self.width, x.shape[-1])
+        return x[:, self.dofs]
 
 
 @dataclass(frozen=True)
 class Topology:
     """Index arrays derived once from a model's parent array (plain data)."""
 
-    levels: tuple[np.ndarray, ...]  # bodies at depth 0, 1, ...
-    level_parents: tuple[np.ndarray, ...]  # their parents (−1 at depth 0)
+    jumps: tuple[np.ndarray, ...]  # ancestor 2^k levels up (nb = the ground), k = 0, 1, ...
+    revolute_k: np.ndarray  # <a> of each revolute pair's axis (Rodrigues' formula)
+    revolute_k2: np.ndarray  # <a>²
     anc: np.ndarray  # anc[k, j] = 1.0 if k is j or an ancestor of j
     dof_body: np.ndarray  # body of each full coordinate
     weight: np.ndarray  # 1 where body(l) ⊀ body(a) strictly, ½ on a body's own block
@@ -66,7 +74,13 @@ def _build_topology(model: Model) -> Topology:
     depth = np.zeros(nb, dtype=int)
     for j in range(nb):
         depth[j] = 0 if model.parent[j] < 0 else depth[model.parent[j]] + 1
-    levels = tuple(np.flatnonzero(depth == d) for d in range(depth.max() + 1 if nb else 0))
+    # pointer jumping: jumps[k][j] is the ancestor 2^k levels above j, or nb (the ground)
+    jump = np.where(model.parent < 0, nb, model.parent).astype(int)
+    jump = np.append(jump, nb)
+    jumps = []
+    for _ in range(int(np.ceil(np.log2(depth.max() + 1))) if nb else 0):
+        jumps.append(jump[:nb].copy())
+        jump = jump[jump]
     anc = np.zeros((nb, nb))
     for j in range(nb):
         anc[model.ancestors(j), j] = 1.0
@@ -79,8 +93,8 @@ def _build_topology(model: Model) -> Topology:
     for width in (1, 3, 6):
         bodies = np.flatnonzero(model.ndof == width)
         if bodies.size:
-            dofs = model.q_start[bodies][:, None] + np.arange(width)
-            groups.append(Group(width, bodies, dofs.astype(int)))
+            dofs = (model.q_start[bodies][:, None] + np.arange(width)).astype(int)
+            groups.append(Group(width, _as_slice(bodies), _as_slice(dofs), bodies.size))
     kinds, kind_dofs = {}, {}
     for kind, width in (("euler6", 6), ("revolute", 1), ("prismatic", 1), ("planar", 3)):
         bodies = np.array([j for j in range(nb) if model.kind[j] == kind], dtype=int)
@@ -92,8 +106,10 @@ def _build_topology(model: Model) -> Topology:
         rows_1dof[i, 0, 3:] = model.axis[j] if model.kind[j] == "revolute" else 0.0
         rows_1dof[i, 0, :3] = model.axis[j] if model.kind[j] == "prismatic" else 0.0
     return Topology(
-        levels=levels,
-        level_parents=tuple(model.parent[lv] for lv in levels),
+        jumps=tuple(jumps),
+        revolute_k=_skew_batch(model.axis[kinds["revolute"]]),
+        revolute_k2=_skew_batch(model.axis[kinds["revolute"]])
+        @ _skew_batch(model.axis[kinds["revolute"]]),
         anc=anc,
         dof_body=dof_body,
         weight=weight,
@@ -106,6 +122,14 @@ def _build_topology(model: Model) -> Topology:
     )
 
 
+def _as_slice(index: np.ndarray) -> np.ndarray | slice:
+    """A slice equal to ``index`` (flattened) if it is a contiguous range, else ``index``."""
+    flat = index.ravel()
+    if np.array_equal(flat, np.arange(flat[0], flat[0] + flat.size)):
+        return slice(int(flat[0]), int(flat[0] + flat.size))
+    return index
+
+
 def topology(model: Model) -> Topology:
     """The :class:`Topology` of ``model`` (computed once, kept on the model object)."""
     topo = model.__dict__.get("_topology")
@@ -114,37 +138,58 @@ def topology(model: Model) -> Topology:
     return topo
 
 
+#: Work arrays of one chunk of the batched mass matrix stay below this many bytes, so
+#: that the nv × nv passes run in cache and only the result goes to memory.
+CHUNK_BYTES = 8 << 20
+
+
+class Work:
+    """Work buffers of the structured algorithms for ``size`` configurations."""
+
+    def __init__(self, model: Model, size: int) -> None:
+        nb, n = model.nb, model.n_full
+        topo = topology(model)
+        self.size = size
+        self.c_rel = np.empty((size, nb, 3, 3))
+        self.r_rel = np.empty((size, nb, 3))
+        self.L_pair = np.zeros((size, nb, 6, 6))
+        self.L0 = np.empty((size, nb + 1, 6, 6))  # L_0^j of every body; [nb] = ground = 1
+        self.L0[:, nb] = np.eye(6)
+        self.X = np.zeros((size, nb, 6, 6))  # (L_0^j)⁻ᵀ
+        self.rows = {g.width: np.zeros((size, g.count, g.width, 6)) for g in topo.groups}
+        self.sigma = np.empty((size, n, 6))  # σ, one row per full coordinate
+        self.F = np.empty((size, n, 6))
+        self.theta0 = np.empty((size, nb, 6, 6))
+        self.theta_c = np.empty((size, nb, 6, 6))
+        self.Gm = np.empty((size, n, n))
+        self.GmT = np.empty((size, n, n))
+
+
 class BatchData:
-    """Work buffers of the structured algorithms for K configurations of one model.
+    """Work buffers and results of the structured algorithms for K configurations.
+
+    The mass matrix is computed in chunks of ``chunk`` configurations (sized by
+    :data:`CHUNK_BYTES`); each chunk size has its own :class:`Work`.
 
     Attributes
     ----------
-    L0 : numpy.ndarray
-        ``L_0^j`` of every body, (K, nb, 6, 6).
-    sigma : numpy.ndarray
-        Mobility axes seen from E0, one row per full coordinate, (K, n_full, 6).
     A : numpy.ndarray
         The last mass matrices computed, (K, nv, nv).
     """
 
-    def __init__(self, model: Model, K: int) -> None:
-        nb, n = model.nb, model.n_full
-        topo = topology(model)
+    def __init__(self, model: Model, K: int, chunk: int | None = None) -> None:
+        n = max(model.n_full, 1)
         self.K = K
-        self.c_rel = np.empty((K, nb, 3, 3))
-        self.r_rel = np.empty((K, nb, 3))
-        self.L_pair = np.zeros((K, nb, 6, 6))
-        self.L0 = np.empty((K, nb, 6, 6))
-        self.X = np.zeros((K, nb, 6, 6))
-        self.rows = {g.width: np.zeros((K, g.bodies.size, g.width, 6)) for g in topo.groups}
-        self.sigma = np.empty((K, n, 6))
-        self.F = np.empty((K, n, 6))
-        self.theta0 = np.empty((K, nb, 6, 6))
-        self.theta_c = np.empty((K, nb, 6, 6))
-        self.Gm = np.empty((K, n, n))
-        self.GmT = np.empty((K, n, n))
-        self.A_full = np.empty((K, n, n))
-        self.A = self.A_full if model.G is None else np.empty((K, model.nv, model.nv))
+        self.chunk = chunk or max(1, min(K, CHUNK_BYTES // (24 * n * n)))
+        self.A = np.empty((K, model.nv, model.nv))
+        self._model = model
+        self._works: dict[int, Work] = {}
+
+    def work(self, size: int) -> Work:
+        """The work buffers for ``size`` configurations (made once, then reused)."""
+        if size not in self._works:
+            self._works[size] = Work(self._model, size)
+        return self._works[size]
 
 
 def _data_for(model: Model, K: int, data: BatchData | None) -> BatchData:
@@ -153,33 +198,32 @@ def _data_for(model: Model, K: int, data: BatchData | None) -> BatchData:
     return data
 
 
+_SKEW_SRC = np.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
+_SKEW_SIGN = np.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])
+
+
 def _skew_batch(x: np.ndarray) -> np.ndarray:
     """``<x>`` for an array of 3-vectors, shape (..., 3) → (..., 3, 3)."""
-    out = np.zeros(x.shape + (3,))
-    out[..., 0, 1], out[..., 0, 2] = -x[..., 2], x[..., 1]
-    out[..., 1, 0], out[..., 1, 2] = x[..., 2], -x[..., 0]
-    out[..., 2, 0], out[..., 2, 1] = -x[..., 1], x[..., 0]
-    return out
+    return (x[..., _SKEW_SRC] * _SKEW_SIGN).reshape(x.shape + (3,))
+
+
+_E123 = np.eye(3)
 
 
 def _euler123_batch(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``c = c1(β) c2(θ) c3(α)`` (1.23) and the Euler matrix ε (1.38), batched."""
-    sb, cb = np.sin(phi[..., 0]), np.cos(phi[..., 0])
-    st, ct = np.sin(phi[..., 1]), np.cos(phi[..., 1])
-    sa, ca = np.sin(phi[..., 2]), np.cos(phi[..., 2])
-    c = np.empty(phi.shape[:-1] + (3, 3))
-    c[..., 0, 0], c[..., 0, 1], c[..., 0, 2] = ct * ca, -ct * sa, st
-    c[..., 1, 0] = cb * sa + sb * st * ca
-    c[..., 1, 1] = cb * ca - sb * st * sa
-    c[..., 1, 2] = -sb * ct
-    c[..., 2, 0] = sb * sa - cb * st * ca
-    c[..., 2, 1] = sb * ca + cb * st * sa
-    c[..., 2, 2] = cb * ct
-    eps = np.zeros_like(c)
-    eps[..., 0, 0], eps[..., 0, 1] = ct * ca, sa
-    eps[..., 1, 0], eps[..., 1, 1] = -ct * sa, ca
-    eps[..., 2, 0], eps[..., 2, 2] = st, 1.0
-    return c, eps
+    """``c = c1(β) c2(θ) c3(α)`` (1.23) and the transposed Euler matrix εᵀ (1.38), batched.
+
+    The rows of ``εᵀ`` are ``(c2 c3)ᵀ e_x``, ``c3ᵀ e_y`` and ``e_z`` read as rows of
+    ``c2 c3`` and ``c3``.
+    """
+    elementary = _rotations_about_axes(_E123, phi)  # c1(β), c2(θ), c3(α)
+    c23 = elementary[..., 1, :, :] @ elementary[..., 2, :, :]
+    c = elementary[..., 0, :, :] @ c23
+    eps_t = np.empty_like(c)
+    eps_t[..., 0, :] = c23[..., 0, :]
+    eps_t[..., 1, :] = elementary[..., 2, 1, :]
+    eps_t[..., 2, :] = _E123[2]
+    return c, eps_t
 
 
 def _rotations_about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
@@ -190,7 +234,7 @@ def _rotations_about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return _E3 + s * k + (1.0 - c) * k2
 
 
-def forward_kinematics_batch(model: Model, data: BatchData, Qf: np.ndarray) -> None:
+def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
     """Fill ``data.L0`` (``L_0^j`` of every body) and ``data.sigma`` for K configurations.
 
     ``L_i^j = T(r_c + c_c r_j)[c_c c_j]`` (4.5)–(4.7); forward pass over the depth of
@@ -203,19 +247,21 @@ def forward_kinematics_batch(model: Model, data: BatchData, Qf: np.ndarray) -> N
     r_rel[:] = 0.0
     bodies, dofs = topo.kinds["revolute"], topo.kind_dofs["revolute"]
     if bodies.size:
-        c_rel[:, bodies] = _rotations_about_axes(model.axis[bodies], Qf[:, dofs[:, 0]])
+        angles = Qf[:, dofs[:, 0], None, None]  # Rodrigues: 1 + sin q <a> + (1 − cos q) <a>²
+        c_rel[:, bodies] = _E3 + np.sin(angles) * topo.revolute_k
+        c_rel[:, bodies] += (1.0 - np.cos(angles)) * topo.revolute_k2
     bodies, dofs = topo.kinds["prismatic"], topo.kind_dofs["prismatic"]
     if bodies.size:
         r_rel[:, bodies] = Qf[:, dofs[:, 0], None] * model.axis[bodies]
     bodies, dofs = topo.kinds["euler6"], topo.kind_dofs["euler6"]
     if bodies.size:
         q6 = Qf[:, dofs]  # (K, n6, 6)
-        c, eps = _euler123_batch(q6[..., 3:])
+        c, eps_t = _euler123_batch(q6[..., 3:])
         c_rel[:, bodies] = c
         r_rel[:, bodies] = q6[..., :3]
         rows = data.rows[6]  # row a = column a of M_j = diag(cᵀ, ε)
         rows[..., :3, :3] = c
-        rows[..., 3:, 3:] = np.swapaxes(eps, -1, -2)
+        rows[..., 3:, 3:] = eps_t
     bodies, dofs = topo.kinds["planar"], topo.kind_dofs["planar"]
     if bodies.size:
         q3 = Qf[:, dofs]
@@ -233,12 +279,13 @@ def forward_kinematics_batch(model: Model, data: BatchData, Qf: np.ndarray) -> N
     L_pair[..., :3, :3] = C
     L_pair[..., 3:, 3:] = C
     np.matmul(_skew_batch(P), C, out=L_pair[..., 3:, :3])
+    # L_0^j = L_0^i L_i^j (chain property) for all bodies at once by pointer jumping:
+    # after step k, L0[j] holds the transform from the ancestor 2^(k+1) levels up to j.
     L0 = data.L0
-    for level, parents in zip(topo.levels, topo.level_parents, strict=True):
-        if parents[0] < 0:  # depth 0: children of the ground
-            L0[:, level] = L_pair[:, level]
-        else:
-            L0[:, level] = L0[:, parents] @ L_pair[:, level]
+    L0[:, :-1] = L_pair
+    for jump in topo.jumps:
+        L0[:, :-1] = L0[:, jump] @ L0[:, :-1]
+    L0 = L0[:, :-1]
     X = data.X  # (L_0^j)⁻ᵀ = [[c, <p>c], [0, c]]
     X[..., :3, :3] = L0[..., :3, :3]
     X[..., 3:, 3:] = L0[..., 3:, 3:]
@@ -246,12 +293,16 @@ def forward_kinematics_batch(model: Model, data: BatchData, Qf: np.ndarray) -> N
     Xt = np.swapaxes(X, -1, -2)
     for g in topo.groups:
         rows = topo.rows_1dof if g.width == 1 else data.rows[g.width]
-        data.sigma[:, g.dofs] = rows @ Xt[:, g.bodies]
+        if isinstance(g.dofs, slice):
+            np.matmul(rows, Xt[:, g.bodies], out=g.rows_of(data.sigma))
+        else:
+            data.sigma[:, g.dofs] = rows @ Xt[:, g.bodies]
 
 
-def ground_inertias(model: Model, data: BatchData) -> np.ndarray:
+def ground_inertias(model: Model, data: Work) -> np.ndarray:
     """``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` for every body, into ``data.theta0`` (4.77)."""
-    np.matmul(data.L0 @ model.Theta, np.swapaxes(data.L0, -1, -2), out=data.theta0)
+    L0 = data.L0[:, :-1]
+    np.matmul(L0 @ model.Theta, np.swapaxes(L0, -1, -2), out=data.theta0)
     return data.theta0
 
 
@@ -266,7 +317,7 @@ def _check_batch(name: str, Q: np.ndarray, nv: int) -> np.ndarray:
     Q = np.asarray(Q, dtype=float)
     if Q.ndim != 2 or Q.shape[1] != nv:
         raise ValueError(f"{name} must have shape (K, {nv}), got {Q.shape}")
-    if not np.all(np.isfinite(Q)):
+    if np.isnan(Q.ravel() @ np.zeros(Q.size)):  # 0·x is NaN exactly for x = ±inf or NaN
         raise NonFiniteError(f"{name} contains NaN or infinite values")
     return Q
 
@@ -280,21 +331,33 @@ def mass_matrix_batch(model: Model, Q: np.ndarray, data: BatchData | None = None
     """
     Q = _check_batch("Q", Q, model.nv)
     data = _data_for(model, Q.shape[0], data)
-    topo = topology(model)
-    forward_kinematics_batch(model, data, _expand_batch(model, Q))
-    theta0 = ground_inertias(model, data)
-    K, nb = theta0.shape[:2]
-    np.matmul(topo.anc, theta0.reshape(K, nb, 36), out=data.theta_c.reshape(K, nb, 36))
-    for g in topo.groups:  # F_a = Θᶜ_body(a) σ_a (Θᶜ symmetric)
-        data.F[:, g.dofs] = data.sigma[:, g.dofs] @ data.theta_c[:, g.bodies]
-    np.matmul(data.sigma, np.swapaxes(data.F, -1, -2), out=data.Gm)  # σ_lᵀ Θᶜ_body(a) σ_a
-    np.matmul(data.F, np.swapaxes(data.sigma, -1, -2), out=data.GmT)  # its transpose
-    np.multiply(data.Gm, topo.weight, out=data.A_full)
-    data.GmT *= topo.weight_t
-    data.A_full += data.GmT
-    if model.G is not None:
-        np.matmul(model.G.T @ data.A_full, model.G, out=data.A)
+    Qf = _expand_batch(model, Q)
+    for start in range(0, Q.shape[0], data.chunk):
+        stop = min(start + data.chunk, Q.shape[0])
+        work = data.work(stop - start)
+        out = data.A[start:stop] if model.G is None else np.empty_like(work.Gm)
+        _mass_matrix_chunk(model, work, Qf[start:stop], out)
+        if model.G is not None:
+            np.matmul(model.G.T @ out, model.G, out=data.A[start:stop])
     return data.A
+
+
+def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray) -> None:
+    topo = topology(model)
+    forward_kinematics_batch(model, work, Qf)
+    theta0 = ground_inertias(model, work)
+    K, nb = theta0.shape[:2]
+    np.matmul(topo.anc, theta0.reshape(K, nb, 36), out=work.theta_c.reshape(K, nb, 36))
+    for g in topo.groups:  # F_a = Θᶜ_body(a) σ_a (Θᶜ symmetric)
+        if isinstance(g.dofs, slice):
+            np.matmul(g.rows_of(work.sigma), work.theta_c[:, g.bodies], out=g.rows_of(work.F))
+        else:
+            work.F[:, g.dofs] = work.sigma[:, g.dofs] @ work.theta_c[:, g.bodies]
+    np.matmul(work.sigma, np.swapaxes(work.F, -1, -2), out=work.Gm)  # σ_lᵀ Θᶜ_body(a) σ_a
+    np.matmul(work.F, np.swapaxes(work.sigma, -1, -2), out=work.GmT)  # its transpose
+    np.multiply(work.Gm, topo.weight, out=out)
+    work.GmT *= topo.weight_t
+    out += work.GmT
 
 
 def mass_matrix(model: Model, q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
@@ -312,7 +375,7 @@ def _crm_batch(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray, data: BatchData):
+def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray, data: Work):
     """``Ṁ_j f_j q̇_j`` in body frames, shape (K, nb, 6) (4.82).
 
     euler6: ``[ċᵀ ẋ; ε̇ φ̇]`` with ``ċᵀ = −<ω> cᵀ``, ``ω = ε φ̇``; planar likewise with
@@ -351,7 +414,7 @@ def bias_force_batch(
     Qd = _check_batch("Qd", Qd, model.nv)
     topo = topology(model)
     Qf, Vf = _expand_batch(model, Q), _expand_batch(model, Qd, offset=False)
-    data = _data_for(model, Q.shape[0], data)
+    data = _data_for(model, Q.shape[0], data).work(Q.shape[0])
     forward_kinematics_batch(model, data, Qf)
     u = topo.incidence @ (data.sigma * Vf[..., None])  # Σ_a σ_a q̇_a per pair, (K, nb, 6)
     V = topo.anc.T @ u  # V⁰_j = Σ_{k ⪯ j} u_k
@@ -378,7 +441,7 @@ def gravity_force_batch(model: Model, Q: np.ndarray, data: BatchData | None = No
     """``Q_g = S G`` (4.113)–(4.128) for K configurations: ``σ_aᵀ Θᶜ_body(a) [g0; 0]``."""
     Q = _check_batch("Q", Q, model.nv)
     topo = topology(model)
-    data = _data_for(model, Q.shape[0], data)
+    data = _data_for(model, Q.shape[0], data).work(Q.shape[0])
     forward_kinematics_batch(model, data, _expand_batch(model, Q))
     theta0 = ground_inertias(model, data)
     w = topo.anc @ (theta0[..., :, :3] @ model.gravity)  # Σ_{j ⪰ k} Θ⁰_j [g0; 0]

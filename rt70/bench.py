@@ -1,0 +1,237 @@
+"""Benchmarks of the textbook algorithm against Pinocchio, as ratios taken in one run.
+
+This machine is shared and noisy, so every comparison interleaves the two sides:
+each round times the textbook call and the Pinocchio call back to back, the ratio is
+taken per round, and the median ratio is reported (with the best time of each side).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from rt70.atomic import atomic_write, atomic_write_text
+from rt70.scene import Scene, load_scene, scene_from_text
+from rt70.textbook import dynamics, structured
+
+
+@dataclass(frozen=True)
+class Row:
+    """One benchmark result: seconds per configuration on each side and their ratio."""
+
+    benchmark: str
+    target: str
+    nv: int
+    K: int
+    t_textbook_s: float
+    t_pinocchio_s: float
+    ratio: float
+
+
+def _per_call(fn: Callable[[], object], budget_s: float) -> float:
+    """Seconds per call of ``fn``, timing enough calls to fill about ``budget_s``."""
+    start = time.perf_counter()
+    fn()
+    once = max(time.perf_counter() - start, 1e-7)
+    number = max(1, int(budget_s / once))
+    start = time.perf_counter()
+    for _ in range(number):
+        fn()
+    return (time.perf_counter() - start) / number
+
+
+def compare(
+    textbook: Callable[[], object],
+    pinocchio: Callable[[], object],
+    rounds: int = 7,
+    budget_s: float = 0.02,
+) -> tuple[float, float, float]:
+    """Interleaved timing: (best textbook s/call, best Pinocchio s/call, median ratio)."""
+    t_tb, t_pin = [], []
+    for _ in range(rounds):
+        t_tb.append(_per_call(textbook, budget_s))
+        t_pin.append(_per_call(pinocchio, budget_s))
+    ratios = np.array(t_tb) / np.array(t_pin)
+    return min(t_tb), min(t_pin), float(np.median(ratios))
+
+
+def _pin_crba(scene: Scene, q: np.ndarray) -> Callable[[], object]:
+    import pinocchio as pin
+
+    ref = scene.reference
+    qp = ref.to_pinocchio(scene.to_reference(q))[0]
+    model, data = ref.model, ref.model.createData()
+    return lambda: pin.crba(model, data, qp)
+
+
+def per_call(scene: Scene, rounds: int, budget_s: float) -> Row:
+    """Textbook structured A(q) against one ``pin.crba`` call."""
+    model = scene.textbook
+    q = np.random.default_rng(0).uniform(-0.5, 0.5, model.nv)
+    bdata = structured.BatchData(model, 1)
+    t_tb, t_pin, ratio = compare(
+        lambda: structured.mass_matrix(model, q, bdata), _pin_crba(scene, q), rounds, budget_s
+    )
+    return Row("per_call", scene.name, model.nv, 1, t_tb, t_pin, ratio)
+
+
+def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
+    """Textbook batched A for K configurations against K calls of ``pin.crba``."""
+    import pinocchio as pin
+
+    model = scene.textbook
+    Q = np.random.default_rng(1).uniform(-0.5, 0.5, (K, model.nv))
+    bdata = structured.BatchData(model, K)
+    ref = scene.reference
+    QP = [ref.to_pinocchio(scene.to_reference(q))[0] for q in Q]
+    pm, pd = ref.model, ref.model.createData()
+
+    def pin_loop() -> None:
+        for qp in QP:
+            pin.crba(pm, pd, qp)
+
+    t_tb, t_pin, ratio = compare(
+        lambda: structured.mass_matrix_batch(model, Q, bdata), pin_loop, rounds, budget_s
+    )
+    return Row("batched", scene.name, model.nv, K, t_tb / K, t_pin / K, ratio)
+
+
+def scaling(kind: str, sizes: list[int], rounds: int, budget_s: float, dense_max: int) -> list[Row]:
+    """Cost of A(q) on generated serial chains or balanced trees of the given sizes.
+
+    The dense form (full L and S) is timed as well up to ``dense_max`` bodies.
+    """
+    from rt70.scenes import synthetic
+
+    make = synthetic.serial_chain if kind == "chain" else synthetic.balanced_tree
+    rows = []
+    for n in sizes:
+        scene = scene_from_text(make(n), f"{kind}_{n}")
+        rows.append(replace(per_call(scene, rounds, budget_s), benchmark=f"scaling_{kind}"))
+        if n <= dense_max:
+            model, data = scene.textbook, scene.textbook_data
+            q = np.zeros(model.nv)
+            t_dense, t_pin, ratio = compare(
+                lambda m=model, d=data, q=q: dynamics.mass_matrix(m, d, q),
+                _pin_crba(scene, q),
+                max(3, rounds // 2),
+                budget_s,
+            )
+            rows.append(
+                Row(f"scaling_{kind}_dense", scene.name, model.nv, 1, t_dense, t_pin, ratio)
+            )
+    return rows
+
+
+def fit_exponent(rows: list[Row], benchmark: str, min_nv: int = 0) -> float:
+    """Slope of log(time) against log(nv) over the rows of one benchmark."""
+    pts = [(r.nv, r.t_textbook_s) for r in rows if r.benchmark == benchmark and r.nv >= min_nv]
+    if len(pts) < 2:
+        return float("nan")
+    nv, t = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
+    return float(np.polyfit(nv, t, 1)[0])
+
+
+#: Targets of the issue, as (benchmark, value): ratios ≤ value, exponent ≤ value.
+TARGETS = {"per_call": 10.0, "batched": 1.0, "exponent_chain": 2.2}
+
+
+def run(
+    robots: tuple[str, ...] = ("ur5", "panda", "talos_full"),
+    sizes: tuple[int, ...] = (10, 20, 50, 100, 200, 400),
+    K: int = 1000,
+    rounds: int = 7,
+    budget_s: float = 0.02,
+    dense_max: int = 100,
+    progress: Callable[[str], None] | None = None,
+) -> list[Row]:
+    """All mass-matrix benchmarks: per call, batched, and growth with size."""
+    from rt70.robots import load_robot
+
+    say = progress or (lambda _msg: None)
+    scenes = [load_scene("rt70")] + [load_robot(name) for name in robots]
+    rows = []
+    for scene in scenes:
+        say(f"per call: {scene.name}")
+        rows.append(per_call(scene, rounds, budget_s))
+    for scene in scenes[:2]:
+        say(f"batched K={K}: {scene.name}")
+        rows.append(batched(scene, K, max(3, rounds // 2), budget_s))
+    for kind in ("chain", "tree"):
+        say(f"scaling: {kind}s of {', '.join(map(str, sizes))} bodies")
+        rows.extend(scaling(kind, list(sizes), rounds, budget_s, dense_max))
+    return rows
+
+
+def format_report(rows: list[Row]) -> str:
+    """The benchmark table, the fitted exponents and the targets."""
+    head = f"{'benchmark':<22} {'target':<14} {'nv':>4} {'K':>5} {'textbook µs':>12} "
+    head += f"{'pinocchio µs':>12} {'ratio':>8}"
+    lines = [head, "-" * len(head)]
+    for r in rows:
+        lines.append(
+            f"{r.benchmark:<22} {r.target:<14} {r.nv:>4} {r.K:>5} {r.t_textbook_s * 1e6:>12.2f} "
+            f"{r.t_pinocchio_s * 1e6:>12.2f} {r.ratio:>8.2f}"
+        )
+    lines.append("")
+    for kind in ("chain", "tree"):
+        bench = f"scaling_{kind}"
+        if any(r.benchmark == bench for r in rows):
+            lines.append(
+                f"exponent of textbook A(q) time vs nv, {kind}s: "
+                f"{fit_exponent(rows, bench):.2f} (all sizes), "
+                f"{fit_exponent(rows, bench, min_nv=100):.2f} (nv ≥ 100); dense form "
+                f"{fit_exponent(rows, bench + '_dense'):.2f}"
+            )
+    lines.append(
+        "targets: per-call ratio ≤ 10 on rt70 and talos_full, batched ratio ≤ 1 at K = 1000, "
+        "chain exponent ≤ 2.2"
+    )
+    return "\n".join(lines)
+
+
+def write_results(rows: list[Row], directory: Path) -> list[Path]:
+    """Write ``mass_matrix_bench.csv`` and the log–log plot ``mass_matrix_bench.png``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=[f.name for f in fields(Row)])
+    writer.writeheader()
+    for r in rows:
+        writer.writerow(asdict(r))
+    csv_path = atomic_write_text(directory / "mass_matrix_bench.csv", buf.getvalue())
+
+    fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
+    styles = {"chain": "o", "tree": "s"}
+    for kind, marker in styles.items():
+        for bench, label, ls in (
+            (f"scaling_{kind}", "textbook structured", "-"),
+            (f"scaling_{kind}_dense", "textbook dense", ":"),
+        ):
+            pts = sorted((r.nv, r.t_textbook_s) for r in rows if r.benchmark == bench)
+            if pts:
+                nv, t = zip(*pts, strict=True)
+                ax.loglog(nv, np.array(t) * 1e6, ls, marker=marker, label=f"{label}, {kind}")
+        pts = sorted((r.nv, r.t_pinocchio_s) for r in rows if r.benchmark == f"scaling_{kind}")
+        if pts:
+            nv, t = zip(*pts, strict=True)
+            ax.loglog(nv, np.array(t) * 1e6, "--", marker=marker, label=f"pin.crba, {kind}")
+    ax.set_xlabel("nv (generalised coordinates)")
+    ax.set_ylabel("time per A(q), µs")
+    ax.set_title("Mass matrix cost against size (one run, interleaved)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    png_path = atomic_write(
+        directory / "mass_matrix_bench.png", lambda tmp: fig.savefig(tmp, dpi=120)
+    )
+    plt.close(fig)
+    return [csv_path, png_path]
