@@ -31,6 +31,7 @@ import numpy as np
 
 from rt70.errors import NonFiniteError
 from rt70.textbook.model import Model
+from rt70.textbook.spatial import placement
 
 _E3 = np.eye(3)
 
@@ -57,7 +58,11 @@ class Topology:
 
     jumps: tuple[np.ndarray, ...]  # ancestor 2^k levels up (nb = the ground), k = 0, 1, ...
     revolute_k: np.ndarray  # <a> of each revolute pair's axis (Rodrigues' formula)
-    revolute_k2: np.ndarray  # <a>²
+    revolute_basis: np.ndarray  # rows 1, <a>, <a>² flattened, (n_rev, 3, 9)
+    revolute_bodies: np.ndarray | slice  # revolute pairs (a slice when contiguous)
+    revolute_dofs: np.ndarray | slice  # their coordinates
+    L_construction: np.ndarray  # T(r_c)[c_c] of every pair (nb, 6, 6)
+    translates: bool  # whether any pair has a variable translation
     anc: np.ndarray  # anc[k, j] = 1.0 if k is j or an ancestor of j
     dof_body: np.ndarray  # body of each full coordinate
     weight: np.ndarray  # 1 where body(l) ⊀ body(a) strictly, ½ on a body's own block
@@ -105,11 +110,23 @@ def _build_topology(model: Model) -> Topology:
     for i, j in enumerate(one):
         rows_1dof[i, 0, 3:] = model.axis[j] if model.kind[j] == "revolute" else 0.0
         rows_1dof[i, 0, :3] = model.axis[j] if model.kind[j] == "prismatic" else 0.0
+    rev_k = _skew_batch(model.axis[kinds["revolute"]])
     return Topology(
         jumps=tuple(jumps),
-        revolute_k=_skew_batch(model.axis[kinds["revolute"]]),
-        revolute_k2=_skew_batch(model.axis[kinds["revolute"]])
-        @ _skew_batch(model.axis[kinds["revolute"]]),
+        L_construction=np.array(
+            [placement(r, c) for r, c in zip(model.r_c, model.c_c, strict=True)]
+        ).reshape(-1, 6, 6),
+        translates=any(k in ("prismatic", "euler6", "planar") for k in model.kind),
+        revolute_k=rev_k,
+        revolute_basis=np.stack(
+            [np.broadcast_to(_E3, rev_k.shape), rev_k, rev_k @ rev_k], axis=-3
+        ).reshape(-1, 3, 9),
+        revolute_bodies=_as_slice(kinds["revolute"])
+        if kinds["revolute"].size
+        else kinds["revolute"],
+        revolute_dofs=_as_slice(kind_dofs["revolute"][:, 0])
+        if kinds["revolute"].size
+        else kind_dofs["revolute"][:, 0],
         anc=anc,
         dof_body=dof_body,
         weight=weight,
@@ -142,6 +159,9 @@ def topology(model: Model) -> Topology:
 #: that the nv × nv passes run in cache and only the result goes to memory.
 CHUNK_BYTES = 8 << 20
 
+#: Up to this many entries the nv × nv work is cache-resident (transposed reads are cheap).
+_SMALL = 1 << 16
+
 
 class Work:
     """Work buffers of the structured algorithms for ``size`` configurations."""
@@ -150,11 +170,14 @@ class Work:
         nb, n = model.nb, model.n_full
         topo = topology(model)
         self.size = size
-        self.c_rel = np.empty((size, nb, 3, 3))
-        self.r_rel = np.empty((size, nb, 3))
-        self.L_pair = np.zeros((size, nb, 6, 6))
-        self.L0 = np.empty((size, nb + 1, 6, 6))  # L_0^j of every body; [nb] = ground = 1
-        self.L0[:, nb] = np.eye(6)
+        self.M_rel = np.zeros((size, nb, 6, 6))  # T(r_j)[c_j]: the pairs' own motion
+        self.M_rel[..., :3, :3] = _E3
+        self.c_rel = self.M_rel[..., :3, :3]
+        self.r_rel = np.zeros((size, nb, 3))
+        self.L0_buffers = (np.empty((size, nb + 1, 6, 6)), np.empty((size, nb + 1, 6, 6)))
+        for buf in self.L0_buffers:
+            buf[:, nb] = np.eye(6)  # the ground
+        self.L0 = self.L0_buffers[0][:, :nb]  # L_0^j of every body (a view, set per call)
         self.X = np.zeros((size, nb, 6, 6))  # (L_0^j)⁻ᵀ
         self.rows = {g.width: np.zeros((size, g.count, g.width, 6)) for g in topo.groups}
         self.sigma = np.empty((size, n, 6))  # σ, one row per full coordinate
@@ -242,14 +265,13 @@ def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
     product per level; then ``σ = (L_0^j)⁻ᵀ M_j f_j`` per group of equal-width pairs.
     """
     topo = topology(model)
-    c_rel, r_rel = data.c_rel, data.r_rel
-    c_rel[:] = _E3
-    r_rel[:] = 0.0
-    bodies, dofs = topo.kinds["revolute"], topo.kind_dofs["revolute"]
-    if bodies.size:
-        angles = Qf[:, dofs[:, 0], None, None]  # Rodrigues: 1 + sin q <a> + (1 − cos q) <a>²
-        c_rel[:, bodies] = _E3 + np.sin(angles) * topo.revolute_k
-        c_rel[:, bodies] += (1.0 - np.cos(angles)) * topo.revolute_k2
+    c_rel, r_rel = data.c_rel, data.r_rel  # views into data.M_rel
+    bodies, dofs = topo.revolute_bodies, topo.revolute_dofs
+    if topo.revolute_k.size:
+        # Rodrigues: c = 1 + sin q <a> + (1 − cos q) <a>², as one product with the basis
+        angles = Qf[:, dofs]
+        coef = np.stack([np.ones_like(angles), np.sin(angles), 1.0 - np.cos(angles)], axis=-1)
+        c_rel[:, bodies] = (coef[..., None, :] @ topo.revolute_basis).reshape(angles.shape + (3, 3))
     bodies, dofs = topo.kinds["prismatic"], topo.kind_dofs["prismatic"]
     if bodies.size:
         r_rel[:, bodies] = Qf[:, dofs[:, 0], None] * model.axis[bodies]
@@ -273,24 +295,24 @@ def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
         rows[..., 0, 0], rows[..., 0, 1] = ca, -sa  # cᵀ e_x
         rows[..., 1, 0], rows[..., 1, 1] = sa, ca  # cᵀ e_y
         rows[..., 2, 5] = 1.0
-    C = model.c_c @ c_rel
-    P = model.r_c + (model.c_c @ r_rel[..., None])[..., 0]
-    L_pair = data.L_pair  # T(P)[C] = [[C, 0], [<P> C, C]] (4.3)
-    L_pair[..., :3, :3] = C
-    L_pair[..., 3:, 3:] = C
-    np.matmul(_skew_batch(P), C, out=L_pair[..., 3:, :3])
+    # L_i^j = T(r_c)[c_c] · T(r_j)[c_j] (4.5)–(4.7): the constant part times M_rel
+    M_rel = data.M_rel
+    M_rel[..., 3:, 3:] = c_rel
+    if topo.translates:
+        np.matmul(_skew_batch(r_rel), c_rel, out=M_rel[..., 3:, :3])
     # L_0^j = L_0^i L_i^j (chain property) for all bodies at once by pointer jumping:
-    # after step k, L0[j] holds the transform from the ancestor 2^(k+1) levels up to j.
-    L0 = data.L0
-    L0[:, :-1] = L_pair
+    # after step k, row j holds the transform from the ancestor 2^(k+1) levels up to j
+    # (row nb is the ground's identity).
+    cur, other = data.L0_buffers
+    np.matmul(topo.L_construction, M_rel, out=cur[:, :-1])
     for jump in topo.jumps:
-        L0[:, :-1] = L0[:, jump] @ L0[:, :-1]
-    L0 = L0[:, :-1]
-    X = data.X  # (L_0^j)⁻ᵀ = [[c, <p>c], [0, c]]
-    X[..., :3, :3] = L0[..., :3, :3]
-    X[..., 3:, 3:] = L0[..., 3:, 3:]
-    X[..., :3, 3:] = L0[..., 3:, :3]
-    Xt = np.swapaxes(X, -1, -2)
+        np.matmul(cur[:, jump], cur[:, :-1], out=other[:, :-1])
+        cur, other = other, cur
+    data.L0 = L0 = cur[:, :-1]
+    K, nb = L0.shape[:2]
+    # (L_0^j)⁻ᵀ = [[c, <p>c], [0, c]]: L_0^j = [[c, 0], [<p>c, c]] with its blocks permuted
+    np.take(L0.reshape(K, nb, 36), _INV_T, axis=-1, out=data.X.reshape(K, nb, 36))
+    Xt = np.swapaxes(data.X, -1, -2)
     for g in topo.groups:
         rows = topo.rows_1dof if g.width == 1 else data.rows[g.width]
         if isinstance(g.dofs, slice):
@@ -299,9 +321,22 @@ def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
             data.sigma[:, g.dofs] = rows @ Xt[:, g.bodies]
 
 
+#: Flat indices taking [[c, 0], [<p>c, c]] to [[c, <p>c], [0, c]] (36 = the zero entry 3).
+_INV_T = np.array(
+    [
+        [0, 1, 2, 18, 19, 20],
+        [6, 7, 8, 24, 25, 26],
+        [12, 13, 14, 30, 31, 32],
+        [3, 3, 3, 21, 22, 23],
+        [3, 3, 3, 27, 28, 29],
+        [3, 3, 3, 33, 34, 35],
+    ]
+).ravel()
+
+
 def ground_inertias(model: Model, data: Work) -> np.ndarray:
     """``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` for every body, into ``data.theta0`` (4.77)."""
-    L0 = data.L0[:, :-1]
+    L0 = data.L0
     np.matmul(L0 @ model.Theta, np.swapaxes(L0, -1, -2), out=data.theta0)
     return data.theta0
 
@@ -354,6 +389,10 @@ def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray
         else:
             work.F[:, g.dofs] = work.sigma[:, g.dofs] @ work.theta_c[:, g.bodies]
     np.matmul(work.sigma, np.swapaxes(work.F, -1, -2), out=work.Gm)  # σ_lᵀ Θᶜ_body(a) σ_a
+    if work.Gm.size <= _SMALL:  # in cache: add the transpose directly
+        work.Gm *= topo.weight
+        np.add(work.Gm, np.swapaxes(work.Gm, -1, -2), out=out)
+        return
     np.matmul(work.F, np.swapaxes(work.sigma, -1, -2), out=work.GmT)  # its transpose
     np.multiply(work.Gm, topo.weight, out=out)
     work.GmT *= topo.weight_t
