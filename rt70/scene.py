@@ -9,10 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.errors import SceneError, UrdfError
+from rt70.errors import SceneError
 from rt70.textbook.data import Data
 from rt70.textbook.model import Model, build_model
 from rt70.urdf import RobotDescription, read_urdf_string
+from rt70.urdf.reader import read_source
 
 #: Directory of the project's scenes (``urdf/`` beside the package; ``RT70_URDF_DIR`` overrides).
 URDF_DIR = Path(os.environ.get("RT70_URDF_DIR", Path(__file__).resolve().parents[1] / "urdf"))
@@ -87,12 +88,7 @@ class Scene:
 def load_scene(target: str | Path) -> Scene:
     """Read a scene by name or path (see :func:`scene_path`), validating the URDF."""
     path = scene_path(target)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UrdfError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UrdfError(f"{path}: cannot read file ({exc})") from None
+    text = read_source(path)
     desc = read_urdf_string(text, source=str(path))
     return Scene(path.stem, path, text, desc)
 

@@ -15,13 +15,12 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import re
 import sys
-import tempfile
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
+from rt70.atomic import atomic_write_text
 from rt70.scenes import mechanisms, rt70_data
 
 #: Namespace of the rt70 URDF extension elements.
@@ -645,20 +644,6 @@ SCENES: dict[str, Callable[[], str]] = {
 }
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def write_all(directory: Path) -> list[Path]:
     """Write every scene as ``<name>.urdf`` into ``directory``.
 
@@ -680,7 +665,7 @@ def write_all(directory: Path) -> list[Path]:
     written = []
     for name, build in SCENES.items():
         path = directory / f"{name}.urdf"
-        _write_atomic(path, build())
+        atomic_write_text(path, build())
         written.append(path)
     return written
 

@@ -53,6 +53,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from rt70.scenes.generate import _PAIR_JOINTS, fmt, fmt_vec
+from rt70.textbook.spatial import rpy_matrix, rpy_of_matrix
+
 #: Every joint type of the URDF standard, as :func:`random_tree` draws them.
 ALL_JOINT_TYPES = ("revolute", "prismatic", "fixed", "continuous", "floating", "planar")
 
@@ -74,15 +77,6 @@ _MASSLESS_JOINT_TYPES = ("fixed", *ONE_DOF_JOINT_TYPES)
 _MAX_AXIS_COS = math.cos(math.radians(30.0))
 # Wide limits that never bind (Pinocchio's URDF parser requires <limit>).
 _LIMIT = 'lower="-1000" upper="1000" effort="1e+12" velocity="1e+06"'
-# The six joints of an elastic pair, in the book's coordinate order [x, y, z, β, θ, α].
-_PAIR_JOINTS = (
-    ("x", "prismatic", (1.0, 0.0, 0.0)),
-    ("y", "prismatic", (0.0, 1.0, 0.0)),
-    ("z", "prismatic", (0.0, 0.0, 1.0)),
-    ("rx", "revolute", (1.0, 0.0, 0.0)),
-    ("ry", "revolute", (0.0, 1.0, 0.0)),
-    ("rz", "revolute", (0.0, 0.0, 1.0)),
-)
 _ZERO3 = (0.0, 0.0, 0.0)
 
 
@@ -91,48 +85,10 @@ _ZERO3 = (0.0, 0.0, 0.0)
 # ---------------------------------------------------------------------------------------
 
 
-def _num(x: float) -> str:
-    """Shortest text that reads back as the same float (``0`` for ±0)."""
-    x = float(x)
-    if not math.isfinite(x):
-        raise ValueError(f"non-finite number {x!r} in a generated scene")
-    if x == 0.0:
-        return "0"
-    text = repr(x)
-    return text[:-2] if text.endswith(".0") else text
-
-
-def _vec(values: Sequence[float]) -> str:
-    return " ".join(_num(v) for v in values)
-
-
-def _rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
-    """URDF rotation ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-    r, p, y = rpy
-    cr, sr = math.cos(r), math.sin(r)
-    cp, sp = math.cos(p), math.sin(p)
-    cy, sy = math.cos(y), math.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def _matrix_rpy(rot: np.ndarray) -> np.ndarray:
-    """URDF ``rpy`` of a rotation matrix (inverse of :func:`_rpy_matrix`)."""
-    pitch = math.atan2(-rot[2, 0], math.hypot(rot[0, 0], rot[1, 0]))
-    roll = math.atan2(rot[2, 1], rot[2, 2])
-    yaw = math.atan2(rot[1, 0], rot[0, 0])
-    return np.array([roll, pitch, yaw])
-
-
 def _pose(xyz: Sequence[float], rpy: Sequence[float]) -> np.ndarray:
     """Homogeneous 4 × 4 transform of a URDF origin."""
     out = np.eye(4)
-    out[:3, :3] = _rpy_matrix(rpy)
+    out[:3, :3] = rpy_matrix(rpy)
     out[:3, 3] = xyz
     return out
 
@@ -209,7 +165,7 @@ class _Body:
 
     def axis_in_link_frame(self) -> np.ndarray:
         """The joint axis in the parent link's frame."""
-        return _rpy_matrix(self.rpy) @ self.axis
+        return rpy_matrix(self.rpy) @ self.axis
 
 
 def _random_inertial(rng: np.random.Generator) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
@@ -240,9 +196,9 @@ def _write_joint(w: _Writer, body: _Body) -> None:
     w.add(f'<joint name="{body.joint}" type="{body.jtype}">')
     w.add(f'<parent link="{body.parent}"/>', 2)
     w.add(f'<child link="{body.name}"/>', 2)
-    w.add(f'<origin xyz="{_vec(body.xyz)}" rpy="{_vec(body.rpy)}"/>', 2)
+    w.add(f'<origin xyz="{fmt_vec(body.xyz)}" rpy="{fmt_vec(body.rpy)}"/>', 2)
     if body.jtype in (*ONE_DOF_JOINT_TYPES, "planar"):
-        w.add(f'<axis xyz="{_vec(body.axis)}"/>', 2)
+        w.add(f'<axis xyz="{fmt_vec(body.axis)}"/>', 2)
     if body.jtype in ("revolute", "prismatic"):
         w.add(f"<limit {_LIMIT}/>", 2)
     w.add("</joint>")
@@ -255,11 +211,11 @@ def _write_link(w: _Writer, body: _Body) -> None:
     mass, com, com_rpy, t = body.inertial
     w.add(f'<link name="{body.name}">')
     w.add("<inertial>", 2)
-    w.add(f'<origin xyz="{_vec(com)}" rpy="{_vec(com_rpy)}"/>', 3)
-    w.add(f'<mass value="{_num(mass)}"/>', 3)
+    w.add(f'<origin xyz="{fmt_vec(com)}" rpy="{fmt_vec(com_rpy)}"/>', 3)
+    w.add(f'<mass value="{fmt(mass)}"/>', 3)
     w.add(
-        f'<inertia ixx="{_num(t[0, 0])}" ixy="{_num(t[0, 1])}" ixz="{_num(t[0, 2])}" '
-        f'iyy="{_num(t[1, 1])}" iyz="{_num(t[1, 2])}" izz="{_num(t[2, 2])}"/>',
+        f'<inertia ixx="{fmt(t[0, 0])}" ixy="{fmt(t[0, 1])}" ixz="{fmt(t[0, 2])}" '
+        f'iyy="{fmt(t[1, 1])}" iyz="{fmt(t[1, 2])}" izz="{fmt(t[2, 2])}"/>',
         3,
     )
     w.add("</inertial>", 2)
@@ -273,13 +229,13 @@ def _write_bodies(w: _Writer, bodies: Sequence[_Body]) -> None:
 
 
 def _write_gravity(w: _Writer, gravity: Sequence[float]) -> None:
-    w.add(f'<rt70:gravity xyz="{_vec(gravity)}"/>')
+    w.add(f'<rt70:gravity xyz="{fmt_vec(gravity)}"/>')
 
 
 def _write_joint_spring(w: _Writer, joint: str, stiffness: float, damping: float) -> None:
     w.add(
         f'<rt70:joint_spring name="{joint}_spring" joint="{joint}" '
-        f'stiffness="{_num(stiffness)}" damping="{_num(damping)}"/>'
+        f'stiffness="{fmt(stiffness)}" damping="{fmt(damping)}"/>'
     )
 
 
@@ -291,9 +247,10 @@ def _write_bushing(
     stiffness: Sequence[float],
     damping: Sequence[float],
 ) -> None:
-    w.add(f'<rt70:bushing name="{name}" stiffness="{_vec(stiffness)}" damping="{_vec(damping)}">')
+    gains = f'stiffness="{fmt_vec(stiffness)}" damping="{fmt_vec(damping)}"'
+    w.add(f'<rt70:bushing name="{name}" {gains}>')
     for tag, (link, xyz, rpy) in (("frame1", frame1), ("frame2", frame2)):
-        w.add(f'<rt70:{tag} link="{link}" xyz="{_vec(xyz)}" rpy="{_vec(rpy)}"/>', 2)
+        w.add(f'<rt70:{tag} link="{link}" xyz="{fmt_vec(xyz)}" rpy="{fmt_vec(rpy)}"/>', 2)
     w.add("</rt70:bushing>")
 
 
@@ -484,7 +441,7 @@ def elastic_chain(n_bodies: int, seed: int = 0) -> str:
         body = f"body{k}"
         offset = np.array([*rng.uniform(-0.2, 0.2, 2), rng.uniform(0.5, 2.0)])
         offset_rpy = rng.uniform(-0.3, 0.3, 3)
-        w.add(f"<!-- {body}: 6-DOF pair on {parent}, construction offset [{_vec(offset)}] -->")
+        w.add(f"<!-- {body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}] -->")
         previous = parent
         for step, (suffix, jtype, axis) in enumerate(_PAIR_JOINTS):
             last = step == len(_PAIR_JOINTS) - 1
@@ -634,7 +591,7 @@ def random_tree(
             w,
             f"bushing{k + 1}",
             (link1, xyz1, rpy1),
-            (link2, frame2[:3, 3], _matrix_rpy(frame2[:3, :3])),
+            (link2, frame2[:3, 3], rpy_of_matrix(frame2[:3, :3])),
             _log_uniform(rng, 1.0, 1.0e3, 6),
             _log_uniform(rng, 0.01, 10.0, 6),
         )

@@ -48,6 +48,14 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     return c3(rpy[2]) @ c2(rpy[1]) @ c1(rpy[0])
 
 
+def rpy_of_matrix(rot: np.ndarray) -> np.ndarray:
+    """URDF ``rpy`` of a rotation matrix (the inverse of :func:`rpy_matrix`)."""
+    pitch = np.arctan2(-rot[2, 0], np.hypot(rot[0, 0], rot[1, 0]))
+    roll = np.arctan2(rot[2, 1], rot[2, 2])
+    yaw = np.arctan2(rot[1, 0], rot[0, 0])
+    return np.array([roll, pitch, yaw])
+
+
 def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
     """Rotation by ``angle`` about the unit vector ``axis`` (Rodrigues' formula)."""
     k = skew(axis)

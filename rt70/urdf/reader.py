@@ -6,7 +6,6 @@ starts with the source file, so the command line can print it as one readable li
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -20,7 +19,7 @@ from rt70.errors import (
     TopologyError,
     UrdfError,
 )
-from rt70.textbook.spatial import rpy_matrix
+from rt70.textbook.spatial import rpy_matrix, rpy_of_matrix
 from rt70.urdf.description import (
     URDF_JOINT_TYPES,
     Bushing,
@@ -47,6 +46,17 @@ _EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_p
 _ZERO3 = np.zeros(3)
 
 
+def read_source(path: str | Path) -> str:
+    """The text of a URDF file, or a :class:`~rt70.errors.UrdfError` naming the file."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UrdfError(f"{path}: file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UrdfError(f"{path}: cannot read file ({exc})") from None
+
+
 def read_urdf(path: str | Path) -> RobotDescription:
     """Read a URDF file into a validated :class:`RobotDescription`.
 
@@ -56,14 +66,7 @@ def read_urdf(path: str | Path) -> RobotDescription:
         (or a subclass) if the file is missing, malformed, or describes an impossible
         or unsupported model; the message names the file and the offending element.
     """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UrdfError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UrdfError(f"{path}: cannot read file ({exc})") from None
-    return read_urdf_string(text, source=str(path))
+    return read_urdf_string(read_source(path), source=str(path))
 
 
 def read_urdf_string(text: str, source: str = "<string>") -> RobotDescription:
@@ -400,7 +403,7 @@ class _Reader:
             k, d = self.gains(sub, 6, f"{where} <rt70:strut name='{sname}'>")
             # frame 1 = package origin ∘ (r_s, c_s), expressed in the parent link
             f1_xyz = origin_xyz + origin_rot @ r_s
-            f1_rpy = _matrix_to_rpy(origin_rot @ rpy_matrix(rpy_s))
+            f1_rpy = rpy_of_matrix(origin_rot @ rpy_matrix(rpy_s))
             struts.append(
                 Bushing(
                     f"{name}/{sname}",
@@ -421,11 +424,3 @@ def _tag(elem: ET.Element) -> str:
     if tag.startswith("{" + RT70_NS + "}"):
         return "rt70:" + tag[len(RT70_NS) + 2 :]
     return tag
-
-
-def _matrix_to_rpy(rot: np.ndarray) -> np.ndarray:
-    """URDF ``rpy`` of a rotation ``Rz(y) Ry(p) Rx(r)`` (inverse of ``rpy_matrix``)."""
-    pitch = math.atan2(-rot[2, 0], math.hypot(rot[0, 0], rot[1, 0]))
-    roll = math.atan2(rot[2, 1], rot[2, 2])
-    yaw = math.atan2(rot[1, 0], rot[0, 0])
-    return np.array([roll, pitch, yaw])
