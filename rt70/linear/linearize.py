@@ -1,0 +1,222 @@
+"""Static equilibrium and the linear model ``M δq̈ + D δq̇ + K δq = B u`` of a URDF scene.
+
+The linear model is taken on the textbook side at an equilibrium q0 of gravity and
+springs (formalism §4.3–§4.4):
+
+- ``M = A(q0)`` (4.79);
+- ``K = −∂(Q_g + Q_c)/∂q`` at q0 — the springs' stiffness plus the geometric stiffness
+  of gravity — by **central finite differences** of the textbook forces (step
+  ``h = 1e-6`` per coordinate; the truncation error is O(h²) ≈ 1e-12 relative, the
+  rounding error O(ε/h) ≈ 1e-10 relative). The tests check the gravity part against
+  Pinocchio's analytic ``computeGeneralizedGravityDerivatives`` and the spring part at
+  rest against the exact ``Σ Jᵀ C J``;
+- ``D = −∂Q_d/∂q̇`` at q0 — exact (Q_d is linear in q̇): its columns are ``−Q_d(q0, e_i)``.
+
+Coordinates held by drives (the azimuth and elevation axes of the RT-70) can be held at
+given values while the equilibrium is solved, and locked (removed) or left free in the
+linear model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+
+from rt70.errors import Rt70Error
+from rt70.scene import Scene
+from rt70.textbook import dynamics, forces
+
+#: Finite-difference step of the stiffness matrix, per coordinate (m or rad).
+FD_STEP = 1e-6
+
+#: RT-70 pointing axes: the coordinates the drives turn (rt70-data §D).
+AZIMUTH_COORDINATE = "platform_rz"
+ELEVATION_COORDINATE = "base_rx"
+
+
+def static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
+    """Generalised static force ``Q_g + Q_c`` at rest (q̇ = 0)."""
+    model, data = scene.textbook, scene.textbook_data
+    Qc, _ = forces.spring_damper_force(model, data, q, np.zeros(model.nv))
+    return dynamics.gravity_force(model, data, q) + Qc
+
+
+def stiffness_matrix(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+    """``K = −∂(Q_g + Q_c)/∂q`` by central differences, symmetrised (see module docstring)."""
+    nv = scene.textbook.nv
+    K = np.empty((nv, nv))
+    for i in range(nv):
+        e = np.zeros(nv)
+        e[i] = h
+        K[:, i] = -(static_force(scene, q + e) - static_force(scene, q - e)) / (2.0 * h)
+    return 0.5 * (K + K.T)
+
+
+def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
+    """``D = −∂Q_d/∂q̇``, exact: the columns are ``−Q_d(q, e_i)``."""
+    model, data = scene.textbook, scene.textbook_data
+    D = np.empty((model.nv, model.nv))
+    for i in range(model.nv):
+        e = np.zeros(model.nv)
+        e[i] = 1.0
+        D[:, i] = -forces.spring_damper_force(model, data, q, e)[1]
+    return 0.5 * (D + D.T)
+
+
+def coordinate_indices(scene: Scene, names: list[str] | tuple[str, ...]) -> np.ndarray:
+    """Indices of the named textbook coordinates (clear error for an unknown name)."""
+    known = scene.textbook.coordinate_names
+    missing = [n for n in names if n not in known]
+    if missing:
+        raise Rt70Error(f"{scene.name}: no coordinate(s) {', '.join(missing)}")
+    return np.array([known.index(n) for n in names], dtype=int)
+
+
+def equilibrium(
+    scene: Scene,
+    held: dict[str, float] | None = None,
+    q_start: np.ndarray | None = None,
+    tol: float = 1e-10,
+    max_iter: int = 50,
+) -> np.ndarray:
+    """Static equilibrium ``Q_g(q) + Q_c(q) = 0`` over the coordinates not held.
+
+    Newton's method with the stiffness matrix of :func:`stiffness_matrix`. Held
+    coordinates (``{name: value}``, the drives) keep their values; their generalised
+    force is what the drives must supply. Converged when the force residual is below
+    ``tol`` times the force scale (the largest |Q_g + Q_c| at the start, or 1); the
+    rounding floor of the RT-70's stiff springs is about 2e-12 of it.
+
+    Raises
+    ------
+    Rt70Error
+        If the free coordinates have no stiffness against some direction (singular K),
+        or Newton does not converge.
+    """
+    held = held or {}
+    nv = scene.textbook.nv
+    q = np.zeros(nv) if q_start is None else np.array(q_start, dtype=float)
+    fixed = coordinate_indices(scene, list(held))
+    q[fixed] = list(held.values())
+    free = np.setdiff1d(np.arange(nv), fixed)
+    scale = max(float(np.max(np.abs(static_force(scene, q)))), 1.0)
+    for _ in range(max_iter):
+        residual = static_force(scene, q)[free]
+        if np.max(np.abs(residual), initial=0.0) <= tol * scale:
+            return q
+        K = stiffness_matrix(scene, q)[np.ix_(free, free)]
+        try:
+            step = scipy.linalg.solve(K, residual, assume_a="sym")
+        except (np.linalg.LinAlgError, ValueError):
+            raise Rt70Error(
+                f"{scene.name}: no static equilibrium: the free coordinates have no "
+                "stiffness in some direction (hold or lock it)"
+            ) from None
+        q[free] += step
+    raise Rt70Error(f"{scene.name}: static equilibrium not found in {max_iter} Newton steps")
+
+
+@dataclass
+class LinearModel:
+    """``M δq̈ + D δq̇ + K δq = Q`` about the state ``q0`` of a scene.
+
+    ``coordinates`` names the rows (locked coordinates removed); ``K_gravity`` is the
+    geometric-stiffness part of K (K without springs).
+    """
+
+    scene: str
+    q0: np.ndarray
+    coordinates: list[str]
+    M: np.ndarray
+    K: np.ndarray
+    D: np.ndarray
+    K_gravity: np.ndarray
+    locked: list[str] = field(default_factory=list)
+
+
+def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> LinearModel:
+    """The linear model about ``q0``; ``locked`` coordinates are removed (f = 0, §4.1).
+
+    Locking a coordinate of the pair structure is the book's holonomic constraint in 3-D:
+    its column of the mobility matrix f is deleted, so its rows and columns of A, K and
+    D are deleted.
+    """
+    model, data = scene.textbook, scene.textbook_data
+    keep = np.setdiff1d(np.arange(model.nv), coordinate_indices(scene, list(locked)))
+    ix = np.ix_(keep, keep)
+    M = dynamics.mass_matrix(model, data, q0).copy()
+    K = stiffness_matrix(scene, q0)
+    D = damping_matrix(scene, q0)
+    K_g = _gravity_stiffness(scene, q0)
+    return LinearModel(
+        scene=scene.name,
+        q0=np.array(q0, dtype=float),
+        coordinates=[model.coordinate_names[i] for i in keep],
+        M=M[ix],
+        K=K[ix],
+        D=D[ix],
+        K_gravity=K_g[ix],
+        locked=list(locked),
+    )
+
+
+def _gravity_stiffness(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+    """``−∂Q_g/∂q`` by central differences (the geometric stiffness of gravity)."""
+    model, data = scene.textbook, scene.textbook_data
+    nv = model.nv
+    K = np.empty((nv, nv))
+    for i in range(nv):
+        e = np.zeros(nv)
+        e[i] = h
+        K[:, i] = -(
+            dynamics.gravity_force(model, data, q + e) - dynamics.gravity_force(model, data, q - e)
+        ) / (2.0 * h)
+    return 0.5 * (K + K.T)
+
+
+def rt70_pointing(elevation_deg: float, azimuth_deg: float = 0.0) -> dict[str, float]:
+    """Held coordinates of the RT-70 drives for a pointing.
+
+    q = 0 is the listing's construction, the dish looking at the zenith (the mirror axis
+    along z): elevation E sets the base's rotation ``base_rx = π/2 − E``, azimuth A the
+    platform's ``platform_rz = A``.
+    """
+    return {
+        AZIMUTH_COORDINATE: np.radians(azimuth_deg),
+        ELEVATION_COORDINATE: np.pi / 2 - np.radians(elevation_deg),
+    }
+
+
+#: Arc seconds per radian (the listing's TURNE0 output unit).
+ARCSEC = 206264.80624709636
+
+
+@dataclass(frozen=True)
+class Sag:
+    """Static deflection of one body under gravity, against its rigid (q_elastic = 0) pose."""
+
+    body: str
+    displacement_mm: np.ndarray  # of the body frame origin, ground axes
+    rotation_arcsec: float  # angle of the relative rotation
+
+
+def sag(scene: Scene, q_eq: np.ndarray, held: dict[str, float]) -> list[Sag]:
+    """Deflection of every body at the equilibrium ``q_eq`` relative to the rigid pose.
+
+    The rigid pose has the held coordinates at their values and every other coordinate
+    at 0; displacements are in mm, rotations in arc seconds.
+    """
+    model, data = scene.textbook, scene.textbook_data
+    q_rigid = np.zeros(model.nv)
+    q_rigid[coordinate_indices(scene, list(held))] = list(held.values())
+    dynamics.mass_matrix(model, data, q_rigid)
+    R0, p0 = data.R.copy(), data.p.copy()
+    dynamics.mass_matrix(model, data, q_eq)
+    out = []
+    for j, name in enumerate(model.body_names):
+        rel = R0[j].T @ data.R[j]
+        angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
+        out.append(Sag(name, (data.p[j] - p0[j]) * 1e3, angle * ARCSEC))
+    return out

@@ -1,0 +1,97 @@
+"""Linearisation of the nonlinear model: equilibrium, K with geometric stiffness, locking."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from rt70.linear import linearize as lin
+from rt70.scene import load_scene
+
+
+@pytest.fixture(scope="module")
+def rt70():
+    return load_scene("rt70")
+
+
+def test_equilibrium_balances_gravity_and_springs(rt70):
+    held = lin.rt70_pointing(45.0, 30.0)
+    q0 = lin.equilibrium(rt70, held)
+    free = np.setdiff1d(np.arange(rt70.textbook.nv), lin.coordinate_indices(rt70, list(held)))
+    Q = lin.static_force(rt70, q0)
+    g_scale = np.abs(lin.static_force(rt70, np.where(np.isin(np.arange(42), free), 0.0, q0))).max()
+    assert np.abs(Q[free]).max() <= 1e-10 * g_scale
+    for name, value in held.items():
+        assert q0[rt70.textbook.coordinate_names.index(name)] == value
+
+
+def test_gravity_stiffness_matches_pinocchio_analytic(rt70):
+    """The finite-difference geometric stiffness equals −∂Q_g/∂q from Pinocchio's derivatives."""
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-0.3, 0.3, rt70.textbook.nv)
+    K_g = lin._gravity_stiffness(rt70, q)
+    ref = rt70.reference
+    qp = ref.to_pinocchio(rt70.to_reference(q))[0]
+    dg = pin.computeGeneralizedGravityDerivatives(ref.model, ref.data, qp)  # ∂g/∂q, g = −Q_g
+    perm = rt70.perm
+    K_ref = dg[np.ix_(perm, perm)]
+    K_ref = 0.5 * (K_ref + K_ref.T)
+    assert np.abs(K_g - K_ref).max() <= 1e-7 * np.abs(K_ref).max()
+
+
+def test_spring_stiffness_at_rest_is_sum_jt_c_j(rt70):
+    """At q = 0 (δ = 0) the springs' stiffness is exactly Σ Jᵀ C J."""
+    from rt70.textbook import forces
+    from rt70.textbook.kinematics import update_structure
+
+    tm, td = rt70.textbook, rt70.textbook_data
+    q = np.zeros(tm.nv)
+    K = lin.stiffness_matrix(rt70, q) - lin._gravity_stiffness(rt70, q)
+    update_structure(tm, td, q)
+    exact = np.zeros((tm.nv, tm.nv))
+    for b in tm.bushings:
+        J = forces.bushing_deformation(td, b).jacobian
+        exact += J.T @ np.diag(b.stiffness) @ J
+    assert np.abs(K - exact).max() <= 1e-8 * np.abs(exact).max()
+
+
+def test_damping_matrix_is_exact(rt70):
+    from rt70.textbook import forces
+
+    q = np.random.default_rng(1).uniform(-0.2, 0.2, 42)
+    D = lin.damping_matrix(rt70, q)
+    qd = np.random.default_rng(2).uniform(-1, 1, 42)
+    _, Qd = forces.spring_damper_force(rt70.textbook, rt70.textbook_data, q, qd)
+    assert np.abs(D @ qd + Qd).max() <= 1e-12 * np.abs(Qd).max()
+
+
+def test_locked_coordinates_equal_pinocchio_reduced_model(rt70):
+    """Locking coordinates (f in 3-D) equals Pinocchio's buildReducedModel."""
+    locked = [n for n in rt70.textbook.coordinate_names if not n.endswith("_rz")]
+    q0 = np.zeros(42)
+    model = lin.linearize(rt70, q0, locked=tuple(locked))
+    assert len(model.coordinates) == 7
+    ref = rt70.reference
+    lock_ids = [ref.model.getJointId(n) for n in locked]
+    reduced = pin.buildReducedModel(ref.model, lock_ids, pin.neutral(ref.model))
+    M_pin = pin.crba(reduced, reduced.createData(), pin.neutral(reduced))
+    M_pin = np.triu(M_pin) + np.triu(M_pin, 1).T
+    order = [reduced.names[i] for i in range(1, reduced.njoints)]
+    idx = [order.index(n) for n in model.coordinates]
+    assert np.abs(model.M - M_pin[np.ix_(idx, idx)]).max() <= 1e-12 * np.abs(M_pin).max()
+
+
+def test_sag_reports_mm_and_arcsec(rt70):
+    held = lin.rt70_pointing(90.0)
+    q0 = lin.equilibrium(rt70, held)
+    sags = {s.body: s for s in lin.sag(rt70, q0, held)}
+    assert set(sags) == set(rt70.textbook.body_names)
+    # gravity pushes the platform down: its origin sinks (z < 0) by m g / C_z
+    expected = -sum(rt70.textbook.mass) * 9.81 / 5.0e10 * 1e3
+    assert sags["platform"].displacement_mm[2] == pytest.approx(expected, rel=1e-9)
+
+
+def test_unknown_coordinate_is_a_clear_error(rt70):
+    from rt70.errors import Rt70Error
+
+    with pytest.raises(Rt70Error, match="no coordinate"):
+        lin.equilibrium(rt70, {"nope": 0.0})
