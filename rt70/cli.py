@@ -65,6 +65,63 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _modes(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from rt70.linear import linearize as lin
+    from rt70.linear import modal
+    from rt70.scene import load_scene
+
+    scene = load_scene(args.scene)
+    names = scene.textbook.coordinate_names
+    has_axes = lin.AZIMUTH_COORDINATE in names and lin.ELEVATION_COORDINATE in names
+    if (args.elevation is not None or args.azimuth is not None) and not has_axes:
+        raise Rt70Error(
+            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes "
+            f"({lin.AZIMUTH_COORDINATE}, {lin.ELEVATION_COORDINATE})"
+        )
+    elevation = 90.0 if args.elevation is None else args.elevation
+    azimuth = 0.0 if args.azimuth is None else args.azimuth
+    held = lin.rt70_pointing(elevation, azimuth) if has_axes else {}
+    q0 = lin.equilibrium(scene, held)
+    model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
+    result = modal.modes(model.M, model.K, model.D)
+    rows = []
+    energy = result.shapes * (model.M @ result.shapes)  # kinetic-energy share per coordinate
+    for i in range(len(result.freq_hz)):
+        unstable = bool(result.negative[i])
+        rows.append(
+            {
+                "mode": i + 1,
+                "freq_hz": None if unstable else float(result.freq_hz[i]),
+                "kind": "unstable" if unstable else "rigid" if result.rigid[i] else "elastic",
+                # an unstable mode diverges as exp(λt), λ = √(−ω²)
+                "divergence_rate": float(np.sqrt(-result.omega2[i])) if unstable else None,
+                "zeta": None if np.isnan(result.zeta[i]) else float(result.zeta[i]),
+                "dominant": model.coordinates[int(np.argmax(np.abs(energy[:, i])))],
+            }
+        )
+    if args.json:
+        print(json.dumps({"scene": scene.name, "held": held, "modes": rows}, indent=2))
+        return 0
+    where = f", elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
+    axes = " (axes locked)" if args.lock_axes and held else ""
+    print(f"{scene.name}: {len(rows)} modes at static equilibrium{where}{axes}")
+    print(f"{'mode':>4} {'f, Hz':>10} {'ξ':>8}  {'kind':<8} dominant coordinate (energy)")
+    for r in rows:
+        zeta = "" if r["zeta"] is None else f"{r['zeta']:.4f}"
+        freq = f"{r['freq_hz']:.4f}" if r["freq_hz"] is not None else "—"
+        print(f"{r['mode']:>4} {freq:>10} {zeta:>8}  {r['kind']:<8} {r['dominant']}")
+    unstable = [r for r in rows if r["kind"] == "unstable"]
+    for r in unstable:
+        print(
+            f"mode {r['mode']} is unstable (negative stiffness, divergence rate "
+            f"{r['divergence_rate']:.4g} 1/s): gravity is not balanced on a free axis; "
+            "use --lock-axes to let the drives hold it"
+        )
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``rt70`` command."""
     parser = argparse.ArgumentParser(
@@ -100,6 +157,23 @@ def build_parser() -> argparse.ArgumentParser:
     ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")
     ben.add_argument("--out", default="validation/results", help="directory for CSV and PNG output")
     ben.set_defaults(func=_bench)
+    mod = sub.add_parser(
+        "modes",
+        help="eigenfrequencies and mode shapes at static equilibrium",
+        description="Linearise a scene at its static equilibrium under gravity (the "
+        "RT-70 at a given pointing, its drives holding azimuth and elevation) and print "
+        "the eigenfrequencies of K v = ω² M v.",
+    )
+    mod.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
+    mod.add_argument("--elevation", type=float, help="RT-70 elevation, degrees (default 90)")
+    mod.add_argument("--azimuth", type=float, help="RT-70 azimuth, degrees (default 0)")
+    mod.add_argument(
+        "--lock-axes",
+        action="store_true",
+        help="remove the azimuth and elevation coordinates (drives infinitely stiff)",
+    )
+    mod.add_argument("--json", action="store_true", help="print JSON")
+    mod.set_defaults(func=_modes)
     return parser
 
 
