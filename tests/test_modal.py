@@ -146,7 +146,7 @@ def test_dense_mass_matrix():
 def test_proportional_damping_gives_book_ratios():
     M, K = elevation()
     md0 = modal.modes(M, K)
-    D, delta = modal.proportional_damping(K, md0)  # D = δ ΓᵀCΓ = Γᵀ(δC)Γ
+    D, delta = modal.stiffness_proportional_damping(K, md0)  # D = δ ΓᵀCΓ = Γᵀ(δC)Γ
     Omega1 = md0.omega[1]
     assert delta == pytest.approx(0.1 / Omega1, rel=1e-15)
     np.testing.assert_allclose(D, GAMMA_ELEV.T @ np.diag(delta * C_ELEV) @ GAMMA_ELEV)
@@ -202,7 +202,7 @@ def test_principal_coordinates_reject_foreign_modes():
 
 def test_state_space_matrices():
     M, K = elevation()
-    D, _ = modal.proportional_damping(K, modal.modes(M, K))
+    D, _ = modal.stiffness_proportional_damping(K, modal.modes(M, K))
     B_in = np.eye(6)[:, [0]]
     ss = modal.state_space(M, K, D, B_in, np.eye(6)[[2, 5]], output_names=["mirror", "cr"])
     Minv = np.diag(1 / I_ELEV)
@@ -221,7 +221,7 @@ def test_state_space_matrices():
 
 def test_second_and_first_order_responses_agree():
     M, K = elevation()
-    D, _ = modal.proportional_damping(K, modal.modes(M, K))
+    D, _ = modal.stiffness_proportional_damping(K, modal.modes(M, K))
     D = D + np.diag([0, 0, 0, 0, 0, 30.0])  # and some non-proportional damping
     B_in = np.eye(6)[:, [0, 2]]
     C_out, C_vel = np.eye(6)[[2, 5]], np.eye(6)[[5, 0]]
@@ -237,7 +237,7 @@ def test_second_and_first_order_responses_agree():
 def test_modal_state_space_matches_full_and_truncates():
     M, K = elevation()
     md0 = modal.modes(M, K)
-    D, _ = modal.proportional_damping(K, md0)
+    D, _ = modal.stiffness_proportional_damping(K, md0)
     md = modal.modes(M, K, D)
     B_in, C_out = np.eye(6)[:, [0]], np.eye(6)[[2]]
     f = np.geomspace(0.5, 30.0, 200)
@@ -288,7 +288,7 @@ def test_oscillator_resonance_peak_is_20_db():
 def test_rt70_first_resonance_with_book_damping():
     """RT-70 elevation, D = δC: mode 1 in isolation peaks +20 dB over its static part."""
     M, K = elevation()
-    D, _ = modal.proportional_damping(K, modal.modes(M, K))
+    D, _ = modal.stiffness_proportional_damping(K, modal.modes(M, K))
     md = modal.modes(M, K, D)
     assert md.zeta[1] == pytest.approx(0.05, rel=1e-12)
     # principal coordinate z_1 alone: z̈_1 + (VᵀDV)_11 ż_1 + Ω1² z_1 = u
@@ -341,7 +341,7 @@ def test_free_structure_at_zero_frequency():
 
 def test_plots_return_figures():
     M, K = elevation()
-    md = modal.modes(M, K, modal.proportional_damping(K, modal.modes(M, K))[0])
+    md = modal.modes(M, K, modal.stiffness_proportional_damping(K, modal.modes(M, K))[0])
     ss = modal.modal_state_space(md, np.eye(6)[:, 0], np.eye(6)[2])
     fr = modal.frequency_response(ss, np.geomspace(1, 30, 50))
     fig = modal.plot_bode(fr)
@@ -408,4 +408,6 @@ def test_bad_inputs_elsewhere_raise():
         bare = modal.StateSpace(ss.A, ss.B, ss.C, ss.D, ss.state_names, ("u",), ("y",))
         modal.frequency_response(bare, [1.0], method="second_order")
     with pytest.raises(Rt70Error, match="elastic"):
-        modal.proportional_damping(np.zeros((2, 2)), modal.modes(np.eye(2), np.zeros((2, 2))))
+        modal.stiffness_proportional_damping(
+            np.zeros((2, 2)), modal.modes(np.eye(2), np.zeros((2, 2)))
+        )

@@ -119,7 +119,7 @@ def equilibrium(
 
 
 @dataclass
-class LinearModel:
+class Linearization:
     """``M δq̈ + D δq̇ + K δq = Q`` about the state ``q0`` of a scene.
 
     ``coordinates`` names the rows (locked coordinates removed); ``K_gravity`` is the
@@ -136,7 +136,7 @@ class LinearModel:
     locked: list[str] = field(default_factory=list)
 
 
-def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> LinearModel:
+def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Linearization:
     """The linear model about ``q0``; ``locked`` coordinates are removed (f = 0, §4.1).
 
     Locking a coordinate of the pair structure is the book's holonomic constraint in 3-D:
@@ -150,7 +150,7 @@ def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Lin
     K = stiffness_matrix(scene, q0)
     D = damping_matrix(scene, q0)
     K_g = _gravity_stiffness(scene, q0)
-    return LinearModel(
+    return Linearization(
         scene=scene.name,
         q0=np.array(q0, dtype=float),
         coordinates=[model.coordinate_names[i] for i in keep],

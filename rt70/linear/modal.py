@@ -20,7 +20,7 @@ symmetric. This module turns it into what a control engineer uses (formalism §2
 
 Proportional damping (2.16) ``D = δ C`` with ``δ = 0.1/Ω1`` gives ``ξ_1 = 0.05`` — the
 book's "+20 dB at the first resonance" — and ``ξ_i = 0.05 Ω_i/Ω1`` (§2.3);
-:func:`proportional_damping` builds it.
+:func:`stiffness_proportional_damping` builds it.
 
 Only numpy and scipy are needed; matplotlib is imported by the plot helpers alone.
 """
@@ -355,7 +355,7 @@ def residuals(M: np.ndarray, K: np.ndarray, modes: Modes) -> dict[str, float]:
     }
 
 
-def proportional_damping(
+def stiffness_proportional_damping(
     K: np.ndarray, modes: Modes, zeta1: float = 0.05
 ) -> tuple[np.ndarray, float]:
     """Proportional damping (2.16) ``D = δ K`` with ``ξ = zeta1`` on the first elastic mode.
