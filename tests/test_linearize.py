@@ -95,3 +95,38 @@ def test_unknown_coordinate_is_a_clear_error(rt70):
 
     with pytest.raises(Rt70Error, match="no coordinate"):
         lin.equilibrium(rt70, {"nope": 0.0})
+
+
+def test_inputs_and_outputs_of_the_rt70(rt70):
+    """Drive torque in, mirror focus out: B and C from the textbook Jacobians, checked."""
+    from rt70.linear import modal
+
+    held = lin.rt70_pointing(60.0)
+    q0 = lin.equilibrium(rt70, held)
+    lm = lin.linearize(rt70, q0, locked=(lin.ELEVATION_COORDINATE,))
+    # azimuth drive: a torque about the ground z axis on the platform acts on platform_rz
+    b = lin.force_input(lm, rt70, "platform", [0, 0, 1], torque=True)
+    assert b[lm.coordinates.index("platform_rz")] == pytest.approx(1.0)
+    # elevation drive force on the counterweight along y (formalism §4.5)
+    b_el = lin.force_input(lm, rt70, "counterweight", [0, 1, 0])
+    assert np.abs(b_el).max() > 0
+    # focus of the main mirror: a rigid azimuth rotation moves it by ω × r
+    focus = next(p for p in rt70.description.optical_points if p.name == "main_mirror_focus")
+    C = lin.point_output(lm, rt70, focus.link, focus.xyz)
+    dq = np.zeros(len(lm.coordinates))
+    dq[lm.coordinates.index("platform_rz")] = 1e-6
+    tm, td = rt70.textbook, rt70.textbook_data
+    from rt70.textbook.kinematics import frame_pose, update_structure
+
+    def focus_position(q):
+        update_structure(tm, td, q)
+        body, r, c = tm.link_frames[focus.link]
+        return frame_pose(td, body, r + c @ focus.xyz, np.eye(3))[1]
+
+    q1 = q0.copy()
+    q1[lin.coordinate_indices(rt70, lm.coordinates)] += dq
+    moved = focus_position(q1) - focus_position(q0)
+    assert np.allclose(C @ dq, moved, rtol=1e-5, atol=1e-10)  # θ² r / 2 ≈ 1e-11 is second order
+    # a state-space model from the drive torque to the focus displacement
+    ss = modal.state_space(lm.M, lm.K, lm.D, b, C)
+    assert ss.A.shape == (2 * len(lm.coordinates),) * 2 and ss.C.shape[0] == 3
