@@ -1,0 +1,397 @@
+"""Time simulation of a scene with an energy audit (formalism §1, (1.73)).
+
+Both backends integrate the same equations ``A q̈ + B q̇ = Q_g + Q_c + Q_d + Q_u``: the
+Pinocchio backend by ABA with the spring and damper forces as ``tau``, the textbook
+backend by the structured ``S Θ Sᵀ`` algorithm and a Cholesky solve. The state carries
+two extra components integrated with it (not by quadrature of samples):
+the dissipated energy ``E_ψ = ∫ q̇ᵀ D q̇ dt = −∫ q̇ᵀ Q_d dt`` and the work of the inputs
+``W_u = ∫ q̇ᵀ Q_u dt``. Along any trajectory ``T + U_g + U_c + E_ψ − W_u`` is constant;
+its drift is reported with every result.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.scene import Scene
+
+#: Integration methods of scipy.integrate.solve_ivp accepted by :func:`simulate`.
+METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
+#: Methods that use the Jacobian of the right-hand side.
+IMPLICIT = ("Radau", "BDF", "LSODA")
+#: A drift of the energy balance larger than this many times rtol (relative to the energy
+#: exchanged during the run) is flagged: more than the tolerance explains.
+DRIFT_FACTOR = 100.0
+
+Inputs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+
+
+class _Backend:
+    """Right-hand side, Jacobian and energies of one side of the cross-check."""
+
+    name = ""
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.nv = scene.textbook.nv
+
+    def accelerations(self, q, qd, Q_u) -> tuple[np.ndarray, np.ndarray]:  # q̈, Q_d
+        raise NotImplementedError
+
+    def jacobian(self, q, qd, Q_u) -> np.ndarray | None:  # ∂(q̇, q̈)/∂(q, q̇) or None
+        return None
+
+    def energies(self, q, qd) -> tuple[float, float, float]:  # T, U_g, U_c
+        raise NotImplementedError
+
+
+class _PinocchioBackend(_Backend):
+    """Pinocchio's ABA with springs as tau; analytic Jacobian from computeABADerivatives."""
+
+    name = "pinocchio"
+
+    def __init__(self, scene: Scene) -> None:
+        super().__init__(scene)
+        import pinocchio as pin
+
+        self.pin = pin
+        self.ref = scene.reference
+        self.perm = scene.perm
+        self.direct = self.ref.identity_map and np.array_equal(self.perm, np.arange(self.nv))
+
+    def _pin_state(self, q, qd):
+        ref = self.ref
+        return ref.to_pinocchio(self.scene.to_reference(q), self.scene.to_reference(qd))
+
+    def accelerations(self, q, qd, Q_u):
+        if not self.direct:  # general coordinates: through the book-coordinate map
+            ref = self.ref
+            a = ref.forward_dynamics(self.scene.to_reference(q), self.scene.to_reference(qd))
+            _, Qd = ref.spring_damper_force(self.scene.to_reference(q), self.scene.to_reference(qd))
+            if Q_u is not None:
+                A = ref.mass_matrix(self.scene.to_reference(q))
+                a = a + np.linalg.solve(A, self.scene.to_reference(Q_u))
+            return a[self.perm], Qd[self.perm]
+        ref, pin = self.ref, self.pin
+        Qc, Qd = ref._joint_space_forces(q, qd, q, qd, None)
+        tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
+        return pin.aba(ref.model, ref.data, q, qd, tau), Qd
+
+    def jacobian(self, q, qd, Q_u):
+        if not self.direct:
+            return None
+        ref, pin = self.ref, self.pin
+        Qc, Qd = ref._joint_space_forces(q, qd, q, qd, None)
+        tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
+        dq, dv, Minv = pin.computeABADerivatives(ref.model, ref.data, q, qd, tau)
+        Kc, Dc = self._spring_jacobians(q)
+        n = self.nv
+        J = np.zeros((2 * n, 2 * n))
+        J[:n, n:] = np.eye(n)
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T
+        J[n:, :n] = dq - Minv @ Kc
+        J[n:, n:] = dv - Minv @ Dc
+        return J
+
+    def _spring_jacobians(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """``Σ Jᵀ C J`` and ``Σ Jᵀ D J`` at q: −∂τ/∂q (Gauss–Newton part) and −∂τ/∂q̇ (exact)."""
+        ref, pin = self.ref, self.pin
+        n = self.nv
+        K, D = np.zeros((n, n)), np.zeros((n, n))
+        K[ref.spring_v, ref.spring_v] += ref.spring_k
+        D[ref.spring_v, ref.spring_v] += ref.spring_d
+        if ref.bushings:
+            pin.computeJointJacobians(ref.model, ref.data, q)
+            pin.updateFramePlacements(ref.model, ref.data)
+            for b in ref.bushings:
+                _, jac = ref._deformation(b)
+                K += jac.T @ (b.stiffness[:, None] * jac)
+                D += jac.T @ (b.damping[:, None] * jac)
+        return K, D
+
+    def energies(self, q, qd):
+        ref, s = self.ref, self.scene
+        qr, vr = s.to_reference(q), s.to_reference(qd)
+        return ref.kinetic_energy(qr, vr), ref.gravity_potential(qr), ref.spring_potential(qr)
+
+
+class _TextbookBackend(_Backend):
+    """The structured S Θ Sᵀ algorithm; the Jacobian by finite differences (scipy's)."""
+
+    name = "textbook"
+
+    def __init__(self, scene: Scene) -> None:
+        super().__init__(scene)
+        from rt70.textbook import structured
+
+        self.structured = structured
+        self.bdata = structured.BatchData(scene.textbook, 1)
+
+    def accelerations(self, q, qd, Q_u):
+        import scipy.linalg
+
+        from rt70.textbook import forces
+
+        st, model = self.structured, self.scene.textbook
+        A = st.mass_matrix(model, q, self.bdata)
+        Qc, Qd = forces.spring_damper_force(model, self.scene.textbook_data, q, qd)
+        rhs = st.gravity_force_batch(model, q[None], self.bdata)[0] + Qc + Qd
+        rhs -= st.bias_force(model, q, qd, self.bdata)
+        if Q_u is not None:
+            rhs += Q_u
+        return scipy.linalg.cho_solve(scipy.linalg.cho_factor(A), rhs), Qd
+
+    def energies(self, q, qd):
+        from rt70.textbook import forces
+
+        model, data = self.scene.textbook, self.scene.textbook_data
+        return (
+            forces.kinetic_energy(model, data, q, qd),
+            forces.gravity_potential(model, data, q),
+            forces.spring_potential(model, data, q),
+        )
+
+
+BACKENDS = {"pinocchio": _PinocchioBackend, "textbook": _TextbookBackend}
+
+
+@dataclass
+class SimulationResult:
+    """Trajectory, energies and solver statistics of one run.
+
+    Energies in J: ``kinetic`` T, ``gravity`` U_g, ``elastic`` U_c, ``dissipated`` E_ψ,
+    ``input_work`` W_u; ``balance = T + U_g + U_c + E_ψ − W_u − (its value at t0)`` and
+    ``balance_scale`` the energy exchanged in the run (what ``relative_drift`` is
+    relative to). ``drift_flagged`` is set when a passive run drifts by more than
+    ``DRIFT_FACTOR · rtol`` of it.
+    """
+
+    scene: str
+    backend: str
+    method: str
+    rtol: float
+    atol: float
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    kinetic: np.ndarray
+    gravity: np.ndarray
+    elastic: np.ndarray
+    dissipated: np.ndarray
+    input_work: np.ndarray
+    balance: np.ndarray
+    balance_scale: float
+    nfev: int
+    njev: int
+    nlu: int
+    n_steps: int
+    wall_time_s: float
+    success: bool
+    message: str
+    coordinates: list[str] = field(default_factory=list)
+    drift_flagged: bool = False
+
+    @property
+    def relative_drift(self) -> float:
+        """Largest |balance| over the run, relative to ``balance_scale``."""
+        return float(np.max(np.abs(self.balance)) / self.balance_scale)
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated time per wall-clock second."""
+        return float((self.t[-1] - self.t[0]) / self.wall_time_s)
+
+    def save(self, path: str | Path) -> Path:
+        """Write the result atomically: ``.npz`` (all arrays) or ``.csv`` (a table)."""
+        from rt70.atomic import atomic_write, atomic_write_text
+
+        path = Path(path)
+        if path.suffix == ".npz":
+            arrays = {
+                k: getattr(self, k)
+                for k in ("t", "q", "qd", "kinetic", "gravity", "elastic", "dissipated")
+            }
+            arrays.update(input_work=self.input_work, balance=self.balance)
+            arrays["coordinates"] = np.array(self.coordinates)
+            return atomic_write(path, lambda tmp: np.savez_compressed(tmp, **arrays))
+        if path.suffix != ".csv":
+            raise Rt70Error(f"{path}: output must end in .csv or .npz")
+        names = ["t"] + [f"q:{c}" for c in self.coordinates] + [f"qd:{c}" for c in self.coordinates]
+        names += ["kinetic", "gravity", "elastic", "dissipated", "input_work", "balance"]
+        table = np.column_stack(
+            [self.t, self.q, self.qd, self.kinetic, self.gravity, self.elastic]
+            + [self.dissipated, self.input_work, self.balance]
+        )
+        lines = [",".join(names)] + [",".join(f"{x:.17g}" for x in row) for row in table]
+        return atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def listing_initial_state(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """The §4.2.3 listing's Q_NU, dQ_NU for the RT-70 scene (by coordinate name)."""
+    from rt70.scenes import rt70_data
+    from rt70.scenes.generate import pair_joint_names
+
+    names = [n for body in rt70_data.LISTING_BODIES for n in pair_joint_names(body["name"])]
+    model = scene.textbook
+    if sorted(names) != sorted(model.coordinate_names):
+        raise Rt70Error(f"{scene.name}: the listing's initial state is for the rt70 scene")
+    order = [names.index(c) for c in model.coordinate_names]
+    return np.asarray(rt70_data.LISTING_Q0)[order], np.asarray(rt70_data.LISTING_V0)[order]
+
+
+def simulate(
+    scene: Scene,
+    t_span: tuple[float, float],
+    x0: tuple[np.ndarray, np.ndarray] | None = None,
+    backend: str = "pinocchio",
+    method: str = "BDF",
+    rtol: float = 1e-6,
+    atol: float | None = None,
+    inputs: Inputs | None = None,
+    t_eval: np.ndarray | None = None,
+    progress: bool = False,
+) -> SimulationResult:
+    """Integrate the scene's equations of motion over ``t_span``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (:func:`rt70.scene.load_scene`).
+    t_span : (t0, t1)
+        Time interval, s.
+    x0 : (q0, q̇0), optional
+        Initial state; default the listing's state for the RT-70 scene, else rest.
+    backend : {"pinocchio", "textbook"}
+        Which implementation evaluates q̈ (and, for "pinocchio", the analytic Jacobian
+        ``∂q̈/∂(q, q̇)`` of ``computeABADerivatives`` plus the springs' ``Σ JᵀCJ``,
+        ``Σ JᵀDJ``; the textbook backend lets scipy difference the right-hand side).
+    method : str
+        A ``scipy.integrate.solve_ivp`` method (:data:`METHODS`).
+    rtol, atol : float
+        Tolerances; ``atol`` defaults to ``1e-3 · rtol`` on q and q̇ (m, rad) and
+        ``rtol`` of the initial energy scale on the two energy states.
+    inputs : callable (t, q, q̇) -> Q_u, optional
+        Generalised input forces (drives, wind).
+    t_eval : array, optional
+        Output times (default: the solver's steps).
+    progress : bool
+        Show a progress bar on stderr.
+    """
+    from scipy.integrate import solve_ivp
+
+    if backend not in BACKENDS:
+        raise Rt70Error(f"unknown backend '{backend}' (choose from {', '.join(BACKENDS)})")
+    if method not in METHODS:
+        raise Rt70Error(f"unknown method '{method}' (choose from {', '.join(METHODS)})")
+    t0, t1 = map(float, t_span)
+    if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+        raise Rt70Error(f"bad time span {t_span!r}")
+    side = BACKENDS[backend](scene)
+    n = scene.textbook.nv
+    if x0 is None:
+        try:
+            q0, qd0 = listing_initial_state(scene)
+        except Rt70Error:
+            q0, qd0 = np.zeros(n), np.zeros(n)
+    else:
+        q0, qd0 = (np.asarray(x, dtype=float) for x in x0)
+    if q0.shape != (n,) or qd0.shape != (n,) or not np.all(np.isfinite(np.r_[q0, qd0])):
+        raise Rt70Error(f"initial state must be two finite vectors of {n} entries")
+    T0, Ug0, Uc0 = side.energies(q0, qd0)
+    energy_scale = max(T0 + Uc0, 1e-12 * max(abs(Ug0), 1.0), 1e-300)
+    atol_q = 1e-3 * rtol if atol is None else atol
+    atol_vec = np.r_[np.full(2 * n, atol_q), np.full(2, rtol * energy_scale)]
+    bar = _Progress(t0, t1) if progress else None
+
+    def rhs(t, x):
+        q, qd = x[:n], x[n : 2 * n]
+        Q_u = None if inputs is None else np.asarray(inputs(t, q, qd), dtype=float)
+        qdd, Qd = side.accelerations(q, qd, Q_u)
+        if bar is not None:
+            bar.update(t)
+        power_u = 0.0 if Q_u is None else float(qd @ Q_u)
+        return np.concatenate([qd, qdd, [-float(qd @ Qd), power_u]])
+
+    jac = None
+    if method in IMPLICIT and backend == "pinocchio" and side.jacobian(q0, qd0, None) is not None:
+
+        def jac(t, x):
+            q, qd = x[:n], x[n : 2 * n]
+            Q_u = None if inputs is None else np.asarray(inputs(t, q, qd), dtype=float)
+            J = np.zeros((2 * n + 2, 2 * n + 2))
+            J[: 2 * n, : 2 * n] = side.jacobian(q, qd, Q_u)
+            return J
+
+    start = time.perf_counter()
+    sol = solve_ivp(
+        rhs,
+        (t0, t1),
+        np.r_[q0, qd0, 0.0, 0.0],
+        method=method,
+        rtol=rtol,
+        atol=atol_vec,
+        jac=jac,
+        t_eval=t_eval,
+    )
+    wall = time.perf_counter() - start
+    if bar is not None:
+        bar.close()
+    q, qd = sol.y[:n].T, sol.y[n : 2 * n].T
+    energies = np.array([side.energies(a, b) for a, b in zip(q, qd, strict=True)])
+    E_psi, W_u = sol.y[2 * n], sol.y[2 * n + 1]
+    total = energies.sum(axis=1) + E_psi - W_u
+    balance = total - total[0]
+    mech = energies[:, 0] + energies[:, 2]
+    exchanged = max(float(np.max(mech)), float(E_psi[-1]), float(np.max(np.abs(W_u))))
+    scale = max(exchanged, energy_scale)
+    result = SimulationResult(
+        scene=scene.name,
+        backend=backend,
+        method=method,
+        rtol=rtol,
+        atol=atol_q,
+        t=sol.t,
+        q=q,
+        qd=qd,
+        kinetic=energies[:, 0],
+        gravity=energies[:, 1],
+        elastic=energies[:, 2],
+        dissipated=E_psi,
+        input_work=W_u,
+        balance=balance,
+        balance_scale=scale,
+        nfev=int(sol.nfev),
+        njev=int(sol.njev),
+        nlu=int(sol.nlu),
+        n_steps=len(sol.t) - 1 if t_eval is None else -1,
+        wall_time_s=wall,
+        success=bool(sol.success),
+        message=str(sol.message),
+        coordinates=list(scene.textbook.coordinate_names),
+    )
+    result.drift_flagged = inputs is None and result.relative_drift > DRIFT_FACTOR * rtol
+    return result
+
+
+class _Progress:
+    """A minimal text progress bar on stderr (only when stderr is a terminal or forced)."""
+
+    def __init__(self, t0: float, t1: float, width: int = 40) -> None:
+        self.t0, self.t1, self.width, self.shown = t0, t1, width, -1
+
+    def update(self, t: float) -> None:
+        done = int(self.width * min(max((t - self.t0) / (self.t1 - self.t0), 0.0), 1.0))
+        if done != self.shown:
+            self.shown = done
+            sys.stderr.write(f"\r[{'#' * done}{'.' * (self.width - done)}] t = {t:.3f} s")
+            sys.stderr.flush()
+
+    def close(self) -> None:
+        sys.stderr.write("\n")
