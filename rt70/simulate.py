@@ -337,8 +337,8 @@ def simulate(
         method=method,
         rtol=rtol,
         atol=atol_vec,
-        jac=jac,
         t_eval=t_eval,
+        **({} if jac is None else {"jac": jac}),
     )
     wall = time.perf_counter() - start
     if bar is not None:
