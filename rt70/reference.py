@@ -84,6 +84,10 @@ class ReferenceModel:
             )
             for b in desc.bushings
         ]
+        self._frames1 = [b.frame1 for b in self.bushings]
+        self._frames2 = [b.frame2 for b in self.bushings]
+        self._stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6)
+        self._damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6)
         self._coordinates(desc)
         self.spring_v = np.array(
             [self.model.idx_vs[self.model.getJointId(s.joint)] for s in desc.joint_springs],
@@ -261,13 +265,60 @@ class ReferenceModel:
             np.subtract.at(Qc, self.spring_v, self.spring_k * angles[self.spring_v])
             np.subtract.at(Qd, self.spring_v, self.spring_d * vp[self.spring_v])
         if self.bushings:
-            pin.computeJointJacobians(self.model, self.data, qp)
-            pin.updateFramePlacements(self.model, self.data)
-            for b in self.bushings:
-                delta, jac = self._deformation(b)
-                Qc -= jac.T @ (b.stiffness * delta)
-                Qd -= jac.T @ (b.damping * (jac @ vp))
+            delta, jac = self.deformations(qp)
+            rate = jac @ vp  # δ̇ of every bushing, (n_b, 6)
+            Qc -= np.einsum("bin,bi->n", jac, self._stiffness * delta)
+            Qd -= np.einsum("bin,bi->n", jac, self._damping * rate)
         return Qc, Qd
+
+    def deformations(self, qp: np.ndarray, jacobian: bool = True):
+        """δ of every bushing (n_b, 6) and ∂δ/∂v (n_b, 6, nv), from Pinocchio's kinematics.
+
+        Frame placements ``oMf`` and local frame Jacobians come from Pinocchio; the
+        relative placement, Pinocchio's roll-pitch-yaw of its transpose and the inverse
+        world rpy Jacobian are evaluated for all bushings at once (the formulas of
+        ``pin.rpy.matrixToRpy`` / ``computeRpyJacobianInverse``, checked against them in
+        the tests). ``c12 = Rx(β) Ry(θ) Rz(α)`` has ``c12ᵀ`` with rpy ``ρ = −[β, θ, α]``;
+        the angular velocity of frame 2 relative to frame 1 is ``ω = J_W(ρ) φ̇``.
+        """
+        m, d = self.model, self.data
+        if jacobian:
+            pin.computeJointJacobians(m, d, qp)
+        else:
+            pin.forwardKinematics(m, d, qp)
+        pin.updateFramePlacements(m, d)
+        f1, f2 = self._frames1, self._frames2
+        R1 = np.array([d.oMf[i].rotation for i in f1])
+        R2 = np.array([d.oMf[i].rotation for i in f2])
+        p1 = np.array([d.oMf[i].translation for i in f1])
+        p2 = np.array([d.oMf[i].translation for i in f2])
+        R1t = np.swapaxes(R1, -1, -2)
+        c12 = R1t @ R2
+        r12 = (R1t @ (p2 - p1)[..., None])[..., 0]
+        ct = np.swapaxes(c12, -1, -2)  # ρ = rpy of c12ᵀ (Pinocchio's Rz(y) Ry(p) Rx(r))
+        pitch = np.arctan2(-ct[:, 2, 0], np.hypot(ct[:, 0, 0], ct[:, 1, 0]))
+        roll = np.arctan2(ct[:, 2, 1], ct[:, 2, 2])
+        yaw = np.arctan2(ct[:, 1, 0], ct[:, 0, 0])
+        cp = np.cos(pitch)
+        if np.any(np.abs(cp) < GIMBAL_LOCK_COS):
+            raise SingularConfigurationError("bushing at Euler-angle gimbal lock (θ = ±π/2)")
+        delta = np.concatenate([r12, -np.stack([roll, pitch, yaw], axis=1)], axis=1)
+        if not jacobian:
+            return delta, None
+        J1 = np.array([pin.getFrameJacobian(m, d, i, pin.LOCAL) for i in f1]).reshape(-1, 6, m.nv)
+        J2 = np.array([pin.getFrameJacobian(m, d, i, pin.LOCAL) for i in f2]).reshape(-1, 6, m.nv)
+        # J_rel = J2 − Ad(M12⁻¹) J1; δ̇_trans = c12 v_rel, φ̇ = J_W(ρ)⁻¹ ω_rel
+        lin1 = J1[:, :3] - _skew(r12) @ J1[:, 3:]
+        jac = np.empty_like(J2)
+        jac[:, :3] = c12 @ J2[:, :3] - lin1
+        w_rel = J2[:, 3:] - ct @ J1[:, 3:]
+        cy, sy, tp = np.cos(yaw), np.sin(yaw), np.tan(pitch)
+        inv = np.zeros((len(f1), 3, 3))
+        inv[:, 0, 0], inv[:, 0, 1] = cy / cp, sy / cp
+        inv[:, 1, 0], inv[:, 1, 1] = -sy, cy
+        inv[:, 2, 0], inv[:, 2, 1], inv[:, 2, 2] = cy * tp, sy * tp, 1.0
+        jac[:, 3:] = inv @ w_rel
+        return delta, jac
 
     def _joint_angles(self, qp: np.ndarray) -> np.ndarray:
         """Coordinate of every 1-DOF joint, indexed by velocity index (cos/sin → angle)."""
@@ -279,26 +330,6 @@ class ReferenceModel:
             elif jm.nv == 1 and jm.nq == 2:
                 out[jm.idx_v] = np.arctan2(qp[jm.idx_q + 1], qp[jm.idx_q])
         return out
-
-    def _deformation(self, b: _Bushing) -> tuple[np.ndarray, np.ndarray]:
-        """δ = [position of frame 2 in frame 1; 1–2–3 angles], and ∂δ/∂v."""
-        m, d = self.model, self.data
-        M12 = d.oMf[b.frame1].actInv(d.oMf[b.frame2])
-        c12 = M12.rotation
-        # c12 = Rx(β) Ry(θ) Rz(α), so c12ᵀ = Rz(−α) Ry(−θ) Rx(−β): Pinocchio's rpy of c12ᵀ
-        # is −[β, θ, α].
-        rho = pin.rpy.matrixToRpy(c12.T)
-        if abs(np.cos(rho[1])) < GIMBAL_LOCK_COS:
-            raise SingularConfigurationError("bushing at Euler-angle gimbal lock (θ = ±π/2)")
-        J1 = pin.getFrameJacobian(m, d, b.frame1, pin.LOCAL).reshape(6, m.nv)
-        J2 = pin.getFrameJacobian(m, d, b.frame2, pin.LOCAL).reshape(6, m.nv)
-        J_rel = J2 - M12.inverse().toActionMatrix() @ J1
-        jac = np.empty_like(J_rel)
-        jac[:3] = c12 @ J_rel[:3]
-        # ω (frame-2 axes) of c12 is the world-frame rate of c12ᵀ with the sign flipped:
-        # ω = J_W(ρ) φ̇, hence φ̇ = J_W(ρ)⁻¹ ω.
-        jac[3:] = pin.rpy.computeRpyJacobianInverse(rho, pin.WORLD) @ J_rel[3:]
-        return np.concatenate([M12.translation, -rho]), jac
 
     def forward_dynamics(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """``pin.aba`` with the spring and damper forces as ``tau``, in book coordinates.
@@ -338,9 +369,14 @@ class ReferenceModel:
             angles = self._joint_angles(qp)
             U += 0.5 * float(np.sum(self.spring_k * angles[self.spring_v] ** 2))
         if self.bushings:
-            pin.computeJointJacobians(self.model, self.data, qp)
-            pin.updateFramePlacements(self.model, self.data)
-            for b in self.bushings:
-                delta, _ = self._deformation(b)
-                U += 0.5 * float(delta @ (b.stiffness * delta))
+            delta, _ = self.deformations(qp, jacobian=False)
+            U += 0.5 * float(np.sum(self._stiffness * delta**2))
         return U
+
+
+def _skew(x: np.ndarray) -> np.ndarray:
+    """Skew matrices of an array of 3-vectors (n, 3) → (n, 3, 3)."""
+    out = np.zeros(x.shape + (3,))
+    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -x[:, 2], x[:, 1], -x[:, 0]
+    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = x[:, 2], -x[:, 1], x[:, 0]
+    return out

@@ -102,18 +102,14 @@ class _PinocchioBackend(_Backend):
 
     def _spring_jacobians(self, q) -> tuple[np.ndarray, np.ndarray]:
         """``Σ Jᵀ C J`` and ``Σ Jᵀ D J`` at q: −∂τ/∂q (Gauss–Newton part) and −∂τ/∂q̇ (exact)."""
-        ref, pin = self.ref, self.pin
-        n = self.nv
+        ref, n = self.ref, self.nv
         K, D = np.zeros((n, n)), np.zeros((n, n))
         K[ref.spring_v, ref.spring_v] += ref.spring_k
         D[ref.spring_v, ref.spring_v] += ref.spring_d
         if ref.bushings:
-            pin.computeJointJacobians(ref.model, ref.data, q)
-            pin.updateFramePlacements(ref.model, ref.data)
-            for b in ref.bushings:
-                _, jac = ref._deformation(b)
-                K += jac.T @ (b.stiffness[:, None] * jac)
-                D += jac.T @ (b.damping[:, None] * jac)
+            _, jac = ref.deformations(q)
+            K += np.einsum("bin,bi,bim->nm", jac, ref._stiffness, jac)
+            D += np.einsum("bin,bi,bim->nm", jac, ref._damping, jac)
         return K, D
 
     def energies(self, q, qd):

@@ -113,3 +113,27 @@ def test_direct_pair_bushing_deformation_is_pair_coordinates(rt70_scene):
         expected = np.zeros((6, tm.nv))
         expected[:, tm.coords(j)] = np.eye(6)
         assert np.allclose(d.jacobian, expected, atol=1e-12)
+
+
+def test_reference_rpy_formulas_are_pinocchios():
+    """The batched rpy and inverse rpy Jacobian of rt70.reference equal pin.rpy's."""
+    import pinocchio as pin
+
+    scene = load_scene("rt70")
+    ref = scene.reference
+    rng = np.random.default_rng(5)
+    q = rng.uniform(-0.4, 0.4, ref.nv)
+    delta, jac = ref.deformations(q)
+    d = ref.data
+    for k, (f1, f2) in enumerate(zip(ref._frames1, ref._frames2, strict=True)):
+        M12 = d.oMf[f1].actInv(d.oMf[f2])
+        rho = pin.rpy.matrixToRpy(M12.rotation.T)
+        assert np.allclose(delta[k], np.r_[M12.translation, -rho], atol=1e-12)
+        J1 = pin.getFrameJacobian(ref.model, d, f1, pin.LOCAL)
+        J2 = pin.getFrameJacobian(ref.model, d, f2, pin.LOCAL)
+        J_rel = J2 - M12.inverse().toActionMatrix() @ J1
+        expected = np.r_[
+            M12.rotation @ J_rel[:3],
+            pin.rpy.computeRpyJacobianInverse(rho, pin.WORLD) @ J_rel[3:],
+        ]
+        assert np.allclose(jac[k], expected, atol=1e-9 * np.abs(expected).max())
