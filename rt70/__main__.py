@@ -4,4 +4,5 @@ import sys
 
 from rt70.cli import main
 
-sys.exit(main())
+if __name__ == "__main__":  # guarded: benchmark workers are started with "spawn"
+    sys.exit(main())

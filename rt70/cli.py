@@ -49,6 +49,17 @@ def _validate(args: argparse.Namespace) -> int:
 def _bench(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    if args.what == "simulate":
+        from rt70 import work_precision
+
+        rows = work_precision.run(
+            quick=args.quick, progress=lambda msg: print(f"  {msg}", file=sys.stderr, flush=True)
+        )
+        print(work_precision.format_table(rows))
+        for path in work_precision.write_results(rows, Path(args.out)):
+            print(f"wrote {path}")
+        return 0
+
     from rt70 import bench
 
     sizes = (10, 20, 50) if args.quick else (10, 20, 50, 100, 200, 400)
@@ -195,6 +206,13 @@ def build_parser() -> argparse.ArgumentParser:
         description="Per-call and batched textbook A(q) against pin.crba on rt70, ur5, panda "
         "and talos_full, and the growth of its cost on serial chains and balanced trees; "
         "writes CSV and a log-log plot.",
+    )
+    ben.add_argument(
+        "what",
+        nargs="?",
+        default="mass-matrix",
+        choices=("mass-matrix", "simulate"),
+        help="mass-matrix (default) or simulate (the work-precision report)",
     )
     ben.add_argument("--K", type=int, default=1000, help="batch size")
     ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")

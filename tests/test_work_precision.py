@@ -1,0 +1,75 @@
+"""The work–precision report: quick run, files, convergence, references, the time cap."""
+
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from rt70 import work_precision as wp
+from rt70.scene import load_scene, scene_from_text
+
+
+@pytest.fixture(scope="module")
+def quick_rows():
+    return wp.run(quick=True)
+
+
+def test_quick_run_writes_files(quick_rows, tmp_path):
+    paths = wp.write_results(quick_rows, tmp_path)
+    assert [p.name for p in paths] == ["work_precision.csv", "work_precision.png"]
+    with open(tmp_path / "work_precision.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    assert len(table) == len(quick_rows)
+    assert {r["problem"] for r in table} == {p.name for p in wp.QUICK_PROBLEMS}
+    assert {r["method"] for r in table} == set(wp.METHODS)
+    assert (tmp_path / "work_precision.png").stat().st_size > 10_000
+    text = wp.format_table(quick_rows)
+    assert "fastest to error" in text and "references" in text
+
+
+def test_errors_decrease_with_tolerance(quick_rows):
+    for problem in wp.QUICK_PROBLEMS:
+        for method in ("DOP853", "BDF"):
+            ok = sorted(
+                (r.rtol, r.error)
+                for r in quick_rows
+                if r.problem == problem.name and r.method == method and r.status == "ok"
+            )
+            if problem.name == "rt70" and method == "DOP853":
+                assert not ok  # stiff: over the cap
+                continue
+            assert len(ok) == len(wp.QUICK_RTOLS), (problem.name, method)
+            errors = [e for _, e in ok]  # tightest tolerance first
+            assert all(np.isfinite(errors))
+            assert errors == sorted(errors), (problem.name, method, ok)
+            assert errors[0] < 0.1 * errors[-1]
+
+
+def test_reference_is_another_method(quick_rows):
+    for r in quick_rows:
+        ref_method, ref_rtol = r.reference.split()[:2]
+        assert ref_method != r.method
+        assert ref_rtol == f"rtol={wp.REFERENCE_RTOL:g}"
+        assert r.reference_floor < 1e-8  # the two references agree
+        if r.status == "ok":
+            assert r.error > 0 and r.time_s > 0 and not r.over_cap
+            assert len(r.times_s.split(";")) == wp.QUICK_REPEATS
+
+
+def test_stiff_explicit_runs_are_abandoned_at_the_cap(quick_rows):
+    rk = [r for r in quick_rows if r.problem == "rt70" and r.method == "RK45"]
+    assert [r.status for r in rk] == ["over cap", "over cap (not run)"]
+    assert all(r.over_cap and math.isnan(r.error) for r in rk)
+
+
+def test_light_damping_is_proportional():
+    base = load_scene("rt70")
+    delta = 0.05
+    scene = scene_from_text(wp.light_damping_text(base.text, delta), "rt70_light")
+    old, new = base.description.bushings, scene.description.bushings
+    assert [b.name for b in new] == [b.name for b in old] and len(new) == 11
+    for a, b in zip(old, new, strict=True):
+        np.testing.assert_array_equal(b.stiffness, a.stiffness)
+        np.testing.assert_allclose(b.damping, delta * a.stiffness, rtol=1e-15)
+    assert scene.textbook.nv == base.textbook.nv == 42
