@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rt70.errors import SingularConfigurationError
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import (
     check_finite,
@@ -43,7 +44,10 @@ def bushing_deformation(data: Data, b: BushingModel) -> Deformation:
     R2, p2 = frame_pose(data, b.body2, b.r2, b.c2)
     r12 = R1.T @ (p2 - p1)
     c12 = R1.T @ R2
-    phi = euler123_angles(c12)
+    try:
+        phi = euler123_angles(c12)
+    except SingularConfigurationError as exc:
+        raise SingularConfigurationError(f"bushing '{b.name}': {exc}") from None
     J1 = frame_jacobian(data, b.body1, b.r1, b.c1)
     J2 = frame_jacobian(data, b.body2, b.r2, b.c2)
     J_rel = J2 - placement(r12, c12).T @ J1

@@ -192,47 +192,55 @@ def build_model(desc: RobotDescription) -> Model:
     }
     joint_coord: dict[str, int] = {}
 
+    # Depth-first, parents before children, siblings in file order: an explicit stack of
+    # (joint, body, r_link, c_link), the joint's parent link sitting at (r_link, c_link)
+    # in body (a recursion would overflow Python's stack on chains of ~1000 bodies).
+    stack: list[tuple[Joint, int, np.ndarray, np.ndarray]] = []
+
     def visit(link: str, body: int, r_link: np.ndarray, c_link: np.ndarray) -> None:
-        """Add the pairs below ``link``, which sits at ``(r_link, c_link)`` in ``body``."""
-        for joint in desc.child_joints(link):
-            r_joint = r_link + c_link @ joint.xyz
-            c_joint = c_link @ rpy_matrix(joint.rpy)
-            inertial = desc.links[joint.child].inertial
-            if joint.type == "fixed":  # merged into the parent body, as Pinocchio does
-                if inertial is not None and body >= 0:
-                    theta = body_inertia(inertial.mass, inertial.com, inertial.inertia)
-                    X = placement(r_joint, c_joint)
-                    thetas[body] = thetas[body] + X @ theta @ X.T
-                link_frames[joint.child] = (body, r_joint, c_joint)
-                visit(joint.child, body, r_joint, c_joint)
-                continue
-            chain = _euler6_chain(desc, joint, referenced)
-            if chain:
-                jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
-                inertial = desc.links[child].inertial
-            else:
-                child, jkind = joint.child, _URDF_KIND[joint.type]
-                suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
-                names = [joint.name + suffix for suffix in suffixes]
-            j = len(kind)
-            parent.append(body)
-            kind.append(jkind)
-            axis.append(joint.axis)
-            r_c.append(r_joint)
-            c_c.append(c_joint)
-            if inertial is None:
-                thetas.append(np.zeros((6, 6)))
-            else:
-                thetas.append(body_inertia(inertial.mass, inertial.com, inertial.inertia))
-            for name in names:
-                joint_coord[name] = len(coord_names)
-                coord_names.append(name)
-            ndof.append(_NDOF[jkind])
-            body_names.append(child)
-            link_frames[child] = (j, np.zeros(3), np.eye(3))
-            visit(child, j, np.zeros(3), np.eye(3))
+        """Schedule the joints below ``link``, which sits at ``(r_link, c_link)`` in ``body``."""
+        stack.extend((joint, body, r_link, c_link) for joint in desc.child_joints(link)[::-1])
 
     visit(desc.root, -1, np.zeros(3), np.eye(3))
+    while stack:
+        joint, body, r_link, c_link = stack.pop()
+        r_joint = r_link + c_link @ joint.xyz
+        c_joint = c_link @ rpy_matrix(joint.rpy)
+        inertial = desc.links[joint.child].inertial
+        if joint.type == "fixed":  # merged into the parent body, as Pinocchio does
+            if inertial is not None and body >= 0:
+                theta = body_inertia(inertial.mass, inertial.com, inertial.inertia)
+                X = placement(r_joint, c_joint)
+                thetas[body] = thetas[body] + X @ theta @ X.T
+            link_frames[joint.child] = (body, r_joint, c_joint)
+            visit(joint.child, body, r_joint, c_joint)
+            continue
+        chain = _euler6_chain(desc, joint, referenced)
+        if chain:
+            jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
+            inertial = desc.links[child].inertial
+        else:
+            child, jkind = joint.child, _URDF_KIND[joint.type]
+            suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
+            names = [joint.name + suffix for suffix in suffixes]
+        j = len(kind)
+        parent.append(body)
+        kind.append(jkind)
+        axis.append(joint.axis)
+        r_c.append(r_joint)
+        c_c.append(c_joint)
+        if inertial is None:
+            thetas.append(np.zeros((6, 6)))
+        else:
+            thetas.append(body_inertia(inertial.mass, inertial.com, inertial.inertia))
+        for name in names:
+            joint_coord[name] = len(coord_names)
+            coord_names.append(name)
+        ndof.append(_NDOF[jkind])
+        body_names.append(child)
+        link_frames[child] = (j, np.zeros(3), np.eye(3))
+        visit(child, j, np.zeros(3), np.eye(3))
+
     masses = [float(t[0, 0]) for t in thetas]  # Θ = [[m 1, −m<p>], [m<p>, …]] (4.77)
     coms = [
         _unskew(t[3:, :3]) / m if m > 0 else np.zeros(3)

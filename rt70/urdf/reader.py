@@ -294,15 +294,19 @@ class _Reader:
                     f"link '{j.child}' has two parents ('{parent_of[j.child]}' and '{j.parent}')",
                 )
             parent_of[j.child] = j.parent
+        reaches_root: set[str] = set()  # links already followed to a root (linear time)
         for start in parent_of:  # follow parents: a cycle never reaches a root
             seen = [start]
+            on_path = {start}
             link = start
-            while link in parent_of:
+            while link in parent_of and link not in reaches_root:
                 link = parent_of[link]
-                if link in seen:
+                if link in on_path:
                     cycle = " -> ".join([*seen[seen.index(link) :], link])
                     raise self.fail(TopologyError, f"kinematic cycle: {cycle}")
                 seen.append(link)
+                on_path.add(link)
+            reaches_root.update(seen)
         roots = [name for name in links if name not in parent_of]
         if len(roots) != 1:
             raise self.fail(
