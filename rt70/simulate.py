@@ -21,6 +21,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.scene import Scene
+from rt70.textbook.spatial import check_euler_pairs
 
 #: Integration methods of scipy.integrate.solve_ivp accepted by :func:`simulate`.
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
@@ -71,6 +72,7 @@ class _PinocchioBackend(_Backend):
         return ref.to_pinocchio(self.scene.to_reference(q), self.scene.to_reference(qd))
 
     def accelerations(self, q, qd, Q_u):
+        check_euler_pairs(self.scene.textbook, self.scene.textbook.expand(q))
         if not self.direct:  # general coordinates: through the book-coordinate map
             ref = self.ref
             a = ref.forward_dynamics(self.scene.to_reference(q), self.scene.to_reference(qd))
@@ -136,13 +138,18 @@ class _TextbookBackend(_Backend):
         from rt70.textbook import forces
 
         st, model = self.structured, self.scene.textbook
+        check_euler_pairs(model, model.expand(q))
         A = st.mass_matrix(model, q, self.bdata)
         Qc, Qd = forces.spring_damper_force(model, self.scene.textbook_data, q, qd)
         rhs = st.gravity_force_batch(model, q[None], self.bdata)[0] + Qc + Qd
         rhs -= st.bias_force(model, q, qd, self.bdata)
         if Q_u is not None:
             rhs += Q_u
-        return scipy.linalg.cho_solve(scipy.linalg.cho_factor(A), rhs), Qd
+        try:
+            factor = scipy.linalg.cho_factor(A)
+        except np.linalg.LinAlgError:
+            raise Rt70Error(f"{self.scene.name}: mass matrix not positive definite") from None
+        return scipy.linalg.cho_solve(factor, rhs), Qd
 
     def energies(self, q, qd):
         from rt70.textbook import forces

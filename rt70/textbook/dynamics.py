@@ -14,7 +14,7 @@ from rt70.errors import Rt70Error
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import check_finite, pair_motion_rate, update_structure
 from rt70.textbook.model import Model
-from rt70.textbook.spatial import crf
+from rt70.textbook.spatial import check_euler_pairs, crf
 
 
 def mass_matrix(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
@@ -92,9 +92,12 @@ def forward_dynamics(
     """``q̈ = A⁻¹ (Q_g + Q − B q̇)`` with Q the other generalised forces (springs, inputs).
 
     A is factorised by Cholesky (it is symmetric positive definite for a well-posed
-    model); a singular A raises :class:`~rt70.errors.Rt70Error`.
+    model); a singular A raises :class:`~rt70.errors.Rt70Error`, and an Euler pair
+    within ``DYNAMICS_GIMBAL_COS`` of gimbal lock a
+    :class:`~rt70.errors.SingularConfigurationError`.
     """
     Q = check_finite("Q", Q, model.nv)
+    check_euler_pairs(model, model.expand(check_finite("q", q, model.nv)))
     rhs = Q + gravity_force(model, data, q) - bias_force(model, data, q, qd)
     A = data.S @ data.Theta @ data.S.T
     try:
