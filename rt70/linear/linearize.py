@@ -43,15 +43,19 @@ def static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
     return dynamics.gravity_force(model, data, q) + Qc
 
 
+def _negative_jacobian(force, q: np.ndarray, h: float) -> np.ndarray:
+    """``−∂force/∂q`` by central differences with step h per coordinate, symmetrised."""
+    K = np.empty((q.size, q.size))
+    for i in range(q.size):
+        e = np.zeros(q.size)
+        e[i] = h
+        K[:, i] = -(force(q + e) - force(q - e)) / (2.0 * h)
+    return 0.5 * (K + K.T)
+
+
 def stiffness_matrix(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
     """``K = −∂(Q_g + Q_c)/∂q`` by central differences, symmetrised (see module docstring)."""
-    nv = scene.textbook.nv
-    K = np.empty((nv, nv))
-    for i in range(nv):
-        e = np.zeros(nv)
-        e[i] = h
-        K[:, i] = -(static_force(scene, q + e) - static_force(scene, q - e)) / (2.0 * h)
-    return 0.5 * (K + K.T)
+    return _negative_jacobian(lambda x: static_force(scene, x), np.asarray(q, dtype=float), h)
 
 
 def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
@@ -165,15 +169,9 @@ def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Lin
 def _gravity_stiffness(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
     """``−∂Q_g/∂q`` by central differences (the geometric stiffness of gravity)."""
     model, data = scene.textbook, scene.textbook_data
-    nv = model.nv
-    K = np.empty((nv, nv))
-    for i in range(nv):
-        e = np.zeros(nv)
-        e[i] = h
-        K[:, i] = -(
-            dynamics.gravity_force(model, data, q + e) - dynamics.gravity_force(model, data, q - e)
-        ) / (2.0 * h)
-    return 0.5 * (K + K.T)
+    return _negative_jacobian(
+        lambda x: dynamics.gravity_force(model, data, x), np.asarray(q, dtype=float), h
+    )
 
 
 def rt70_pointing(elevation_deg: float, azimuth_deg: float = 0.0) -> dict[str, float]:
