@@ -49,6 +49,7 @@ from rt70.linear.topology import (
     Edge,
     LinearModel,
     LinearModelError,
+    _positive_int,
     check_edges,
     edges_from_topology,
 )
@@ -69,13 +70,7 @@ def _node(value: object, n_nodes: int, what: str) -> int:
 
 
 def _n_nodes(value: object) -> int:
-    try:
-        n = operator.index(value)
-    except TypeError:
-        raise LinearModelError(f"n_nodes must be an integer, got {value!r}") from None
-    if n < 1:
-        raise LinearModelError(f"n_nodes must be at least 1, got {n}")
-    return n
+    return _positive_int(value, "n_nodes")
 
 
 def _roots(root: int | Sequence[int] | None, n_nodes: int) -> list[int]:

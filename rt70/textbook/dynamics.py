@@ -60,7 +60,13 @@ def bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.n
     """Matrix ``B = S Θ Ṡᵀ + S Φ⁰ Θ Sᵀ`` (4.80), ``Φ⁰ = diag(Φ(V_k⁰))``."""
     q = check_finite("q", q, model.nv)
     qd = check_finite("qd", qd, model.nv)
-    S = update_structure(model, data, q)
+    update_structure(model, data, q)
+    return _bias_matrix(model, data, q, qd)
+
+
+def _bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """B of (4.80) for the configuration already in ``data`` (L, S up to date)."""
+    S = data.S
     V = body_velocities(model, data, qd)
     S_dot = structure_matrix_rate(model, data, q, qd)
     Phi0 = np.zeros_like(data.Theta)
@@ -79,11 +85,16 @@ def gravity_force(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
 
     ``G_k = [m_k g_k; <p_cm,k> m_k g_k] = Θ_k [g_k; 0]``, ``g_k = c_{0k}ᵀ g0``.
     """
-    S = update_structure(model, data, q)
+    update_structure(model, data, q)
+    return _gravity_force(model, data)
+
+
+def _gravity_force(model: Model, data: Data) -> np.ndarray:
+    """``S G`` for the configuration already in ``data``."""
     accel = np.zeros((model.nb, 6))
     accel[:, :3] = np.einsum("kji,j->ki", data.R, model.gravity)
     G = np.einsum("kij,kj->ki", model.Theta, accel).ravel()
-    return S @ G
+    return data.S @ G
 
 
 def forward_dynamics(
@@ -97,8 +108,11 @@ def forward_dynamics(
     :class:`~rt70.errors.SingularConfigurationError`.
     """
     Q = check_finite("Q", Q, model.nv)
-    check_euler_pairs(model, model.expand(check_finite("q", q, model.nv)))
-    rhs = Q + gravity_force(model, data, q) - bias_force(model, data, q, qd)
+    q = check_finite("q", q, model.nv)
+    qd = check_finite("qd", qd, model.nv)
+    check_euler_pairs(model, model.expand(q))
+    update_structure(model, data, q)  # one forward pass for A, B q̇ and S G
+    rhs = Q + _gravity_force(model, data) - _bias_matrix(model, data, q, qd) @ qd
     A = data.S @ data.Theta @ data.S.T
     try:
         factor = scipy.linalg.cho_factor(A)
