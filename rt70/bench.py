@@ -65,7 +65,7 @@ def _pin_crba(scene: Scene, q: np.ndarray) -> Callable[[], object]:
     import pinocchio as pin
 
     ref = scene.reference
-    qp = ref.to_pinocchio(scene.to_reference(q))[0]
+    qp = ref.to_pinocchio(q)[0]
     model, data = ref.model, ref.model.createData()
     return lambda: pin.crba(model, data, qp)
 
@@ -89,7 +89,7 @@ def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
     Q = np.random.default_rng(1).uniform(-0.5, 0.5, (K, model.nv))
     bdata = structured.BatchData(model, K)
     ref = scene.reference
-    QP = [ref.to_pinocchio(scene.to_reference(q))[0] for q in Q]
+    QP = [ref.to_pinocchio(q)[0] for q in Q]
     pm, pd = ref.model, ref.model.createData()
 
     def pin_loop() -> None:

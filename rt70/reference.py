@@ -1,6 +1,7 @@
 """The reference side: Pinocchio's recursive algorithms on the same URDF scene.
 
-All methods take the state in the book's coordinates, in Pinocchio's joint order:
+All methods take the state in the book's coordinates, in the user's order
+(:func:`rt70.urdf.coordinate_names`: the file's depth-first order, the textbook side's):
 one angle per revolute or continuous joint (Pinocchio stores cos/sin), one length per
 prismatic joint, ``[x, y, z, β, θ, α]`` for a floating joint (Pinocchio: position and
 quaternion, velocity ``v = M q̇`` with ``M = diag(cᵀ, ε)``), ``[x, y, α]`` for a planar
@@ -26,6 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from rt70.errors import Rt70Error, SingularConfigurationError, UrdfError
+from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
 
 #: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
@@ -52,9 +54,6 @@ class _Coordinate:
     book: int  # first book coordinate (for "mimic": the source's book coordinate)
     multiplier: float = 1.0
     offset: float = 0.0
-
-
-_SUFFIXES = {"floating": (":x", ":y", ":z", ":rx", ":ry", ":rz"), "planar": (":x", ":y", ":rz")}
 
 
 class ReferenceModel:
@@ -101,12 +100,19 @@ class ReferenceModel:
         self.data_no_gravity = self.model_no_gravity.createData()
 
     def _coordinates(self, desc: RobotDescription) -> None:
-        """Book coordinates of every Pinocchio joint, and whether the map is the identity."""
+        """Book coordinates of every Pinocchio joint, numbered in the user's order.
+
+        Pinocchio numbers sibling joints its own way; every result of this class is in
+        the order of :func:`rt70.urdf.coordinate_names` (the file's depth-first order,
+        the same as the textbook side's), so ``c.book`` is the user index of the
+        joint's first coordinate.
+        """
         m = self.model
         mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
+        names = coordinate_names(desc)
+        user = {n: i for i, n in enumerate(names)}
         coords: list[_Coordinate] = []
-        names: list[str] = []
-        book_of: dict[str, int] = {}
+        seen: list[str] = []
         for i in range(1, m.njoints):
             name, jm = m.names[i], m.joints[i]
             short = jm.shortname()
@@ -123,29 +129,37 @@ class ReferenceModel:
                     f"{desc.source}: joint '{name}': Pinocchio joint {short} unsupported"
                 )
             if name in mimics:
-                coords.append(_Coordinate(i, "mimic", (), jm.idx_q, jm.idx_v, -1))
-                continue
-            labels = tuple(name + sfx for sfx in _SUFFIXES.get(kind, ("",)))
-            book_of[name] = len(names)
-            coords.append(_Coordinate(i, kind, labels, jm.idx_q, jm.idx_v, len(names)))
-            names.extend(labels)
-        for n, c in enumerate(coords):  # resolve mimic sources
-            if c.kind == "mimic":
-                mimic = mimics[m.names[c.joint]]
-                is_continuous = m.joints[c.joint].nq == 2
-                coords[n] = _Coordinate(
-                    c.joint,
-                    "mimic-continuous" if is_continuous else "mimic",
-                    (),
-                    c.iq,
-                    c.iv,
-                    book_of[mimic.joint],
-                    mimic.multiplier,
-                    mimic.offset,
+                mimic = mimics[name]
+                coords.append(
+                    _Coordinate(
+                        i,
+                        "mimic-continuous" if kind == "continuous" else "mimic",
+                        (),
+                        jm.idx_q,
+                        jm.idx_v,
+                        user[mimic.joint],
+                        mimic.multiplier,
+                        mimic.offset,
+                    )
                 )
+                continue
+            labels = tuple(name + sfx for sfx in SUFFIXES.get(kind, ("",)))
+            first = user.get(labels[0], -1)
+            if [user.get(label) for label in labels] != list(range(first, first + len(labels))):
+                raise Rt70Error(
+                    f"{desc.source}: joint '{name}': Pinocchio's coordinates "
+                    f"{', '.join(labels)} are not those rt70 reads from the file"
+                )
+            coords.append(_Coordinate(i, kind, labels, jm.idx_q, jm.idx_v, first))
+            seen.extend(labels)
+        if sorted(seen) != sorted(names):
+            raise Rt70Error(
+                f"{desc.source}: Pinocchio's coordinates differ from the file's: "
+                f"{', '.join(sorted(set(seen) ^ set(names))[:5])}"
+            )
         self.coords = coords
         self.coordinate_names = names
-        self.identity_map = all(c.kind == "1dof" for c in coords)
+        self.identity_map = all(c.kind == "1dof" and c.book == c.iv for c in coords)
 
     @classmethod
     def from_file(cls, desc: RobotDescription, path: str | Path) -> ReferenceModel:
@@ -175,7 +189,8 @@ class ReferenceModel:
     def to_pinocchio(self, q: np.ndarray, qd: np.ndarray | None = None):
         """Pinocchio's ``(q, v)``, the Jacobian ``J`` (``v = J q̇``) and ``J̇ q̇``.
 
-        ``J`` is None when it is the identity (only 1-DOF joints, no mimic).
+        ``J`` is None when it is the identity (only 1-DOF joints in the user's order, no
+        mimic); a mere reordering of 1-DOF joints is a permutation matrix.
         """
         if self.identity_map:
             return q, qd, None, None
@@ -231,7 +246,7 @@ class ReferenceModel:
 
     # --- dynamics --------------------------------------------------------------------
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """``Jᵀ crba J``, symmetrised."""
+        """``Jᵀ crba J``, symmetrised (``J`` includes the map to the user's order)."""
         qp, _, J, _ = self.to_pinocchio(q)
         A = pin.crba(self.model, self.data, qp)
         A = np.triu(A) + np.triu(A, 1).T

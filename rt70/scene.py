@@ -7,12 +7,10 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-import numpy as np
-
 from rt70.errors import SceneError
 from rt70.textbook.data import Data
 from rt70.textbook.model import Model, build_model
-from rt70.urdf import RobotDescription, read_urdf_string
+from rt70.urdf import RobotDescription, coordinate_names, read_urdf_string
 from rt70.urdf.reader import read_source
 
 #: Directory of the project's scenes (``urdf/`` beside the package; ``RT70_URDF_DIR`` overrides).
@@ -47,8 +45,10 @@ def scene_path(target: str | Path) -> Path:
 class Scene:
     """One URDF scene: its description, the textbook model and the Pinocchio reference.
 
-    ``perm[i]`` is Pinocchio's velocity index of the textbook's coordinate i, so
-    ``x_pin[perm] = x_textbook`` for any per-coordinate vector.
+    Both sides take and return every per-coordinate vector and matrix in the same
+    order, :attr:`coordinate_names` (the file's depth-first order,
+    :func:`rt70.urdf.coordinate_names`): ``scene.reference.mass_matrix(q)`` and
+    ``dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)`` compare directly.
     """
 
     name: str
@@ -74,15 +74,9 @@ class Scene:
         return ReferenceModel(self.description, self.text)
 
     @cached_property
-    def perm(self) -> np.ndarray:
-        """Pinocchio velocity index of each textbook coordinate."""
-        return self.reference.coordinate_index(self.textbook.coordinate_names)
-
-    def to_reference(self, x: np.ndarray) -> np.ndarray:
-        """Map a textbook-ordered coordinate vector to Pinocchio's order."""
-        out = np.zeros(self.reference.nv)
-        out[self.perm] = x
-        return out
+    def coordinate_names(self) -> list[str]:
+        """Names of the generalised coordinates, in the order of every result."""
+        return coordinate_names(self.description)
 
 
 def load_scene(target: str | Path) -> Scene:

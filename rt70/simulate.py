@@ -64,23 +64,17 @@ class _PinocchioBackend(_Backend):
 
         self.pin = pin
         self.ref = scene.reference
-        self.perm = scene.perm
-        self.direct = self.ref.identity_map and np.array_equal(self.perm, np.arange(self.nv))
-
-    def _pin_state(self, q, qd):
-        ref = self.ref
-        return ref.to_pinocchio(self.scene.to_reference(q), self.scene.to_reference(qd))
+        self.direct = self.ref.identity_map  # book coordinates are Pinocchio's (q, v)
 
     def accelerations(self, q, qd, Q_u):
         check_euler_pairs(self.scene.textbook, self.scene.textbook.expand(q))
         if not self.direct:  # general coordinates: through the book-coordinate map
             ref = self.ref
-            a = ref.forward_dynamics(self.scene.to_reference(q), self.scene.to_reference(qd))
-            _, Qd = ref.spring_damper_force(self.scene.to_reference(q), self.scene.to_reference(qd))
+            a = ref.forward_dynamics(q, qd)
+            _, Qd = ref.spring_damper_force(q, qd)
             if Q_u is not None:
-                A = ref.mass_matrix(self.scene.to_reference(q))
-                a = a + np.linalg.solve(A, self.scene.to_reference(Q_u))
-            return a[self.perm], Qd[self.perm]
+                a = a + np.linalg.solve(ref.mass_matrix(q), Q_u)
+            return a, Qd
         ref, pin = self.ref, self.pin
         Qc, Qd = ref._joint_space_forces(q, qd, q, qd, None)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
@@ -115,9 +109,8 @@ class _PinocchioBackend(_Backend):
         return K, D
 
     def energies(self, q, qd):
-        ref, s = self.ref, self.scene
-        qr, vr = s.to_reference(q), s.to_reference(qd)
-        return ref.kinetic_energy(qr, vr), ref.gravity_potential(qr), ref.spring_potential(qr)
+        ref = self.ref
+        return ref.kinetic_energy(q, qd), ref.gravity_potential(q), ref.spring_potential(q)
 
 
 class _TextbookBackend(_Backend):

@@ -628,7 +628,7 @@ def per_body_qdd_error(scene: Scene, samples: int = CROSS_CHECK_SAMPLES, seed: i
         q, qd = random_state(model.nv, rng)
         Qc, Qd = forces.spring_damper_force(model, data, q, qd)
         a = dynamics.forward_dynamics(model, data, q, qd, Qc + Qd)
-        b = ref.forward_dynamics(scene.to_reference(q), scene.to_reference(qd))[scene.perm]
+        b = ref.forward_dynamics(q, qd)
         for j in range(model.nb):
             rows = model.coords(j)
             if rows.stop > rows.start:
@@ -1239,7 +1239,7 @@ def momentum_pinocchio(scene: Scene, q: np.ndarray, qd: np.ndarray):
     import pinocchio as pin
 
     ref = scene.reference
-    qp, vp, _, _ = ref.to_pinocchio(scene.to_reference(q), scene.to_reference(qd))
+    qp, vp, _, _ = ref.to_pinocchio(q, qd)
     pin.computeCentroidalMomentum(ref.model, ref.data, qp, vp)
     P = np.array(ref.data.hg.linear)
     L = np.array(ref.data.hg.angular) + np.cross(ref.data.com[0], P)

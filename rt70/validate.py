@@ -80,10 +80,8 @@ def _relative(abs_err: float, scale: float) -> float:
 
 
 def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
-    """Per quantity: (textbook evaluation, reference evaluation), both in textbook order."""
-    tm, td, ref, perm = scene.textbook, scene.textbook_data, scene.reference, scene.perm
-    qp, vp = scene.to_reference(q), scene.to_reference(qd)
-    ix = np.ix_(perm, perm)
+    """Per quantity: (textbook evaluation, reference evaluation), in the user's coordinate order."""
+    tm, td, ref = scene.textbook, scene.textbook_data, scene.reference
 
     def tb_forward():
         Qc, Qd = forces.spring_damper_force(tm, td, q, qd)
@@ -92,26 +90,26 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     return {
         "mass_matrix": (
             lambda: dynamics.mass_matrix(tm, td, q),
-            lambda: ref.mass_matrix(qp)[ix],
+            lambda: ref.mass_matrix(q),
         ),
-        "bias": (lambda: dynamics.bias_force(tm, td, q, qd), lambda: ref.bias_force(qp, vp)[perm]),
-        "gravity": (lambda: dynamics.gravity_force(tm, td, q), lambda: ref.gravity_force(qp)[perm]),
+        "bias": (lambda: dynamics.bias_force(tm, td, q, qd), lambda: ref.bias_force(q, qd)),
+        "gravity": (lambda: dynamics.gravity_force(tm, td, q), lambda: ref.gravity_force(q)),
         "spring_force": (
             lambda: forces.spring_damper_force(tm, td, q, qd)[0],
-            lambda: ref.spring_damper_force(qp, vp)[0][perm],
+            lambda: ref.spring_damper_force(q, qd)[0],
         ),
         "damper_force": (
             lambda: forces.spring_damper_force(tm, td, q, qd)[1],
-            lambda: ref.spring_damper_force(qp, vp)[1][perm],
+            lambda: ref.spring_damper_force(q, qd)[1],
         ),
-        "forward_dynamics": (tb_forward, lambda: ref.forward_dynamics(qp, vp)[perm]),
+        "forward_dynamics": (tb_forward, lambda: ref.forward_dynamics(q, qd)),
         "kinetic_energy": (
             lambda: forces.kinetic_energy(tm, td, q, qd),
-            lambda: ref.kinetic_energy(qp, vp),
+            lambda: ref.kinetic_energy(q, qd),
         ),
         "potential_energy": (
             lambda: forces.gravity_potential(tm, td, q) + forces.spring_potential(tm, td, q),
-            lambda: ref.gravity_potential(qp) + ref.spring_potential(qp),
+            lambda: ref.gravity_potential(q) + ref.spring_potential(q),
         ),
     }
 

@@ -60,7 +60,7 @@ def test_rt70_mass_matrix_spd_and_equal_to_crba():
         A = dynamics.mass_matrix(tm, td, q)
         assert np.array_equal(A, A.T) or np.abs(A - A.T).max() <= 1e-15 * np.abs(A).max()
         assert np.linalg.eigvalsh(A).min() > 0.0
-        A_ref = ref.mass_matrix(scene.to_reference(q))[np.ix_(scene.perm, scene.perm)]
+        A_ref = ref.mass_matrix(q)
         assert np.abs(A - A_ref).max() <= TOL * np.abs(A_ref).max()
 
 
@@ -70,7 +70,7 @@ def test_energies_match_pinocchio(name):
     tm, td, ref = scene.textbook, scene.textbook_data, scene.reference
     rng = np.random.default_rng(9)
     q, qd = rng.uniform(-0.5, 0.5, tm.nv), rng.uniform(-1, 1, tm.nv)
-    qp, vp = scene.to_reference(q), scene.to_reference(qd)
+    qp, vp = q, qd
     T = forces.kinetic_energy(tm, td, q, qd)
     assert T > 0.0
     assert abs(T - ref.kinetic_energy(qp, vp)) <= 1e-12 * T

@@ -59,6 +59,9 @@ FAMILIES = {
 def assert_agrees(text: str, label: str, seed: int, samples: int = 2) -> None:
     """Cross-check one generated scene; the message names the scene, seed and quantities."""
     scene = scene_from_text(text, label)
+    # one coordinate order for the user: the textbook derives it, the file fixes it
+    assert scene.textbook.coordinate_names == scene.coordinate_names, label
+    assert scene.reference.coordinate_names == scene.coordinate_names, label
     records = cross_check(scene, samples=samples, seed=seed, repeat=1)
     assert [r.quantity for r in records] == list(QUANTITIES)
     bad = [

@@ -17,6 +17,7 @@ from rt70.urdf.description import (
     OpticalPoint,
     RobotDescription,
 )
+from rt70.urdf.coordinates import coordinate_names
 from rt70.urdf.reader import RT70_NS, read_urdf, read_urdf_string
 
 __all__ = [
@@ -30,6 +31,7 @@ __all__ = [
     "Mimic",
     "OpticalPoint",
     "RobotDescription",
+    "coordinate_names",
     "read_urdf",
     "read_urdf_string",
 ]
