@@ -6,6 +6,7 @@ for the dynamics and takes only the rt70 extension elements (springs, gravity, o
 points) from here. Nothing in this package imports Pinocchio.
 """
 
+from rt70.urdf.coordinates import coordinate_names
 from rt70.urdf.description import (
     Bushing,
     FrameRef,
@@ -17,7 +18,6 @@ from rt70.urdf.description import (
     OpticalPoint,
     RobotDescription,
 )
-from rt70.urdf.coordinates import coordinate_names
 from rt70.urdf.reader import RT70_NS, read_urdf, read_urdf_string
 
 __all__ = [
