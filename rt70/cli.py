@@ -17,10 +17,12 @@ from rt70.errors import Rt70Error
 
 def _validate(args: argparse.Namespace) -> int:
     from rt70.robots import UNEXPECTED, survey
-    from rt70.scene import load_scene, scene_names
+    from rt70.scene import URDF_DIR, load_scene, require_coordinates, scene_names
     from rt70.validate import cross_check, format_table
 
     targets = args.targets or scene_names()
+    if not targets:
+        raise Rt70Error(f"no target to check: no scene files in {URDF_DIR}")
     scenes, not_loaded = [], {}
     for t in targets:  # read everything first: bad input exits 2
         if t == "robots" or t.startswith("robot:"):  # example-robot-data (rt70.robots)
@@ -29,7 +31,15 @@ def _validate(args: argparse.Namespace) -> int:
             not_loaded.update(failed)
         else:
             scenes.append(load_scene(t))
+    bug = any(reason.startswith(UNEXPECTED) for reason in not_loaded.values())
+    if not scenes:  # every robot asked for failed to load: nothing was checked
+        reasons = "; ".join(f"{name}: {why}" for name, why in not_loaded.items())
+        if bug:
+            print(f"rt70: no target could be checked, a bug in rt70: {reasons}", file=sys.stderr)
+            return 1
+        raise Rt70Error(f"no target could be checked ({reasons})")
     for scene in scenes:
+        require_coordinates(scene)
         scene.reference  # noqa: B018  (Pinocchio must load it too)
     records = [r for scene in scenes for r in cross_check(scene, args.samples, args.seed)]
     if args.json:
@@ -42,7 +52,6 @@ def _validate(args: argparse.Namespace) -> int:
         )
     for name, reason in not_loaded.items():  # reported, not an error by itself
         print(f"not loaded: {name}: {reason}", file=sys.stderr if args.json else sys.stdout)
-    bug = any(reason.startswith(UNEXPECTED) for reason in not_loaded.values())
     return 0 if all(r.passed(args.tolerance) for r in records) and not bug else 1
 
 

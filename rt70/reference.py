@@ -376,6 +376,24 @@ class ReferenceModel:
         qp, _, _, _ = self.to_pinocchio(q)
         return float(pin.computePotentialEnergy(self.model, self.data, qp))
 
+    def weight_moment(self, q: np.ndarray) -> float:
+        """``G₀ = Σ_b m_b |g| |c_b|``: the moment of the weights about the ground origin.
+
+        ``c_b`` is body b's centre of mass in the ground frame (Pinocchio's joint
+        placements ``oMi`` and inertia levers). It is the size of the terms that gravity
+        torques and the gravity potential are sums and differences of (the natural
+        scale of :func:`rt70.validate.natural_scales`), in N·m = J.
+        """
+        qp, _, _, _ = self.to_pinocchio(q)
+        pin.forwardKinematics(self.model, self.data, qp)
+        g = float(np.linalg.norm(self.model.gravity.linear))
+        total = 0.0
+        for i in range(1, self.model.njoints):
+            inertia = self.model.inertias[i]
+            com = self.data.oMi[i].act(inertia.lever)
+            total += inertia.mass * g * float(np.linalg.norm(com))
+        return total
+
     def spring_potential(self, q: np.ndarray) -> float:
         """``Σ ½ δᵀ C δ`` with δ from Pinocchio's frame placements."""
         qp, _, _, _ = self.to_pinocchio(q)

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from rt70.errors import Rt70Error, SceneError
-from rt70.scene import Scene, load_scene
+from rt70.scene import Scene, load_scene, require_coordinates
 from rt70.textbook import dynamics
 
 #: Distribution that ships the robots.
@@ -207,6 +207,7 @@ def _try_both_sides(scene: Scene, rng: np.random.Generator) -> None:
     coordinate that moves no mass) makes the robot unusable for the cross-check.
     """
     model, data, ref = scene.textbook, scene.textbook_data, scene.reference
+    require_coordinates(scene)
     _check_coordinates(scene)
     q, qd = rng.uniform(-0.5, 0.5, model.nv), rng.uniform(-1.0, 1.0, model.nv)
     A = dynamics.mass_matrix(model, data, q)

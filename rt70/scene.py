@@ -13,8 +13,23 @@ from rt70.textbook.model import Model, build_model
 from rt70.urdf import RobotDescription, coordinate_names, read_urdf_string
 from rt70.urdf.reader import read_source
 
-#: Directory of the project's scenes (``urdf/`` beside the package; ``RT70_URDF_DIR`` overrides).
-URDF_DIR = Path(os.environ.get("RT70_URDF_DIR", Path(__file__).resolve().parents[1] / "urdf"))
+
+def _scene_dir() -> Path:
+    """Where the project's scenes are: ``RT70_URDF_DIR``, the installed package, or urdf/.
+
+    A normal install ships the files of the repository's ``urdf/`` as package data
+    ``rt70/scene_files/`` (pyproject.toml); in a source tree or an editable install they
+    are read from ``urdf/`` beside the package.
+    """
+    override = os.environ.get("RT70_URDF_DIR")
+    if override:
+        return Path(override)
+    installed = Path(__file__).resolve().parent / "scene_files"
+    return installed if installed.is_dir() else Path(__file__).resolve().parents[1] / "urdf"
+
+
+#: Directory of the project's scenes (see :func:`_scene_dir`).
+URDF_DIR = _scene_dir()
 
 
 def scene_names() -> list[str]:
@@ -36,9 +51,9 @@ def scene_path(target: str | Path) -> Path:
     path = Path(target)
     if path.suffix == ".urdf" or path.is_file():
         return path
-    raise SceneError(
-        f"{target}: no such scene (known: {', '.join(scene_names())}) and no such file"
-    )
+    known = scene_names()
+    where = f"known: {', '.join(known)}" if known else f"no scene files in {URDF_DIR}"
+    raise SceneError(f"{target}: no such scene ({where}) and no such file")
 
 
 @dataclass
@@ -91,3 +106,17 @@ def scene_from_text(text: str, name: str = "<string>") -> Scene:
     """Build a scene from URDF text (generated models, tests); ``name`` labels messages."""
     desc = read_urdf_string(text, source=name)
     return Scene(name, Path(name), text, desc)
+
+
+def require_coordinates(scene: Scene) -> None:
+    """Refuse a scene with no generalised coordinate: there would be nothing to check.
+
+    Raises
+    ------
+    SceneError
+        If every joint of the scene is fixed (or it has none).
+    """
+    if scene.textbook.nv == 0:
+        raise SceneError(
+            f"{scene.path}: the model has no degree of freedom (no moving joint): nothing to check"
+        )

@@ -8,13 +8,15 @@ each side.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from rt70.scene import Scene
+from rt70.errors import Rt70Error
+from rt70.scene import Scene, require_coordinates
 from rt70.textbook import dynamics, forces
 
 #: Default agreement tolerance, relative to the reference's max-norm.
@@ -35,7 +37,12 @@ QUANTITIES = (
 
 @dataclass(frozen=True)
 class Record:
-    """One row of the cross-check report."""
+    """One row of the cross-check report.
+
+    ``nonfinite`` names the side(s) on which the quantity was NaN or infinite in some
+    sample (empty when every value was finite); such a row has infinite errors and
+    never passes.
+    """
 
     target: str
     nv: int
@@ -44,14 +51,23 @@ class Record:
     max_rel_err: float
     t_textbook_s: float
     t_reference_s: float
+    nonfinite: str = ""
 
     def passed(self, tolerance: float = DEFAULT_TOLERANCE) -> bool:
-        """Whether the relative error is within ``tolerance``."""
-        return bool(self.max_rel_err <= tolerance)
+        """Whether every value was finite and the relative error is within ``tolerance``."""
+        return (
+            not self.nonfinite
+            and math.isfinite(self.max_rel_err)
+            and (self.max_rel_err <= tolerance)
+        )
 
     def as_dict(self) -> dict:
-        """The record as a JSON-ready dict."""
-        return asdict(self)
+        """The record as a JSON-ready dict (infinite errors as the string ``"inf"``)."""
+        out = asdict(self)
+        for key in ("max_abs_err", "max_rel_err"):
+            if not math.isfinite(out[key]):
+                out[key] = str(out[key])
+        return out
 
 
 def random_state(nv: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -114,48 +130,96 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     }
 
 
-#: Quantities that are generalised forces (see :func:`_force_floor`).
-_FORCES = ("bias", "gravity", "spring_force", "damper_force")
+#: Every value is measured against at least this fraction of its natural scale.
+FLOOR = 1e-6
+
+#: Mass matrices whose condition number passes this leave q̈ undetermined in doubles.
+MAX_CONDITION = 1e14
 
 
-#: Forces below this fraction of the state's force scale are measured against it.
-FORCE_FLOOR = 1e-6
+def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) -> dict:
+    """The size of the terms each compared quantity is computed from, at this state.
 
+    A quantity that nearly cancels (the velocity-product force of joints that barely
+    couple, the gravity torque of a wheel whose centre of mass is on its axis, the
+    accelerations of a balanced robot) carries the rounding error of its terms, about
+    ε times their size, so its error relative to its own tiny value means nothing. Each
+    quantity is therefore measured against ``max(own max-norm, FLOOR · scale)``; with a
+    tolerance of 10⁻¹⁰ any error above 10⁻¹⁶ of the scale — anything beyond rounding —
+    still fails. The scales (max-norms of Pinocchio's values):
 
-def _force_floor(values: dict, qd: np.ndarray) -> dict[str, float]:
-    """Smallest scale each force is measured against: ``FORCE_FLOOR · F₀``.
+    - forces (bias, gravity, springs, dampers): ``F₀ = ‖A‖ (1 + ‖q̇‖²) + ‖Q_g‖ + ‖Q_c‖
+      + ‖Q_d‖ + G₀``, the size of the terms of the equations of motion. ``G₀ = Σ_b m_b
+      |g| |c_b|`` is the moment of the weights about the ground origin (``c_b`` the
+      bodies' centres of mass): gravity torques are differences of such moments;
+    - q̈: ``F₀ ‖A⁻¹‖₂ = F₀ / λ_min(A)``, how far a rounding of the forces moves q̈;
+    - the mass matrix: its own norm (positive definite, nothing cancels);
+    - energies: ``E₀ = ‖A‖ ‖q̇‖² + G₀ + U_c``, the size of the kinetic energy's terms,
+      of the gravity potential's terms ``m_b g·c_b`` and of the spring energy.
 
-    ``F₀ = ‖A‖ (1 + ‖q̇‖²) + ‖Q_g‖ + ‖Q_c‖ + ‖Q_d‖`` (max-norms, Pinocchio's values) is the
-    size of the terms of the equations of motion at this state. A force that nearly
-    cancels (the velocity-product force of joints that barely couple, say) carries the
-    rounding error of its terms, about ε F₀, so its error relative to its own tiny value
-    means nothing. Forces above ``10⁻⁶ F₀`` keep their own norm as the scale; smaller
-    ones are measured against ``10⁻⁶ F₀`` — a 10⁻¹⁰ tolerance then still fails any
-    error above ``10⁻¹⁶ F₀``, that is anything beyond rounding.
+    Raises
+    ------
+    Rt70Error
+        If Pinocchio's mass matrix at this state is singular or has a condition number
+        above :data:`MAX_CONDITION` (q̈ is then not determined in double precision).
     """
 
     def norm(name: str) -> float:
         x = values[name][1]
         return float(np.max(np.abs(x))) if x.size else 0.0
 
-    f0 = norm("mass_matrix") * (1.0 + float(np.max(np.abs(qd), initial=0.0)) ** 2)
+    A = values["mass_matrix"][1]
+    eig = np.linalg.eigvalsh(A) if A.size else np.ones(1)
+    if not (eig[0] > 0.0 and eig[-1] <= MAX_CONDITION * eig[0]):
+        raise Rt70Error(
+            f"{scene.path}: the mass matrix is singular at a sampled state (eigenvalues "
+            f"{eig[0]:.3g} … {eig[-1]:.3g}): the forward dynamics is not determined"
+        )
+    speed2 = float(np.max(np.abs(qd), initial=0.0)) ** 2
+    g0 = scene.reference.weight_moment(q)
+    f0 = norm("mass_matrix") * (1.0 + speed2) + g0
     f0 += norm("gravity") + norm("spring_force") + norm("damper_force")
-    return dict.fromkeys(_FORCES, FORCE_FLOOR * f0)
+    e0 = norm("mass_matrix") * speed2 + g0 + scene.reference.spring_potential(q)
+    forces = dict.fromkeys(("bias", "gravity", "spring_force", "damper_force"), f0)
+    return {
+        "mass_matrix": norm("mass_matrix"),
+        **forces,
+        "forward_dynamics": f0 / float(eig[0]),
+        "kinetic_energy": e0,
+        "potential_energy": e0,
+    }
+
+
+def _nonfinite(x: np.ndarray) -> bool:
+    return bool(x.size) and not bool(np.all(np.isfinite(x)))
 
 
 def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3) -> list[Record]:
     """Compare every quantity of :data:`QUANTITIES` on ``samples`` random states.
 
-    The relative error is the max-norm of the difference over the max-norm of
-    Pinocchio's value (for forces, at least the floor of :func:`_force_floor`).
-    Each evaluation is timed as the mean of ``repeat`` calls after a warm-up call.
+    The relative error is the max-norm of the difference over the larger of the
+    max-norm of Pinocchio's value and ``FLOOR`` times the quantity's natural scale at
+    the state (:func:`natural_scales`). A NaN or infinite value on either side makes
+    the row's errors infinite and names the side in :attr:`Record.nonfinite`: such a
+    row never passes. Each evaluation is timed as the mean of ``repeat`` calls after a
+    warm-up call.
+
+    Raises
+    ------
+    Rt70Error
+        If the scene has no degree of freedom, ``samples`` < 1, or the mass matrix is
+        numerically singular at a sampled state.
     """
+    require_coordinates(scene)
+    if samples < 1:
+        raise Rt70Error(f"samples must be at least 1, got {samples}")
     rng = np.random.default_rng(seed)
     nv = scene.textbook.nv
     abs_err = dict.fromkeys(QUANTITIES, 0.0)
     rel_err = dict.fromkeys(QUANTITIES, 0.0)
     t_tb = dict.fromkeys(QUANTITIES, 0.0)
     t_ref = dict.fromkeys(QUANTITIES, 0.0)
+    bad: dict[str, set[str]] = {name: set() for name in QUANTITIES}
     for _ in range(samples):
         q, qd = random_state(nv, rng)
         values = {}
@@ -165,14 +229,32 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
             values[name] = np.asarray(x_tb, dtype=float), np.asarray(x_ref, dtype=float)
             t_tb[name] += dt_tb / samples
             t_ref[name] += dt_ref / samples
-        floor = _force_floor(values, qd)
+            for side, x in zip(("textbook", "pinocchio"), values[name], strict=True):
+                if _nonfinite(x):
+                    bad[name].add(side)
+        if any(bad[name] for name in QUANTITIES):  # no scale from non-finite values
+            scales = dict.fromkeys(QUANTITIES, 0.0)
+        else:
+            scales = natural_scales(scene, values, q, qd)
         for name, (x_tb, x_ref) in values.items():
+            if bad[name]:
+                abs_err[name] = rel_err[name] = math.inf
+                continue
             err = float(np.max(np.abs(x_tb - x_ref))) if x_ref.size else 0.0
-            scale = float(np.max(np.abs(x_ref))) if x_ref.size else 0.0
+            own = float(np.max(np.abs(x_ref))) if x_ref.size else 0.0
             abs_err[name] = max(abs_err[name], err)
-            rel_err[name] = max(rel_err[name], _relative(err, max(scale, floor.get(name, 0.0))))
+            rel_err[name] = max(rel_err[name], _relative(err, max(own, FLOOR * scales[name])))
     return [
-        Record(scene.name, nv, name, abs_err[name], rel_err[name], t_tb[name], t_ref[name])
+        Record(
+            scene.name,
+            nv,
+            name,
+            abs_err[name],
+            rel_err[name],
+            t_tb[name],
+            t_ref[name],
+            " and ".join(sorted(bad[name])),
+        )
         for name in QUANTITIES
     ]
 
@@ -190,5 +272,6 @@ def format_table(records: Iterable[Record], tolerance: float = DEFAULT_TOLERANCE
             f"{r.target:<26} {r.nv:>4} {r.quantity:<17} {r.max_abs_err:>11.2e} "
             f"{r.max_rel_err:>11.2e} {r.t_textbook_s * 1e6:>12.1f} {r.t_reference_s * 1e6:>12.1f} "
             f"{ratio:>7.1f}  {'yes' if r.passed(tolerance) else 'NO'}"
+            + (f"  (NaN/inf on the {r.nonfinite} side)" if r.nonfinite else "")
         )
     return "\n".join(lines)

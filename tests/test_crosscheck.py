@@ -120,9 +120,11 @@ def test_cli_validate_json(capsys):
         "max_rel_err",
         "t_textbook_s",
         "t_reference_s",
+        "nonfinite",
     }
     for r in records:
         assert set(r) == keys
+        assert r["nonfinite"] == ""
         assert r["target"] == "rt70" and r["nv"] == 42
         assert r["max_rel_err"] <= TOL
 

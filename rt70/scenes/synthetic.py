@@ -486,7 +486,9 @@ def random_tree(
     - the tree: body ``b<k>`` (joint ``j<k>``) hangs on a parent uniform among
       ``world`` and the bodies ``b1 … b<k-1>``;
     - each joint's type, uniform over the entries of ``joint_types``; a ``floating``
-      joint's body always has mass;
+      joint's body always has mass; if every drawn joint is ``fixed``, the first body's
+      joint becomes the first moving type of ``joint_types`` (new origin and axis), so
+      the tree has a degree of freedom to check;
     - joint origins (xyz within ±0.6 m, rpy uniform in ±π); axes of 1-DOF joints: with
       probability 0.3 exactly ±x, ±y or ±z, else a uniformly random unit vector; planar
       joints always ``0 0 1`` (see the module docstring: Pinocchio ignores the planar
@@ -544,6 +546,10 @@ def random_tree(
         _random_joint_geometry(rng, body)
         body.inertial = _random_inertial(rng)
         bodies.append(body)
+    moving = [t for t in types if t != "fixed"]
+    if moving and all(b.jtype == "fixed" for b in bodies):  # a model that moves at all
+        bodies[0].jtype = moving[0]
+        _random_joint_geometry(rng, bodies[0])
 
     # Massless links: non-leaf, fixed or 1-DOF joint, and a massive "witness" child on a
     # fixed joint or on a 1-DOF joint at least 30° off the link's own axis.

@@ -1,0 +1,69 @@
+"""A normal install works from any directory (issue 8, item 1).
+
+The wheel is built from this tree, installed into a fresh virtual environment (no
+editable install, no source tree on the path) and ``rt70 validate`` is run from a
+temporary directory: the scenes must ship with the package. About a minute: the
+fresh environment installs rt70's dependencies from the package index.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_package_is_listed_in_pyproject():
+    """pyproject.toml lists the packages explicitly (to map urdf/ in): keep it complete."""
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    listed = set(config["tool"]["setuptools"]["packages"])
+    found = {
+        ".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "rt70").rglob("__init__.py")
+    }
+    assert found | {"rt70.scene_files"} == listed
+    assert config["tool"]["setuptools"]["package-dir"]["rt70.scene_files"] == "urdf"
+
+
+def _run(cmd: list[str], cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess:
+    proc = subprocess.run(
+        cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, check=False
+    )
+    assert proc.returncode == 0, f"{' '.join(cmd)}\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}"
+    return proc
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> Path:
+    """``bin/`` of a fresh venv with the wheel of this tree installed."""
+    tmp = tmp_path_factory.mktemp("wheel")
+    pip = [sys.executable, "-m", "pip"]
+    _run([*pip, "wheel", "-q", "--no-deps", "-w", str(tmp / "dist"), str(ROOT)], tmp)
+    wheels = list((tmp / "dist").glob("rt70-*.whl"))
+    assert len(wheels) == 1
+    _run([sys.executable, "-m", "venv", str(tmp / "venv")], tmp)
+    _run([str(tmp / "venv/bin/pip"), "install", "-q", str(wheels[0])], tmp)
+    return tmp / "venv" / "bin"
+
+
+def test_installed_wheel_validates_from_any_directory(installed, tmp_path):
+    proc = _run([str(installed / "rt70"), "validate", "--samples", "1"], tmp_path)
+    assert "7 target(s)" in proc.stdout
+    scenes = {line.split()[0] for line in proc.stdout.splitlines()[2:] if line.strip()}
+    assert {"rt70", "rt70_elevation", "double_pendulum"} <= scenes
+    proc = _run([str(installed / "rt70"), "validate", "rt70", "--samples", "1"], tmp_path)
+    assert "1 target(s)" in proc.stdout
+    proc = _run([str(installed / "rt70"), "modes", "rt70_elevation"], tmp_path)
+    assert "3.2700" in proc.stdout
+
+
+def test_installed_package_is_not_the_source_tree(installed, tmp_path):
+    code = "import rt70.scene as s; print(s.__file__); print(s.URDF_DIR)"
+    proc = _run([str(installed / "python"), "-c", code], tmp_path)
+    module, scenes = proc.stdout.split()
+    assert not module.startswith(str(ROOT)) and not scenes.startswith(str(ROOT))
+    assert scenes.endswith("scene_files")
