@@ -376,6 +376,30 @@ class ReferenceModel:
         qp, _, _, _ = self.to_pinocchio(q)
         return float(pin.computePotentialEnergy(self.model, self.data, qp))
 
+    def spring_damper_magnitudes(
+        self, q: np.ndarray, qd: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Sizes of the terms of the spring and damper forces: ``Σ_e |J_e|ᵀ |C_e δ_e|``.
+
+        The same sums as :meth:`spring_damper_force` with every term taken by its
+        absolute value (joint springs ``|k q|``, bushings ``|∂δ/∂q|ᵀ |C δ|`` and
+        ``|∂δ/∂q|ᵀ |D δ̇|``): forces of elements that oppose each other cancel in the
+        sum but not here. The natural scale of :func:`rt70.validate.natural_scales`.
+        """
+        qp, vp, J, _ = self.to_pinocchio(q, qd)
+        nv = self.model.nv
+        Sc, Sd = np.zeros(nv), np.zeros(nv)
+        if self.spring_v.size:
+            angles = self._joint_angles(qp)
+            np.add.at(Sc, self.spring_v, np.abs(self.spring_k * angles[self.spring_v]))
+            np.add.at(Sd, self.spring_v, np.abs(self.spring_d * vp[self.spring_v]))
+        if self.bushings:
+            delta, jac = self.deformations(qp)
+            rate = jac @ vp
+            Sc += np.einsum("bin,bi->n", np.abs(jac), np.abs(self._stiffness * delta))
+            Sd += np.einsum("bin,bi->n", np.abs(jac), np.abs(self._damping * rate))
+        return (Sc, Sd) if J is None else (np.abs(J).T @ Sc, np.abs(J).T @ Sd)
+
     def weight_moment(self, q: np.ndarray) -> float:
         """``G₀ = Σ_b m_b |g| |c_b|``: the moment of the weights about the ground origin.
 

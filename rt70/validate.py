@@ -130,8 +130,11 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     }
 
 
-#: Every value is measured against at least this fraction of its natural scale.
-FLOOR = 1e-6
+#: Every value is measured against at least this fraction of its natural scale: with the
+#: default tolerance 10⁻¹⁰ an error passes against the floor only below 10⁻¹⁴ of the
+#: scale, about 45 ε — the rounding bound γ_n ≈ n ε of a sum of a few tens of rounded
+#: terms (Higham, *Accuracy and Stability of Numerical Algorithms*, §3.1).
+FLOOR = 1e-4
 
 #: Mass matrices whose condition number passes this leave q̈ undetermined in doubles.
 MAX_CONDITION = 1e14
@@ -145,17 +148,21 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
     accelerations of a balanced robot) carries the rounding error of its terms, about
     ε times their size, so its error relative to its own tiny value means nothing. Each
     quantity is therefore measured against ``max(own max-norm, FLOOR · scale)``; with a
-    tolerance of 10⁻¹⁰ any error above 10⁻¹⁶ of the scale — anything beyond rounding —
-    still fails. The scales (max-norms of Pinocchio's values):
+    tolerance of 10⁻¹⁰ any error above 10⁻¹⁴ of the scale (about 45 ε, see
+    :data:`FLOOR`) — anything beyond rounding — still fails. Each scale is the size of that quantity's own terms (max-norms,
+    Pinocchio's values), so a huge spring force does not excuse an error of gravity:
 
-    - forces (bias, gravity, springs, dampers): ``F₀ = ‖A‖ (1 + ‖q̇‖²) + ‖Q_g‖ + ‖Q_c‖
-      + ‖Q_d‖ + G₀``, the size of the terms of the equations of motion. ``G₀ = Σ_b m_b
-      |g| |c_b|`` is the moment of the weights about the ground origin (``c_b`` the
-      bodies' centres of mass): gravity torques are differences of such moments;
-    - q̈: ``F₀ ‖A⁻¹‖₂ = F₀ / λ_min(A)``, how far a rounding of the forces moves q̈;
-    - the mass matrix: its own norm (positive definite, nothing cancels);
-    - energies: ``E₀ = ‖A‖ ‖q̇‖² + G₀ + U_c``, the size of the kinetic energy's terms,
-      of the gravity potential's terms ``m_b g·c_b`` and of the spring energy.
+    - mass matrix: ``‖A‖`` (positive definite, nothing cancels);
+    - bias ``B q̇``: ``‖A‖ ‖q̇‖² + ‖B q̇‖``, the size of the velocity products;
+    - gravity: ``G₀ + ‖Q_g‖`` with ``G₀ = Σ_b m_b |g| |c_b|``, the moment of the
+      weights about the ground origin (``c_b`` the bodies' centres of mass): gravity
+      torques are differences of such moments;
+    - springs, dampers: ``‖Σ_e |J_e|ᵀ |C_e δ_e|‖`` and ``‖Σ_e |J_e|ᵀ |D_e δ̇_e|‖``, the
+      elements' forces before they cancel (``ReferenceModel.spring_damper_magnitudes``);
+    - q̈: ``F₀ ‖A⁻¹‖₂ = F₀ / λ_min(A)`` with ``F₀`` the sum of the four force scales:
+      how far a rounding of the forces moves q̈;
+    - kinetic energy: ``‖A‖ ‖q̇‖²``; potential energy: ``G₀ + U_c`` (the terms
+      ``m_b g·c_b`` and the spring energy).
 
     Raises
     ------
@@ -175,18 +182,22 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
             f"{scene.path}: the mass matrix is singular at a sampled state (eigenvalues "
             f"{eig[0]:.3g} … {eig[-1]:.3g}): the forward dynamics is not determined"
         )
-    speed2 = float(np.max(np.abs(qd), initial=0.0)) ** 2
-    g0 = scene.reference.weight_moment(q)
-    f0 = norm("mass_matrix") * (1.0 + speed2) + g0
-    f0 += norm("gravity") + norm("spring_force") + norm("damper_force")
-    e0 = norm("mass_matrix") * speed2 + g0 + scene.reference.spring_potential(q)
-    forces = dict.fromkeys(("bias", "gravity", "spring_force", "damper_force"), f0)
+    ref = scene.reference
+    inertia = norm("mass_matrix") * float(np.max(np.abs(qd), initial=0.0)) ** 2
+    g0 = ref.weight_moment(q)
+    sc, sd = (float(np.max(x, initial=0.0)) for x in ref.spring_damper_magnitudes(q, qd))
+    forces = {
+        "bias": inertia + norm("bias"),
+        "gravity": g0 + norm("gravity"),
+        "spring_force": sc,
+        "damper_force": sd,
+    }
     return {
         "mass_matrix": norm("mass_matrix"),
         **forces,
-        "forward_dynamics": f0 / float(eig[0]),
-        "kinetic_energy": e0,
-        "potential_energy": e0,
+        "forward_dynamics": sum(forces.values()) / float(eig[0]),
+        "kinetic_energy": inertia,
+        "potential_energy": g0 + ref.spring_potential(q),
     }
 
 

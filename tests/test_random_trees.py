@@ -5,10 +5,10 @@ joint-type family so that a failure says which joint type is at fault, plus larg
 chains, trees and elastic chains. Every quantity of the cross-check must agree to
 ``TOL`` relative to Pinocchio's max-norm.
 
-A force that nearly cancels (the velocity-product force of a tree whose joints
+A quantity that nearly cancels (the velocity-product force of a tree whose joints
 barely couple) carries the rounding error of its terms; ``rt70.validate`` measures
-forces against ``max(‖Q‖, 10⁻⁶ F₀)`` with F₀ the state's force scale
-(``_force_floor``), so every row is held to the same tolerance.
+each quantity against ``max(own norm, FLOOR · scale)`` with the scale the size of its
+terms at the state (``natural_scales``), so every row is held to the same tolerance.
 
 To reproduce a failure: ``rt70 validate`` takes no generated scenes, so in Python::
 
