@@ -149,8 +149,9 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
     ε times their size, so its error relative to its own tiny value means nothing. Each
     quantity is therefore measured against ``max(own max-norm, FLOOR · scale)``; with a
     tolerance of 10⁻¹⁰ any error above 10⁻¹⁴ of the scale (about 45 ε, see
-    :data:`FLOOR`) — anything beyond rounding — still fails. Each scale is the size of that quantity's own terms (max-norms,
-    Pinocchio's values), so a huge spring force does not excuse an error of gravity:
+    :data:`FLOOR`) — anything beyond rounding — still fails. Each scale is the size of
+    that quantity's own terms (max-norms, Pinocchio's values), so a huge spring force
+    does not excuse an error of gravity:
 
     - mass matrix: ``‖A‖`` (positive definite, nothing cancels);
     - bias ``B q̇``: ``‖A‖ ‖q̇‖² + ‖B q̇‖``, the size of the velocity products;
