@@ -8,6 +8,7 @@ data are never changed to make a number match.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,7 +18,7 @@ import scipy.linalg
 
 from rt70.atomic import atomic_write, atomic_write_text
 from rt70.linear import linearize as lin
-from rt70.linear import modal, topology
+from rt70.linear import modal, topology, tree_invariant
 from rt70.scene import Scene, load_scene
 from rt70.scenes import rt70_data
 
@@ -150,6 +151,163 @@ def _azimuth_edits() -> list[Edit]:
     return edits
 
 
+def _rounding_bound(freq_hz: list[float] | np.ndarray, decimals: int = 4) -> float:
+    """First-order bound on the relative error of ``Π(2πf)²`` from printing f to ``decimals``."""
+    f = np.asarray(freq_hz, dtype=float)
+    f = f[f > 0]
+    return float(np.sum(2 * 0.5 * 10.0**-decimals / f))
+
+
+def _single_value_fits(
+    target: float, inertia: np.ndarray, C: np.ndarray
+) -> list[tuple[str, int, float | None]]:
+    """For each single inertia or stiffness, the one value giving the product ``target``.
+
+    With the others fixed, ``ΠC·ΣI/ΠI`` is proportional to ``C_s``, and for ``I_k = x``
+    it is ``ΠC (S + x) / (P x)`` (S, P: sum and product of the other inertias), which is
+    ``target`` at ``x = ΠC·S / (target·P − ΠC)`` — no positive x when ``target·P ≤ ΠC``.
+    Returns ``(kind, index, value or None)`` with kind ``"I"`` or ``"C"``.
+    """
+    now = tree_invariant.free_tree_omega2_product(inertia, C)
+    fits: list[tuple[str, int, float | None]] = []
+    for k in range(len(inertia)):
+        others = np.delete(inertia, k)
+        pc, rest_sum, rest_prod = np.prod(C), others.sum(), np.prod(others)
+        den = target * rest_prod - pc
+        fits.append(("I", k, float(pc * rest_sum / den) if den > 0 else None))
+    fits += [("C", s, float(C[s] * target / now)) for s in range(len(C))]
+    return fits
+
+
+def _invariant_text(
+    printed: np.ndarray,
+    spectrum: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    dev: Callable[[np.ndarray], float],
+) -> tuple[str, dict]:
+    """The sub-section proving what the search above could only sample (issue 8)."""
+    d = rt70_data
+    names = [n["name"] for n in d.AZIMUTH_NODES]
+    cols = {
+        key: (
+            np.array([n[f"I_el{key}"] for n in d.AZIMUTH_NODES]),
+            np.array([c[f"C_el{key}"] for c in d.AZIMUTH_LINKS]),
+        )
+        for key in topology.AZIMUTH_ELEVATIONS
+    }
+    p_printed = tree_invariant.printed_omega2_product(printed)
+    bound = _rounding_bound(printed)
+    invariants = {}
+    rows = [["printed spectrum, Π(2πf)² over its six non-zero f", f"{p_printed:.5e}", "1"]]
+    for label, i_key, c_key in (
+        ("Tables 2.1–2.2, 0° columns (the printed spectrum's elevation)", "0", "0"),
+        ("Tables 2.1–2.2, 90° columns", "90", "90"),
+        ("inertias 0°, stiffnesses 90°", "0", "90"),
+        ("inertias 90°, stiffnesses 0°", "90", "0"),
+    ):
+        value = tree_invariant.free_tree_omega2_product(cols[i_key][0], cols[c_key][1])
+        invariants[(i_key, c_key)] = value
+        rows.append([label, f"{value:.5e}", f"{p_printed / value:.4g}"])
+    m0 = topology.azimuth_model("0")
+    w = np.sort(scipy.linalg.eigh(m0.C, m0.m, eigvals_only=True))
+    eig_check = abs(float(np.prod(w[1:])) / tree_invariant.model_omega2_product(m0) - 1)
+    ratio0 = p_printed / invariants[("0", "0")]
+    ratio90 = p_printed / invariants[("90", "90")]
+    shortfall = f"{ratio0 - 1:.1%}".replace("-", "−")
+    eig_agrees = "to within 1e-12" if eig_check <= 1e-12 else f"only to {eig_check:.1e}"
+    e_printed = tree_invariant.printed_omega2_product(rt70_data.ELEVATION_SPECTRUM_HZ)
+    e_ratio = e_printed / tree_invariant.model_omega2_product(topology.elevation_model())
+    e_bound = _rounding_bound(rt70_data.ELEVATION_SPECTRUM_HZ)
+
+    inertia, C = cols["0"]
+    fit_rows, fit_devs = [], []
+    for kind, k, value in _single_value_fits(p_printed, inertia, C):
+        link = d.AZIMUTH_LINKS[k]["name"] if kind == "C" else ""
+        what = f"I of {names[k]}" if kind == "I" else f"C of link {k + 1} ({link})"
+        was = inertia[k] if kind == "I" else C[k]
+        if value is None:
+            fit_rows.append([what, f"{was:.4e}", "none (no positive value)", "—"])
+            continue
+        i2, c2 = inertia.copy(), C.copy()
+        (i2 if kind == "I" else c2)[k] = value
+        fit_devs.append(dev(spectrum(i2, c2)))
+        fit_rows.append([what, f"{was:.4e}", f"{value:.4e}", f"{fit_devs[-1]:.1%}"])
+    fit_header = ["value changed", "0° table", "value giving the printed product", "max deviation"]
+    fit_table = _table(fit_header, fit_rows)
+    n_trees = 7 ** (7 - 2)  # Cayley: labelled trees on 7 bodies
+    n_models = n_trees * math.factorial(6)  # a tree and an order of the six stiffnesses
+    text = f"""### A proof instead of a search: the product of the ω² (issue 8)
+
+**Theorem** ([`docs/tree-invariant.md`](../../docs/tree-invariant.md),
+`rt70.linear.tree_invariant`, tested against `eigh` on random trees). For n bodies of
+inertias I_k on one axis joined by n − 1 torsion springs C_s that form a tree with no
+link to the ground (K = Γᵀ diag(C) Γ, Γ one −1 and one +1 per row), the spectrum of
+K v = ω² M v has one zero and
+
+    Π ω² (over the n − 1 non-zero modes) = ΠC · ΣI / ΠI,
+
+whatever the wiring: by Cauchy–Binet the product is ΠC · Σ_k det(Γ_(k))² I_k / ΠI, and
+every Γ_(k) (Γ without column k) of a tree has determinant ±1 — the weighted
+matrix-tree theorem (Kirchhoff). The book's azimuth model is such a tree (Γα has one −1
+and one +1 per row, six links joining all seven bodies, none to the ground; checked by
+`free_tree_check`), so the theorem applies as printed; were a row scaled by a ratio r_s
+(a gear or lever), C_s would become r_s² C_s. The unit cancels (I and C scale alike).
+
+| | Π ω², s⁻¹² | printed / this |
+|---|---|---|
+{chr(10).join("| " + " | ".join(r) + " |" for r in rows)}
+
+(`eigh` of the 0° model gives the same product {eig_agrees}.) Printing each
+frequency to four decimals moves the printed product by at most ±{bound:.1e} (relative,
+first order). As a control, the elevation model, whose spectrum *is* reproduced, gives
+printed / tables = 1 {"+" if e_ratio >= 1 else "−"} {abs(e_ratio - 1):.1e}, inside its
+rounding bound ±{e_bound:.1e}.
+
+**What it proves.** With the 0° tables the printed spectrum's product is
+{ratio0:.4f} of the tables' ({shortfall}, {abs(ratio0 - 1) / bound:.0f} times the
+rounding). Every model made of the same six stiffnesses and seven inertias has the
+tables' product, so none of them has the printed spectrum: no re-wiring of the springs
+into any tree of the seven bodies ({n_trees} trees, Cayley), no permutation of the
+stiffnesses among the springs (720) or of the inertias among the bodies (5040), and no
+combination of them — {n_models:,} distinct models (a permutation of the inertias is
+itself a re-wiring), ruled out by one number instead of sampled. Six springs among the
+seven bodies that do not form a tree leave them in two parts or more: a second zero
+frequency, which the printed spectrum does not have. So no wiring of the six springs
+between the seven bodies, with any order of the values, gives the printed spectrum; the
+swaps and re-wirings of the search above could never have matched.
+With the 90° tables the printed product is {ratio90:.2e} of the tables' — the printed
+spectrum is not the 90° model under any wiring or permutation either — and mixing the
+columns (inertias of one, stiffnesses of the other) does not give it.
+
+**What it does not rule out**: anything that changes the values or the kind of graph —
+a changed value (a misprinted digit of an inertia or a stiffness), an inertia swapped
+with a stiffness, a missing or an extra body or spring (another n; a loop replaces ΠC by
+the sum over spanning trees), a gear or lever ratio on a link (r_s² C_s), or a
+misprinted frequency (then the printed product itself is off), or a spring to the ground
+(its printed zero would then come from a part left free). And the invariant is only
+necessary: an equal product would not make a model right.
+
+It does settle one changed value of any size: the product fixes the only value each
+inertia or stiffness could take, and with Γα that value still misses the spectrum:
+
+{fit_table}
+
+No single changed value, whatever its size, reproduces the printed spectrum with Γα
+(best {min(fit_devs):.1%}).
+"""
+    numbers = {
+        "printed": p_printed,
+        "tables_0": invariants[("0", "0")],
+        "tables_90": invariants[("90", "90")],
+        "ratio_0": ratio0,
+        "ratio_90": ratio90,
+        "rounding_bound": bound,
+        "elevation_ratio": e_ratio,
+        "elevation_bound": e_bound,
+        "best_single_value": min(fit_devs),
+    }
+    return text, numbers
+
+
 def azimuth_section() -> tuple[str, dict]:
     """The azimuth model (§2.3): what is reproduced and what is not, with the search."""
     printed = np.array(rt70_data.AZIMUTH_SPECTRUM_EL0_HZ)
@@ -179,6 +337,7 @@ def azimuth_section() -> tuple[str, dict]:
     )
     best_rows = [[f"{d:.1%}", label] for d, label in singles[:5]]
     best_rows += [[f"{d:.1%}", label] for d, label in doubles[:3]]
+    proof, invariant = _invariant_text(printed, lambda i, c: spectrum(i, c, G), dev)
     text = f"""## Azimuth model, 7 masses (§2.3, Tables 2.1–2.2, Γα (2.14)) — not reproduced
 
 The printed spectrum (elevation 0°) against `eig(ΓᵀCΓ, I)` of Tables 2.1–2.2 (0° columns)
@@ -201,11 +360,18 @@ frequencies). Best candidates:
 
 {_table(["max deviation", "change"], best_rows)}
 
-So the printed spectrum cannot come from the printed tables by one or two slips of the
-kind tried; the model behind it is not recoverable from the book. This stays an open
+{proof}
+So the printed spectrum cannot come from the printed tables by any re-wiring or swap of
+values (proved), nor by one or two slips of the other kinds tried (searched); the model
+behind it is not recoverable from the book. This stays an open
 finding (rt70-data.md §A).
 """
-    return text, {"max_deviation": dev(f0), "best_single": singles[0], "best_pair": doubles[0]}
+    return text, {
+        "max_deviation": dev(f0),
+        "best_single": singles[0],
+        "best_pair": doubles[0],
+        "invariant": invariant,
+    }
 
 
 def damping_section() -> tuple[str, float]:

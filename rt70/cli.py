@@ -225,7 +225,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     ben.add_argument("--K", type=int, default=1000, help="batch size")
     ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")
-    ben.add_argument("--out", default="validation/results", help="directory for CSV and PNG output")
+    ben.add_argument(
+        "--out",
+        default="rt70-results",
+        help="directory for CSV and PNG output (default: rt70-results in the current "
+        "directory; validation/*.py write the committed validation/results)",
+    )
     ben.set_defaults(func=_bench)
     mod = sub.add_parser(
         "modes",

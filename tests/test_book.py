@@ -1,11 +1,17 @@
 """The book reproduction report is regenerated and states every checked printed number."""
 
+import math
 import re
+from pathlib import Path
 
 import pytest
 
-from rt70.book import reproduce
+from rt70.book import azimuth_section, reproduce
+from rt70.linear import topology
+from rt70.linear.tree_invariant import model_omega2_product, printed_omega2_product
 from rt70.scenes import rt70_data
+
+COMMITTED = Path(__file__).parents[1] / "validation" / "results" / "book.md"
 
 
 @pytest.fixture(scope="module")
@@ -40,3 +46,34 @@ def test_reductions_and_sweep_present(report):
     assert "### azimuth" in report and "### elevation" in report
     assert "| 90° | 0.3045" in report  # lowest frequency at the zenith, axes locked
     assert "not balanced about the elevation axis" in report
+
+
+def test_committed_report_is_what_the_code_generates(report):
+    assert COMMITTED.read_text(encoding="utf-8") == report, (
+        "validation/results/book.md is stale: run python validation/reproduce_book.py"
+    )
+
+
+def test_azimuth_invariant_is_stated_with_tables_and_printed_products(report):
+    section = report.split("### A proof instead of a search")[1].split("## Damping")[0]
+    printed = printed_omega2_product(rt70_data.AZIMUTH_SPECTRUM_EL0_HZ)
+    assert printed == pytest.approx(
+        math.prod((2 * math.pi * f) ** 2 for f in rt70_data.AZIMUTH_SPECTRUM_EL0_HZ[1:])
+    )
+    for key, label in (("0", "0° columns"), ("90", "90° columns")):
+        tables = model_omega2_product(topology.azimuth_model(key))
+        assert f"{label}{' (the printed spectrum' if key == '0' else ''}" in section
+        assert f"| {tables:.5e} | {printed / tables:.4g} |" in section
+    assert f"| {printed:.5e} | 1 |" in section
+    assert "| 0.6745 |" in section  # the printed spectrum is 32.5 % short of the 0° tables
+    for claim in ("no re-wiring", "no permutation", "What it does not rule out", "misprinted"):
+        assert claim in section
+    assert "not recoverable" in report and "open\nfinding" in report  # the search is kept
+
+
+def test_invariant_numbers_and_the_elevation_control():
+    numbers = azimuth_section()[1]["invariant"]
+    assert abs(numbers["ratio_0"] - 1) > 100 * numbers["rounding_bound"]  # far outside rounding
+    assert abs(numbers["ratio_90"] - 1) > 100 * numbers["rounding_bound"]
+    assert abs(numbers["elevation_ratio"] - 1) < numbers["elevation_bound"]  # reproduced one
+    assert numbers["best_single_value"] > 0.1  # no single changed value fits

@@ -73,3 +73,45 @@ def test_light_damping_is_proportional():
         np.testing.assert_array_equal(b.stiffness, a.stiffness)
         np.testing.assert_allclose(b.damping, delta * a.stiffness, rtol=1e-15)
     assert scene.textbook.nv == base.textbook.nv == 42
+
+
+def test_runs_are_timed_with_pinned_threads(quick_rows):
+    from rt70.threads import pools
+
+    assert {r.threads for r in quick_rows} == {1}  # read back from the worker's pools
+    unpinned = {r.threads_unpinned for r in quick_rows}
+    assert len(unpinned) == 1 and "openblas" in unpinned.pop()
+    assert "BLAS/OpenMP threads in the worker: 1 (unpinned: " in wp.format_table(quick_rows)
+    assert pools()  # the parent's pools are left as they were
+
+
+def _fake(problem, method, rtol, status, error, time_s, t_end=2.0):
+    return wp.Row(
+        problem, 42, t_end, method, rtol, 1e-3 * rtol, status, status.startswith("over"),
+        error, time_s, "", 0, 0, 0, 20.0, "", 1e-10, "", 1, "openblas 2",
+    )  # fmt: skip
+
+
+def test_real_time_target_is_judged_on_the_fastest_run_to_the_error():
+    rows = [
+        _fake("rt70", "BDF", 1e-6, "ok", 3e-6, 0.30),  # not accurate enough
+        _fake("rt70", "BDF", 1e-7, "ok", 4e-7, 0.45),
+        _fake("rt70", "Radau", 1e-7, "ok", 5e-7, 0.50),
+        _fake("rt70", "RK45", 1e-3, "over cap", math.nan, math.nan),
+        _fake("chain", "RK45", 1e-3, "ok", 1e-9, 0.001),  # another problem: ignored
+    ]
+    (check,) = wp.check_targets(rows)
+    assert check.target.startswith("rt70 (listing damping, T = 2 s) to state error ≤ 1e-06 in")
+    assert "≤ 0.04 s of integration, i.e. ≥ 50× real time" in check.target
+    assert check.measured.startswith("0.450 s, 4.4× real time (BDF, rtol 1e-07")
+    assert check.met is False and check.line().endswith("— NOT met")
+    fast = [_fake("rt70", "BDF", 1e-7, "ok", 4e-7, 0.039)]
+    assert wp.check_targets(fast)[0].met is True
+    (none,) = wp.check_targets(rows[:1] + rows[3:])
+    assert none.met is False and "no method reached it" in none.measured
+    assert wp.check_targets(rows[-1:])[0].met is None
+    quick = [_fake("rt70", "BDF", 1e-6, "ok", 4e-7, 0.0001, t_end=0.05)]  # 500× but 0.05 s
+    assert wp.check_targets(quick)[0].met is None
+    assert wp.check_targets(quick)[0].line().endswith("under the report's 2 s — not judged")
+    text = wp.format_table(rows)
+    assert check.line() in text and "not measured by this report" in text

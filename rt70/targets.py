@@ -1,0 +1,30 @@
+"""A benchmark target of the issues against the value measured in one run."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class TargetCheck:
+    """One target and what this run measured for it.
+
+    Attributes
+    ----------
+    target : str
+        The target as the issue states it, e.g. ``"per-call ratio ≤ 10 on rt70"``.
+    measured : str
+        The measured value, with what it was measured on.
+    met : bool or None
+        Whether the measurement meets the target; None when the run does not measure
+        it (a quick run, another batch size): then it is ``not judged``.
+    """
+
+    target: str
+    measured: str
+    met: bool | None
+
+    def line(self) -> str:
+        """``target … — measured … — met`` (or ``NOT met``, or ``not judged``)."""
+        verdict = {True: "met", False: "NOT met", None: "not judged"}[self.met]
+        return f"target {self.target} — measured {self.measured} — {verdict}"
