@@ -31,6 +31,7 @@ import pinocchio as pin
 
 from rt70.errors import Rt70Error, Rt70Warning, SingularConfigurationError, UrdfError
 from rt70.urdf.description import FrameRef, RobotDescription
+from rt70.urdf.reader import balanced_text, prepare_text
 
 #: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
 GIMBAL_LOCK_COS = 1e-8
@@ -150,8 +151,11 @@ class ReferenceModel:
 
     @classmethod
     def from_file(cls, desc: RobotDescription, path: str | Path) -> ReferenceModel:
-        """Build from a URDF file already read into ``desc``."""
-        return cls(desc, Path(path).read_text(encoding="utf-8"))
+        """Build from a URDF file already read into ``desc`` (its repairs written in)."""
+        text = Path(path).read_text(encoding="utf-8")
+        if desc.inertia_repairs:  # read the repaired inertias, as the textbook side does
+            text = balanced_text(prepare_text(text, desc.source), desc.inertia_repairs)
+        return cls(desc, text)
 
     @property
     def nv(self) -> int:
