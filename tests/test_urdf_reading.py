@@ -194,6 +194,24 @@ def test_zero_mass_dummy_inertia_merged_like_pinocchio():
     np.testing.assert_allclose(scene.textbook.Theta[1], base + X @ theta @ X.T, atol=1e-15)
 
 
+def test_zero_mass_dummy_merged_before_the_mass_of_its_body():
+    """The body's own link is massless; the dummy is welded on before the link with mass."""
+    text = robot(
+        link("base"),
+        joint("j1", "base", "a", xyz="0 0 0.2"),
+        link("a"),
+        joint("fd", "a", "d", jtype="fixed", xyz="0.1 0 0", rpy="0.3 0 0"),
+        link("d", DUMMY),
+        joint("fb", "a", "b", jtype="fixed", xyz="0.5 0 0"),
+        link("b", inertial()),
+        joint("j2", "b", "c", axis="1 0 0"),
+        link("c", inertial()),
+    )
+    scene, caught = read(text)
+    assert len(caught) == 1 and "link 'd'" in caught[0] and "link 'a'" in caught[0]
+    assert_agrees(scene)
+
+
 def test_zero_mass_dummy_on_a_massless_body_is_refused(tmp_path):
     text = robot(link("base"), *PAIR, joint("j3", "l2", "l3"), link("l3", DUMMY))
     with pytest.raises(InertiaError, match=r"link 'l3': zero mass but non-zero inertia"):
