@@ -6,28 +6,38 @@ Pinocchio) and Pinocchio's recursive algorithms (:mod:`rt70.reference`).
 """
 
 from rt70.errors import (
+    DtdError,
     ExtensionError,
     InertiaError,
     JointTypeError,
+    MagnitudeError,
+    MasslessCoordinateError,
     NonFiniteError,
     Rt70Error,
+    Rt70Warning,
     SceneError,
     SingularConfigurationError,
     TopologyError,
     UrdfError,
+    XacroError,
 )
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "DtdError",
     "ExtensionError",
     "InertiaError",
     "JointTypeError",
+    "MagnitudeError",
+    "MasslessCoordinateError",
     "NonFiniteError",
     "Rt70Error",
+    "Rt70Warning",
     "SceneError",
     "SingularConfigurationError",
     "TopologyError",
     "UrdfError",
+    "XacroError",
     "__version__",
 ]

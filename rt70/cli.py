@@ -1,7 +1,9 @@
 """The ``rt70`` command line.
 
 Exit codes: 0 success, 1 a check disagreed (or a robot failed with an unexpected
-exception, a bug in rt70), 2 bad input (one readable line on stderr). Robots of
+exception, a bug in rt70), 2 bad input (one readable line on stderr). Input that is
+read with a caveat (:class:`~rt70.errors.Rt70Warning`) prints one
+``rt70: warning: ...`` line on stderr each. Robots of
 example-robot-data that rt70 cannot load are listed as ``not loaded: <name>: <reason>``
 lines and are no error by themselves.
 """
@@ -11,8 +13,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 
-from rt70.errors import Rt70Error
+from rt70.errors import Rt70Error, Rt70Warning
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -23,14 +26,16 @@ def _validate(args: argparse.Namespace) -> int:
     targets = args.targets or scene_names()
     if not targets:
         raise Rt70Error(f"no target to check: no scene files in {URDF_DIR}")
+    balance = args.balance_inertia
     scenes, not_loaded = [], {}
     for t in targets:  # read everything first: bad input exits 2
         if t == "robots" or t.startswith("robot:"):  # example-robot-data (rt70.robots)
-            loaded, failed = survey(None if t == "robots" else [t.removeprefix("robot:")])
+            names = None if t == "robots" else [t.removeprefix("robot:")]
+            loaded, failed = survey(names, balance_inertia=balance)
             scenes += loaded
             not_loaded.update(failed)
         else:
-            scenes.append(load_scene(t))
+            scenes.append(load_scene(t, balance_inertia=balance))
     bug = any(reason.startswith(UNEXPECTED) for reason in not_loaded.values())
     if not scenes:  # every robot asked for failed to load: nothing was checked
         reasons = "; ".join(f"{name}: {why}" for name, why in not_loaded.items())
@@ -38,7 +43,8 @@ def _validate(args: argparse.Namespace) -> int:
             print(f"rt70: no target could be checked, a bug in rt70: {reasons}", file=sys.stderr)
             return 1
         raise Rt70Error(f"no target could be checked ({reasons})")
-    for scene in scenes:
+    for scene in scenes:  # build both sides first: a model rt70 refuses exits 2
+        scene.textbook  # noqa: B018
         require_coordinates(scene)
         scene.reference  # noqa: B018  (Pinocchio must load it too)
     records = [r for scene in scenes for r in cross_check(scene, args.samples, args.seed)]
@@ -208,6 +214,13 @@ def build_parser() -> argparse.ArgumentParser:
     val.add_argument("--seed", type=int, default=0, help="random seed")
     val.add_argument("--tolerance", type=float, default=1e-10, help="relative tolerance")
     val.add_argument("--json", action="store_true", help="print the records as JSON")
+    val.add_argument(
+        "--balance-inertia",
+        action="store_true",
+        help="repair rotational inertias of moving links that are not positive definite or "
+        "break the triangle inequality (principal moments set to their mean, as MuJoCo's "
+        "balanceinertia) instead of refusing them; each repair is reported",
+    )
     val.set_defaults(func=_validate)
     ben = sub.add_parser(
         "bench",
@@ -274,11 +287,25 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if getattr(args, "samples", 1) < 1:
         parser.error("--samples must be at least 1")
-    try:
-        return args.func(args)
-    except Rt70Error as exc:
-        print(f"rt70: error: {exc}", file=sys.stderr)
-        return 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", Rt70Warning)
+        warnings.showwarning = _show_warning
+        try:
+            return args.func(args)
+        except Rt70Error as exc:
+            print(f"rt70: error: {exc}", file=sys.stderr)
+            return 2
+
+
+_default_showwarning = warnings.showwarning
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print an :class:`~rt70.errors.Rt70Warning` as one ``rt70: warning:`` line on stderr."""
+    if issubclass(category, Rt70Warning):
+        print(f"rt70: warning: {message}", file=sys.stderr)
+    else:
+        _default_showwarning(message, category, filename, lineno, file, line)
 
 
 if __name__ == "__main__":

@@ -28,8 +28,24 @@ class InertiaError(UrdfError):
     """A body's inertia is physically impossible (mass, definiteness, triangle inequality)."""
 
 
+class MasslessCoordinateError(InertiaError):
+    """A generalised coordinate moves no mass: the mass matrix is singular."""
+
+
 class NonFiniteError(UrdfError):
     """A number in the model is NaN or infinite."""
+
+
+class MagnitudeError(UrdfError):
+    """A number in the model is finite but beyond ``rt70.urdf.reader.MAX_MAGNITUDE``."""
+
+
+class XacroError(UrdfError):
+    """The file is a xacro template (xacro elements or substitutions), not a URDF."""
+
+
+class DtdError(UrdfError):
+    """The file declares DTD entities, which rt70 would expand and Pinocchio would not."""
 
 
 class ExtensionError(UrdfError):
@@ -42,3 +58,11 @@ class SingularConfigurationError(Rt70Error):
 
 class SceneError(Rt70Error):
     """A scene name is unknown."""
+
+
+class Rt70Warning(UserWarning):
+    """Something odd in the input that rt70 reads anyway, as Pinocchio does.
+
+    The message is one line starting with the source file; the command line prints each
+    as ``rt70: warning: <message>``.
+    """

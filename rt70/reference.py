@@ -20,15 +20,20 @@ attachment frames, gravity) comes from rt70's URDF description.
 
 from __future__ import annotations
 
+import os
+import sys
+import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from rt70.errors import Rt70Error, SingularConfigurationError, UrdfError
+from rt70.errors import Rt70Error, Rt70Warning, SingularConfigurationError, UrdfError
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
+from rt70.urdf.reader import balanced_text, prepare_text
 
 #: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
 GIMBAL_LOCK_COS = 1e-8
@@ -68,10 +73,7 @@ class ReferenceModel:
     """
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
-        try:
-            self.model = pin.buildModelFromXML(urdf_text)
-        except (RuntimeError, ValueError) as exc:
-            raise UrdfError(f"{desc.source}: Pinocchio cannot load it: {exc}") from None
+        self.model = _parse_urdf(urdf_text, desc.source)
         self.model.gravity.linear = np.asarray(desc.gravity, dtype=float)
         self.model.armature[:] = 0.0
         self.bushings = [
@@ -163,8 +165,11 @@ class ReferenceModel:
 
     @classmethod
     def from_file(cls, desc: RobotDescription, path: str | Path) -> ReferenceModel:
-        """Build from a URDF file already read into ``desc``."""
-        return cls(desc, Path(path).read_text(encoding="utf-8"))
+        """Build from a URDF file already read into ``desc`` (its repairs written in)."""
+        text = Path(path).read_text(encoding="utf-8")
+        if desc.inertia_repairs:  # read the repaired inertias, as the textbook side does
+            text = balanced_text(prepare_text(text, desc.source), desc.inertia_repairs)
+        return cls(desc, text)
 
     @property
     def nv(self) -> int:
@@ -429,6 +434,42 @@ class ReferenceModel:
             delta, _ = self.deformations(qp, jacobian=False)
             U += 0.5 * float(np.sum(self._stiffness * delta**2))
         return U
+
+
+def _parse_urdf(text: str, source: str) -> pin.Model:
+    """``pin.buildModelFromXML`` with its parser's messages turned into rt70's.
+
+    urdfdom (Pinocchio's parser) prints what it skips or rejects to the process's stderr
+    (``Error: <message>`` and an ``at line N in <file>.cpp`` line) and raises a generic
+    exception. Its stderr is captured: when it fails, its first message (naming the
+    element) is the :class:`~rt70.errors.UrdfError`; when it succeeds, each distinct
+    message is an :class:`~rt70.errors.Rt70Warning` (something was skipped).
+    """
+    sys.stderr.flush()
+    saved = os.dup(2)
+    error = None
+    with tempfile.TemporaryFile() as capture:
+        os.dup2(capture.fileno(), 2)
+        try:
+            model = pin.buildModelFromXML(text)
+        except (RuntimeError, ValueError) as exc:
+            error = exc
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        capture.seek(0)
+        chatter = capture.read().decode("utf-8", errors="replace")
+    messages = []
+    for line in chatter.splitlines():
+        head, _, message = line.strip().partition(":")
+        if head in ("Error", "Warning") and message.strip() and message.strip() not in messages:
+            messages.append(" ".join(message.split()))
+    if error is not None:
+        detail = f"{messages[0]} ({error})" if messages else str(error)
+        raise UrdfError(f"{source}: Pinocchio cannot load it: {detail}") from None
+    for message in messages:
+        warnings.warn(Rt70Warning(f"{source}: Pinocchio's URDF parser: {message}"), stacklevel=3)
+    return model
 
 
 def _skew(x: np.ndarray) -> np.ndarray:

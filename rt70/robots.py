@@ -158,13 +158,14 @@ def robot_path(name: str) -> Path:
     return robots_dir() / ROBOTS[name]
 
 
-def load_robot(name: str) -> Scene:
+def load_robot(name: str, balance_inertia: bool = False) -> Scene:
     """Read robot ``name`` as a :class:`~rt70.scene.Scene` named after the robot.
 
     Only the URDF is read and validated here; the two sides are built on first use
-    (:attr:`Scene.textbook`, :attr:`Scene.reference`).
+    (:attr:`Scene.textbook`, :attr:`Scene.reference`). ``balance_inertia`` is passed to
+    :func:`~rt70.scene.load_scene`.
     """
-    scene = load_scene(robot_path(name))
+    scene = load_scene(robot_path(name), balance_inertia=balance_inertia)
     return Scene(name, scene.path, scene.text, scene.description)
 
 
@@ -220,7 +221,9 @@ def _try_both_sides(scene: Scene, rng: np.random.Generator) -> None:
     dynamics.forward_dynamics(model, data, q, qd, np.zeros(model.nv))
 
 
-def survey(names: list[str] | None = None, seed: int = 0) -> tuple[list[Scene], dict[str, str]]:
+def survey(
+    names: list[str] | None = None, seed: int = 0, balance_inertia: bool = False
+) -> tuple[list[Scene], dict[str, str]]:
     """Try to load each robot (default: all of :data:`ROBOTS`) on both sides.
 
     Returns the scenes that load, in the order of ``names``, and ``{name: reason}``
@@ -230,7 +233,7 @@ def survey(names: list[str] | None = None, seed: int = 0) -> tuple[list[Scene], 
     :class:`CoordinateMismatch` between the sides included — is a bug in rt70,
     recorded with a reason starting with :data:`UNEXPECTED`
     (``"unexpected <Type>: message"``) for the caller to report. ``seed`` seeds the
-    random states.
+    random states; ``balance_inertia`` is passed to :func:`load_robot`.
 
     Raises
     ------
@@ -244,7 +247,7 @@ def survey(names: list[str] | None = None, seed: int = 0) -> tuple[list[Scene], 
     failed: dict[str, str] = {}
     for name in names:
         try:
-            scene = load_robot(name)
+            scene = load_robot(name, balance_inertia)
             _try_both_sides(scene, rng)
         except Rt70Error as exc:
             failed[name] = _reason(exc, paths[name])

@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from rt70.errors import SceneError
+from rt70.errors import Rt70Warning, SceneError
 from rt70.textbook.data import Data
+from rt70.textbook.massless import check_moves_mass
 from rt70.textbook.model import Model, build_model
 from rt70.urdf import RobotDescription, coordinate_names, read_urdf_string
-from rt70.urdf.reader import read_source
+from rt70.urdf.reader import balanced_text, prepare_text, read_source
 
 
 def _scene_dir() -> Path:
@@ -64,6 +67,9 @@ class Scene:
     order, :attr:`coordinate_names` (the file's depth-first order,
     :func:`rt70.urdf.coordinate_names`): ``scene.reference.mass_matrix(q)`` and
     ``dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)`` compare directly.
+    ``text`` is what both sides read: the file's text as normalised by
+    :func:`rt70.urdf.reader.prepare_text`, with the inertias repaired on request written
+    in (:func:`load_scene`).
     """
 
     name: str
@@ -73,8 +79,17 @@ class Scene:
 
     @cached_property
     def textbook(self) -> Model:
-        """The textbook model (:mod:`rt70.textbook`)."""
-        return build_model(self.description)
+        """The textbook model (:mod:`rt70.textbook`).
+
+        Raises
+        ------
+        MasslessCoordinateError
+            If a coordinate, or a combination of coordinates, moves no mass
+            (:mod:`rt70.textbook.massless`).
+        """
+        model = build_model(self.description)
+        check_moves_mass(model, self.description.source)
+        return model
 
     @cached_property
     def textbook_data(self) -> Data:
@@ -94,18 +109,32 @@ class Scene:
         return coordinate_names(self.description)
 
 
-def load_scene(target: str | Path) -> Scene:
-    """Read a scene by name or path (see :func:`scene_path`), validating the URDF."""
+def load_scene(target: str | Path, balance_inertia: bool = False) -> Scene:
+    """Read a scene by name or path (see :func:`scene_path`), validating the URDF.
+
+    With ``balance_inertia`` the impossible rotational inertias of moving links are
+    repaired (:func:`rt70.urdf.reader.balanced_moments`) instead of refused, the same on
+    both sides: the repaired values are written into the text Pinocchio parses.
+    """
     path = scene_path(target)
-    text = read_source(path)
-    desc = read_urdf_string(text, source=str(path))
-    return Scene(path.stem, path, text, desc)
+    return _scene(path.stem, path, read_source(path), str(path), balance_inertia)
 
 
-def scene_from_text(text: str, name: str = "<string>") -> Scene:
+def scene_from_text(text: str, name: str = "<string>", balance_inertia: bool = False) -> Scene:
     """Build a scene from URDF text (generated models, tests); ``name`` labels messages."""
-    desc = read_urdf_string(text, source=name)
-    return Scene(name, Path(name), text, desc)
+    return _scene(name, Path(name), text, name, balance_inertia)
+
+
+def _scene(name: str, path: Path, text: str, source: str, balance_inertia: bool) -> Scene:
+    text = prepare_text(text, source)
+    desc = read_urdf_string(text, source=source, balance_inertia=balance_inertia)
+    if desc.inertia_repairs:  # both sides read the repaired text, warned about once
+        text = balanced_text(text, desc.inertia_repairs)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Rt70Warning)
+            repaired = read_urdf_string(text, source=source)
+        desc = dataclasses.replace(repaired, inertia_repairs=desc.inertia_repairs)
+    return Scene(name, path, text, desc)
 
 
 def require_coordinates(scene: Scene) -> None:

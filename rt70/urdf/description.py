@@ -31,6 +31,23 @@ class Inertial:
 
 
 @dataclass(frozen=True)
+class InertiaRepair:
+    """A rotational inertia repaired on request (``balance_inertia``), for the report.
+
+    Attributes
+    ----------
+    link : str
+        The link whose ``<inertia>`` was replaced.
+    old_moments, new_moments : numpy.ndarray
+        Principal moments before and after, kg·m², shape (3,).
+    """
+
+    link: str
+    old_moments: np.ndarray
+    new_moments: np.ndarray
+
+
+@dataclass(frozen=True)
 class Link:
     """A URDF link: a name and, if it has mass, its inertial."""
 
@@ -145,6 +162,8 @@ class RobotDescription:
         Scalar springs on joint coordinates.
     optical_points : list of OpticalPoint
         Named output points.
+    inertia_repairs : list of InertiaRepair
+        Inertias repaired on request (``balance_inertia``), in document order.
     """
 
     name: str
@@ -156,6 +175,7 @@ class RobotDescription:
     bushings: list[Bushing] = field(default_factory=list)
     joint_springs: list[JointSpring] = field(default_factory=list)
     optical_points: list[OpticalPoint] = field(default_factory=list)
+    inertia_repairs: list[InertiaRepair] = field(default_factory=list)
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

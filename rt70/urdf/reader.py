@@ -6,18 +6,24 @@ starts with the source file, so the command line can print it as one readable li
 
 from __future__ import annotations
 
+import warnings
 import xml.etree.ElementTree as ET
+import xml.parsers.expat
 from pathlib import Path
 
 import numpy as np
 
 from rt70.errors import (
+    DtdError,
     ExtensionError,
     InertiaError,
     JointTypeError,
+    MagnitudeError,
     NonFiniteError,
+    Rt70Warning,
     TopologyError,
     UrdfError,
+    XacroError,
 )
 from rt70.textbook.spatial import rpy_matrix, rpy_of_matrix
 from rt70.urdf.description import (
@@ -25,6 +31,7 @@ from rt70.urdf.description import (
     Bushing,
     FrameRef,
     Inertial,
+    InertiaRepair,
     Joint,
     JointSpring,
     Link,
@@ -42,6 +49,14 @@ SUPPORTED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floati
 #: Joint types with one coordinate (the only ones a ``<mimic>`` or a joint spring may use).
 ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
 
+#: Largest magnitude of any number rt70 reads from a URDF (docs/urdf-reader.md): a product
+#: of ten such numbers stays below the largest double (1.8e308), far more factors than
+#: any term of the equations of motion multiplies, so no evaluation can overflow.
+MAX_MAGNITUDE = 1e30
+
+#: Principal moments are checked to this fraction of the largest one (rounding of eigvalsh).
+INERTIA_RTOL = 1e-9
+
 _EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point")
 _ZERO3 = np.zeros(3)
 
@@ -57,8 +72,19 @@ def read_source(path: str | Path) -> str:
         raise UrdfError(f"{path}: cannot read file ({exc})") from None
 
 
-def read_urdf(path: str | Path) -> RobotDescription:
+def read_urdf(path: str | Path, balance_inertia: bool = False) -> RobotDescription:
     """Read a URDF file into a validated :class:`RobotDescription`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The URDF file.
+    balance_inertia : bool
+        Repair the rotational inertia of moving links that is not positive definite or
+        breaks the triangle inequality, instead of refusing it (see
+        :func:`balanced_moments`); each repair is recorded in
+        ``RobotDescription.inertia_repairs`` and reported as an
+        :class:`~rt70.errors.Rt70Warning`.
 
     Raises
     ------
@@ -66,23 +92,174 @@ def read_urdf(path: str | Path) -> RobotDescription:
         (or a subclass) if the file is missing, malformed, or describes an impossible
         or unsupported model; the message names the file and the offending element.
     """
-    return read_urdf_string(read_source(path), source=str(path))
+    return read_urdf_string(read_source(path), source=str(path), balance_inertia=balance_inertia)
 
 
-def read_urdf_string(text: str, source: str = "<string>") -> RobotDescription:
-    """Read URDF text into a validated :class:`RobotDescription` (see :func:`read_urdf`)."""
+def read_urdf_string(
+    text: str, source: str = "<string>", balance_inertia: bool = False
+) -> RobotDescription:
+    """Read URDF text into a validated :class:`RobotDescription` (see :func:`read_urdf`).
+
+    The text is first normalised by :func:`prepare_text`; DTD entity declarations and
+    xacro templates are refused (:class:`~rt70.errors.DtdError`,
+    :class:`~rt70.errors.XacroError`) before anything else is read.
+    """
+    text = prepare_text(text, source)
+    _refuse_entities(text, source)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
+        if "unbound prefix" in str(exc) and "xacro:" in text:
+            raise XacroError(
+                f"{source}: xacro elements without the xacro namespace ({exc}): {_EXPAND}"
+            ) from None
         raise UrdfError(f"{source}: malformed XML: {exc}") from None
-    return _Reader(source).robot(root)
+    return _Reader(source, balance_inertia).robot(root)
+
+
+def warn(message: str) -> None:
+    """Issue ``message`` as an :class:`~rt70.errors.Rt70Warning` (one line)."""
+    warnings.warn(Rt70Warning(message), stacklevel=2)
+
+
+def prepare_text(text: str, source: str = "<string>") -> str:
+    """The URDF text as both sides read it (Pinocchio is handed this text too).
+
+    A byte-order mark is dropped. Whitespace before the ``<?xml`` declaration (which XML
+    forbids, Pinocchio's TinyXML-based parser skips) and NUL characters after the
+    document (where a C parser stops reading) are removed with an
+    :class:`~rt70.errors.Rt70Warning`. Idempotent.
+
+    Raises
+    ------
+    UrdfError
+        If a NUL character is followed by anything but NULs and whitespace.
+    """
+    text = text.removeprefix("\ufeff")
+    nul = text.find("\x00")
+    if nul >= 0:
+        if text[nul:].strip("\x00 \t\r\n"):
+            line = text.count("\n", 0, nul) + 1
+            raise UrdfError(f"{source}: malformed XML: NUL character in the document, line {line}")
+        text = text[:nul]
+        warn(f"{source}: NUL characters after the document ignored")
+    stripped = text.lstrip()
+    if len(stripped) < len(text) and stripped.startswith("<?xml"):
+        warn(f"{source}: whitespace before the XML declaration '<?xml' ignored")
+        text = stripped
+    return text
+
+
+#: How to turn a xacro template into a URDF.
+_EXPAND = (
+    "this is a xacro template, not a URDF: expand it with xacro first (xacro FILE > FILE.urdf)"
+)
+
+
+def _refuse_entities(text: str, source: str) -> None:
+    """Raise :class:`~rt70.errors.DtdError` if the document declares DTD entities.
+
+    Python's XML parser expands internal entities; Pinocchio's (TinyXML) does not, so
+    the two sides of the cross-check would read different numbers.
+    """
+    if "<!DOCTYPE" not in text:
+        return
+    parser = xml.parsers.expat.ParserCreate()
+    declared: list[str] = []
+
+    def entity(name, is_parameter, *_) -> None:
+        declared.append(("%" if is_parameter else "") + name)
+        raise _EntityFound
+
+    parser.EntityDeclHandler = entity
+    try:
+        parser.Parse(text, True)
+    except (_EntityFound, xml.parsers.expat.ExpatError):
+        pass  # malformed XML is reported by the main parse
+    if declared:
+        raise DtdError(
+            f"{source}: <!ENTITY {declared[0]}> in <!DOCTYPE>: DTD entities are not supported "
+            "(rt70's reader would expand them, Pinocchio's parser does not, so the two sides "
+            "would read different models): expand them first (xmllint --noent --dropdtd FILE)"
+        )
+
+
+class _EntityFound(Exception):
+    """Stops the entity scan at the first declaration."""
+
+
+def principal_moments(tensor: np.ndarray) -> np.ndarray:
+    """Principal moments of a rotational inertia, ascending."""
+    return np.linalg.eigvalsh(tensor)
+
+
+def inertia_defect(tensor: np.ndarray) -> str | None:
+    """Why a non-zero rotational inertia is impossible, or None if it is a rigid body's.
+
+    It must be positive definite and its principal moments must satisfy the triangle
+    inequality ``I₁ + I₂ ≥ I₃`` (to :data:`INERTIA_RTOL` of the largest moment).
+    """
+    moments = principal_moments(tensor)
+    scale = max(float(np.max(np.abs(moments))), np.finfo(float).tiny)
+    if moments[0] <= 0.0:
+        listed = ", ".join(f"{m:.6g}" for m in moments)
+        return f"inertia tensor not positive definite (principal moments {listed})"
+    if moments[2] > moments[0] + moments[1] + INERTIA_RTOL * scale:
+        return (
+            f"principal moment {moments[2]:.6g} exceeds the sum of the other "
+            f"two ({moments[0]:.6g} + {moments[1]:.6g}): triangle inequality violated"
+        )
+    return None
+
+
+def balanced_moments(tensor: np.ndarray) -> np.ndarray | None:
+    """The repair of an impossible rotational inertia: its mean principal moment times 1.
+
+    This is MuJoCo's ``<compiler balanceinertia="true">`` rule ("a valid diagonal inertia
+    matrix must satisfy A+B>=C for all permutations of the three diagonal elements ...
+    the compiler will silently set all three diagonal elements to their average value
+    whenever the above condition is violated", MuJoCo XML reference, compiler/
+    balanceinertia), applied to the principal moments and, in rt70, to every tensor
+    :func:`inertia_defect` refuses (a negative moment always breaks the triangle
+    inequality; a zero one, a rod, is refused by rt70 too). The trace — the sum of the
+    moments, ``2 ∫ |r|² dm`` — is kept; the tensor becomes isotropic, so the frame of
+    ``<inertial><origin rpy>`` no longer matters. Returns None when the trace is not
+    positive (nothing to balance).
+    """
+    mean = float(np.trace(tensor)) / 3.0
+    if not mean > 0.0:
+        return None
+    return np.full(3, mean)
+
+
+def balanced_text(text: str, repairs: list[InertiaRepair]) -> str:
+    """``text`` with each repaired link's ``<inertia>`` replaced by its balanced moments.
+
+    The balanced tensor is isotropic (:func:`balanced_moments`), so it is written as
+    ``ixx = iyy = izz``, products zero, whatever the ``<inertial><origin rpy>``: reading
+    the result gives exactly the repaired description. This is the text handed to
+    Pinocchio, so both sides read the same inertias. Comments and the XML declaration
+    are not kept.
+    """
+    ET.register_namespace("rt70", RT70_NS)
+    root = ET.fromstring(text)
+    links = {elem.get("name"): elem for elem in root.findall("link")}
+    for repair in repairs:
+        inertia = links[repair.link].find("inertial").find("inertia")
+        values = (*repair.new_moments, 0.0, 0.0, 0.0)
+        for key, value in zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), values, strict=True):
+            inertia.set(key, repr(float(value)))
+    return ET.tostring(root, encoding="unicode")
 
 
 class _Reader:
     """One pass over the XML tree, with the source name for messages."""
 
-    def __init__(self, source: str) -> None:
+    def __init__(self, source: str, balance_inertia: bool = False) -> None:
         self.source = source
+        self.balance_inertia = balance_inertia
+        #: per link: what is wrong with its <inertial>, decided once the tree is known
+        self.defects: dict[str, str] = {}
 
     # --- small helpers -------------------------------------------------------------
     def fail(self, cls: type[UrdfError], what: str) -> UrdfError:
@@ -108,6 +285,12 @@ class _Reader:
             )
         if not np.all(np.isfinite(values)):
             raise self.fail(NonFiniteError, f'{tag} {attr}="{raw}">: NaN or infinite value')
+        if np.any(np.abs(values) > MAX_MAGNITUDE):
+            raise self.fail(
+                MagnitudeError,
+                f'{tag} {attr}="{raw}">: magnitude above {MAX_MAGNITUDE:g}, the largest number '
+                "rt70 reads (docs/urdf-reader.md)",
+            )
         return values
 
     def number(
@@ -130,7 +313,24 @@ class _Reader:
         return self.numbers(o, "xyz", 3, _ZERO3, owner), self.numbers(o, "rpy", 3, _ZERO3, owner)
 
     # --- the document --------------------------------------------------------------
+    def refuse_xacro(self, root: ET.Element) -> None:
+        """Raise :class:`~rt70.errors.XacroError` at the first xacro element or substitution.
+
+        A xacro namespace declaration alone is no xacro: expanded files keep it.
+        """
+        for elem in root.iter():
+            if _is_xacro(elem.tag):
+                raise self.fail(XacroError, f"<{_qualified(elem.tag)}>: xacro element: {_EXPAND}")
+            for key, value in elem.attrib.items():
+                if _is_xacro(key) or "${" in value or "$(" in value:
+                    raise self.fail(
+                        XacroError,
+                        f'<{_qualified(elem.tag)} {_qualified(key)}="{value}">: xacro '
+                        f"substitution: {_EXPAND}",
+                    )
+
     def robot(self, root: ET.Element) -> RobotDescription:
+        self.refuse_xacro(root)
         if root.tag != "robot":
             raise self.fail(UrdfError, f"root element is <{root.tag}>, expected <robot>")
         links: dict[str, Link] = {}
@@ -144,6 +344,7 @@ class _Reader:
         joints = [self.joint(elem) for elem in root.findall("joint")]
         root_link = self.check_tree(links, joints)
         self.check_mimics(joints)
+        repairs = self.resolve_inertias(links, joints, root_link)
         desc = RobotDescription(
             name=root.get("name", ""),
             source=self.source,
@@ -151,6 +352,7 @@ class _Reader:
             links=links,
             joints=joints,
             gravity=np.array([0.0, 0.0, -9.81]),
+            inertia_repairs=repairs,
         )
         self.extensions(root, desc)
         return desc
@@ -161,6 +363,11 @@ class _Reader:
         return Link(name, None if inertial is None else self.inertial(name, inertial))
 
     def inertial(self, link: str, elem: ET.Element) -> Inertial | None:
+        """The link's mass properties as written; what is impossible goes to ``defects``.
+
+        Whether an impossible inertia is refused, repaired or ignored depends on where
+        the link is in the tree (:meth:`resolve_inertias`).
+        """
         owner = f"link '{link}' <inertial>"
         xyz, rpy = self.origin(elem, owner)
         mass_elem = elem.find("mass")
@@ -174,31 +381,72 @@ class _Reader:
                 for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
             )
             tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        where = f"link '{link}'"
         if mass < 0.0:
-            raise self.fail(InertiaError, f"{where}: negative mass {mass:g} kg")
-        if mass == 0.0:
-            if np.any(tensor != 0.0):
-                raise self.fail(InertiaError, f"{where}: zero mass but non-zero inertia tensor")
+            self.defects[link] = f"negative mass {mass:g} kg"
             return None
-        if not np.any(tensor):  # a point mass (book §2.1): no rotational inertia at all
-            return Inertial(mass=mass, com=xyz, inertia=np.zeros((3, 3)))
-        moments = np.linalg.eigvalsh(tensor)
-        scale = max(float(np.max(np.abs(moments))), np.finfo(float).tiny)
-        if moments[0] <= 0.0:
-            raise self.fail(
-                InertiaError,
-                f"{where}: inertia tensor not positive definite "
-                f"(principal moments {', '.join(f'{m:.6g}' for m in moments)})",
-            )
-        if moments[2] > moments[0] + moments[1] + 1e-9 * scale:
-            raise self.fail(
-                InertiaError,
-                f"{where}: principal moment {moments[2]:.6g} exceeds the sum of the other "
-                f"two ({moments[0]:.6g} + {moments[1]:.6g}): triangle inequality violated",
-            )
+        if mass == 0.0 and not np.any(tensor):
+            return None
+        if np.any(tensor):  # all zero with mass: a point mass (book §2.1)
+            defect = inertia_defect(tensor)
+            if mass == 0.0:
+                detail = f" ({defect})" if defect else ""
+                defect = "zero mass but non-zero inertia tensor" + detail
+            if defect:
+                self.defects[link] = defect
         rot = rpy_matrix(rpy)
         return Inertial(mass=mass, com=xyz, inertia=rot @ tensor @ rot.T)
+
+    def resolve_inertias(
+        self, links: dict[str, Link], joints: list[Joint], root: str
+    ) -> list[InertiaRepair]:
+        """Refuse, repair, accept or ignore each impossible ``<inertial>`` (in place).
+
+        - On the ground (the root link and links welded to it by fixed joints) an inertia
+          never enters the dynamics: it is ignored with a warning (Pinocchio ignores it too).
+        - A zero-mass link with a non-zero, physically possible tensor welded into a body
+          that has mass adds its rotational inertia to that body, as Pinocchio does; warned.
+        - Otherwise the tensor is refused (:class:`~rt70.errors.InertiaError`) unless
+          ``balance_inertia`` is set and :func:`balanced_moments` can repair it.
+        """
+        if not self.defects:
+            return []
+        body = _rigid_bodies(links, joints, root)
+        body_mass: dict[str, float] = {}
+        for name, link in links.items():
+            if link.inertial is not None:
+                body_mass[body[name]] = body_mass.get(body[name], 0.0) + link.inertial.mass
+        repairs = []
+        for name, defect in self.defects.items():
+            where = f"{self.source}: link '{name}'"
+            inertial = links[name].inertial
+            if body[name] == root:
+                welded = "the root link" if name == root else f"welded to the root link '{root}'"
+                warn(
+                    f"{where}: {defect}: ignored, the link is {welded} (the ground), so its "
+                    "inertia never enters the dynamics"
+                )
+                links[name] = Link(name, None)
+            elif inertial is None:  # negative mass
+                raise self.fail(InertiaError, f"link '{name}': {defect}")
+            elif defect.startswith("zero mass") and "(" not in defect and body_mass[body[name]] > 0:
+                warn(
+                    f"{where}: {defect}: its rotational inertia is added to the rigid body of "
+                    f"link '{body[name]}' it is welded to (as Pinocchio does)"
+                )
+            else:
+                moments = principal_moments(inertial.inertia)
+                balanced = balanced_moments(inertial.inertia) if self.balance_inertia else None
+                if balanced is None or (inertial.mass == 0.0 and body_mass[body[name]] <= 0.0):
+                    raise self.fail(InertiaError, f"link '{name}': {defect}")
+                links[name] = Link(name, Inertial(inertial.mass, inertial.com, np.diag(balanced)))
+                repairs.append(InertiaRepair(name, moments, balanced))
+                why = "not positive definite" if moments[0] <= 0.0 else "triangle inequality"
+                warn(
+                    f"{where}: inertia repaired (balance inertia; {why}): principal moments "
+                    f"{', '.join(f'{m:.6g}' for m in moments)} -> "
+                    f"{', '.join(f'{m:.6g}' for m in balanced)}"
+                )
+        return repairs
 
     def joint(self, elem: ET.Element) -> Joint:
         name = self.name_of(elem)
@@ -421,6 +669,44 @@ class _Reader:
         if not struts:
             raise self.fail(ExtensionError, f"{where} has no <rt70:strut>")
         return struts
+
+
+def _is_xacro(name: str) -> bool:
+    """Whether an element or attribute name is in a xacro namespace (``…/xacro``)."""
+    return name.startswith("{") and name[1 : name.find("}")].rstrip("/").endswith("xacro")
+
+
+def _qualified(name: str) -> str:
+    """``{uri}local`` as ``xacro:local``/``rt70:local`` (other URIs kept), else ``name``."""
+    if not name.startswith("{"):
+        return name
+    uri, local = name[1:].split("}", 1)
+    if _is_xacro(name):
+        return f"xacro:{local}"
+    return f"rt70:{local}" if uri == RT70_NS else name
+
+
+def _rigid_bodies(links: dict[str, Link], joints: list[Joint], root: str) -> dict[str, str]:
+    """The rigid body of every link, named by one of its links.
+
+    That is the link it is welded to by fixed joints that itself moves (the child of a
+    moving joint), or ``root`` for the ground.
+    """
+    parent_joint = {j.child: j for j in joints}
+    body: dict[str, str] = {root: root}
+    for name in links:
+        path = []
+        link = name
+        while link not in body:
+            joint = parent_joint[link]
+            if joint.type != "fixed":
+                body[link] = link
+                break
+            path.append(link)
+            link = joint.parent
+        for welded in path:
+            body[welded] = body[link]
+    return body
 
 
 def _tag(elem: ET.Element) -> str:
