@@ -29,7 +29,7 @@ class InertiaError(UrdfError):
 
 
 class NonFiniteError(UrdfError):
-    """A number in the model is NaN or infinite."""
+    """A number in the model, or a state passed to either side, is NaN or infinite."""
 
 
 class ExtensionError(UrdfError):
@@ -42,3 +42,19 @@ class SingularConfigurationError(Rt70Error):
 
 class SceneError(Rt70Error):
     """A scene name is unknown."""
+
+
+class ShapeError(Rt70Error, ValueError):
+    """An array argument has the wrong shape (a ``ValueError`` too, for existing callers)."""
+
+
+class ResourceError(Rt70Error):
+    """The model is too large for this machine (memory) or for Pinocchio's URDF parser."""
+
+
+class OutputError(Rt70Error):
+    """An output path cannot be written (missing permission, a directory, a bad suffix)."""
+
+
+class SimulationError(Rt70Error):
+    """The equations of motion cannot be integrated from the given model and state."""

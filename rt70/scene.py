@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from rt70.errors import SceneError
+from rt70.resources import check_textbook
 from rt70.textbook.data import Data
 from rt70.textbook.model import Model, build_model
 from rt70.urdf import RobotDescription, read_urdf_string
@@ -63,8 +64,10 @@ class Scene:
 
     @cached_property
     def textbook_data(self) -> Data:
-        """Work buffers for :attr:`textbook`."""
-        return Data(self.textbook)
+        """Work buffers for :attr:`textbook` (refused beyond this machine's memory)."""
+        model = self.textbook
+        check_textbook(model.nb, model.n_full, self.description.source)
+        return Data(model)
 
     @cached_property
     def reference(self):  # -> rt70.reference.ReferenceModel (imported lazily: Pinocchio)
