@@ -1,21 +1,33 @@
 """The ``rt70`` command line.
 
 Exit codes: 0 success, 1 a check disagreed (or a robot failed with an unexpected
-exception, a bug in rt70), 2 bad input (one readable line on stderr). Input that is
-read with a caveat (:class:`~rt70.errors.Rt70Warning`) prints one
-``rt70: warning: ...`` line on stderr each. Robots of
-example-robot-data that rt70 cannot load are listed as ``not loaded: <name>: <reason>``
-lines and are no error by themselves.
+exception, a bug in rt70), 2 bad input (one readable line on stderr), 130 interrupted
+(Ctrl-C), 141 standard output closed early (``rt70 ... | head``: the exit status of a
+process killed by SIGPIPE), 143 stopped by SIGTERM. Input that is read with a caveat
+(:class:`~rt70.errors.Rt70Warning`) prints one ``rt70: warning: ...`` line on stderr
+each. Robots of example-robot-data that rt70 cannot load are listed as
+``not loaded: <name>: <reason>`` lines and are no error by themselves.
+
+Every option is checked before any work starts (:mod:`rt70.options`); SIGTERM becomes a
+normal exit, so outputs being written are cleaned up (:mod:`rt70.atomic`).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import signal
 import sys
 import warnings
 
-from rt70.errors import Rt70Error, Rt70Warning
+from rt70 import options
+from rt70.errors import Rt70Error, Rt70Warning, SingularConfigurationError
+
+#: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
+EXIT_TERMINATED = 128 + signal.SIGTERM
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -100,6 +112,8 @@ def _modes(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     names = scene.textbook.coordinate_names
+    if not names:
+        raise Rt70Error(f"{scene.name}: the model has no degree of freedom: no modes")
     has_axes = lin.AZIMUTH_COORDINATE in names and lin.ELEVATION_COORDINATE in names
     if (args.elevation is not None or args.azimuth is not None) and not has_axes:
         raise Rt70Error(
@@ -109,8 +123,18 @@ def _modes(args: argparse.Namespace) -> int:
     elevation = 90.0 if args.elevation is None else args.elevation
     azimuth = 0.0 if args.azimuth is None else args.azimuth
     held = lin.rt70_pointing(elevation, azimuth) if has_axes else {}
-    q0 = lin.equilibrium(scene, held)
-    model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
+            q0 = lin.equilibrium(scene, held)
+            model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
+    except SingularConfigurationError as exc:  # a state on the way: name the scene
+        raise SingularConfigurationError(f"{scene.name}: {exc}") from None
+    massless = [c for c, m in zip(model.coordinates, np.diag(model.M), strict=True) if not m > 0]
+    if massless:
+        raise Rt70Error(
+            f"{scene.name}: mass matrix is singular: no mass moves with coordinate(s) "
+            f"{', '.join(massless)}"
+        )
     result = modal.modes(model.M, model.K, model.D)
     rows = []
     energy = result.shapes * (model.M @ result.shapes)  # kinetic-energy share per coordinate
@@ -178,22 +202,25 @@ def _simulate(args: argparse.Namespace) -> int:
         + ("  [FLAGGED: more than the tolerance explains]" if result.drift_flagged else "")
     )
     if args.out:
+        from rt70.atomic import atomic_write_all
+
         out = Path(args.out)
-        print(f"  wrote {result.save(out)}")
+        writers = {out: result.writer(out)}
         if not args.no_plot:
-            from rt70.atomic import atomic_write
             from rt70.plots import simulation_figure
 
             fig = simulation_figure(result)
-            png = out.with_suffix(".png")
-            atomic_write(png, lambda tmp: fig.savefig(tmp, dpi=110))
-            print(f"  wrote {png}")
+            writers[out.with_suffix(".png")] = lambda tmp: fig.savefig(tmp, dpi=110)
+        for path in atomic_write_all(writers):  # the trajectory and its plot appear together
+            print(f"  wrote {path}")
     return 0 if result.success else 1
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``rt70`` command."""
-    parser = argparse.ArgumentParser(
+    """The argument parser of the ``rt70`` command (errors: one line, exit 2)."""
+    from rt70.simulate import METHODS
+
+    parser = options.Parser(
         prog="rt70", description="Models of flexible structures, cross-checked against Pinocchio."
     )
     sub = parser.add_subparsers(dest="command", required=True)
@@ -210,9 +237,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="scene name, URDF path, 'robots' (every robot of example-robot-data that "
         "loads) or 'robot:NAME' (default: every scene in urdf/)",
     )
-    val.add_argument("--samples", type=int, default=10, help="random states per target")
-    val.add_argument("--seed", type=int, default=0, help="random seed")
-    val.add_argument("--tolerance", type=float, default=1e-10, help="relative tolerance")
+    val.add_argument(
+        "--samples", type=options.positive_int, default=10, help="random states per target"
+    )
+    val.add_argument("--seed", type=options.seed, default=0, help="random seed (≥ 0)")
+    val.add_argument(
+        "--tolerance", type=options.non_negative_float, default=1e-10, help="relative tolerance"
+    )
     val.add_argument("--json", action="store_true", help="print the records as JSON")
     val.add_argument(
         "--balance-inertia",
@@ -236,7 +267,7 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("mass-matrix", "simulate"),
         help="mass-matrix (default) or simulate (the work-precision report)",
     )
-    ben.add_argument("--K", type=int, default=1000, help="batch size")
+    ben.add_argument("--K", type=options.batch_size, default=1000, help="batch size")
     ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")
     ben.add_argument(
         "--out",
@@ -253,8 +284,14 @@ def build_parser() -> argparse.ArgumentParser:
         "the eigenfrequencies of K v = ω² M v.",
     )
     mod.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
-    mod.add_argument("--elevation", type=float, help="RT-70 elevation, degrees (default 90)")
-    mod.add_argument("--azimuth", type=float, help="RT-70 azimuth, degrees (default 0)")
+    mod.add_argument(
+        "--elevation",
+        type=options.elevation,
+        help="RT-70 elevation, degrees, 0 (horizon) to 90 (zenith; the default)",
+    )
+    mod.add_argument(
+        "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
+    )
     mod.add_argument(
         "--lock-axes",
         action="store_true",
@@ -270,10 +307,16 @@ def build_parser() -> argparse.ArgumentParser:
         "the trajectory (CSV or NPZ, atomically) and a plot.",
     )
     sim.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
-    sim.add_argument("--t-end", type=float, default=10.0, help="end time, s (default 10)")
-    sim.add_argument("--method", default="BDF", help="solve_ivp method (default BDF)")
+    sim.add_argument(
+        "--t-end", type=options.positive_float, default=10.0, help="end time, s (default 10)"
+    )
+    sim.add_argument(
+        "--method", default="BDF", choices=METHODS, help="solve_ivp method (default BDF)"
+    )
     sim.add_argument("--backend", default="pinocchio", choices=("pinocchio", "textbook"))
-    sim.add_argument("--rtol", type=float, default=1e-6, help="relative tolerance")
+    sim.add_argument(
+        "--rtol", type=options.rtol, default=1e-6, help="relative tolerance, 0 < rtol < 1"
+    )
     sim.add_argument("--out", help="output file, .csv or .npz (a .png plot beside it)")
     sim.add_argument("--no-plot", action="store_true", help="do not write the plot")
     sim.add_argument("--progress", action="store_true", help="progress bar on stderr")
@@ -284,17 +327,27 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if getattr(args, "samples", 1) < 1:
-        parser.error("--samples must be at least 1")
-    with warnings.catch_warnings():
+    args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
+    with options.sigterm_exits(EXIT_TERMINATED), warnings.catch_warnings():
         warnings.simplefilter("always", Rt70Warning)
         warnings.showwarning = _show_warning
         try:
-            return args.func(args)
+            options.check_outputs(args)  # before any work: a bad output path exits 2 at once
+            code = args.func(args)
+            sys.stdout.flush()  # a closed pipe shows here, inside the try, not at shutdown
+            return code
         except Rt70Error as exc:
             print(f"rt70: error: {exc}", file=sys.stderr)
             return 2
+        except BrokenPipeError:
+            # the reader went away (``| head``); Python flushes stdout again at exit:
+            # point it at /dev/null (the Python docs' recipe for SIGPIPE)
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            return EXIT_BROKEN_PIPE
+        except KeyboardInterrupt:
+            print("rt70: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
 
 
 _default_showwarning = warnings.showwarning

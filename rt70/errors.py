@@ -33,7 +33,7 @@ class MasslessCoordinateError(InertiaError):
 
 
 class NonFiniteError(UrdfError):
-    """A number in the model is NaN or infinite."""
+    """A number in the model, or a state passed to either side, is NaN or infinite."""
 
 
 class MagnitudeError(UrdfError):
@@ -66,3 +66,19 @@ class Rt70Warning(UserWarning):
     The message is one line starting with the source file; the command line prints each
     as ``rt70: warning: <message>``.
     """
+
+
+class ShapeError(Rt70Error, ValueError):
+    """An array argument has the wrong shape (a ``ValueError`` too, for existing callers)."""
+
+
+class ResourceError(Rt70Error):
+    """The model is too large for this machine (memory) or for Pinocchio's URDF parser."""
+
+
+class OutputError(Rt70Error):
+    """An output path cannot be written (missing permission, a directory, a bad suffix)."""
+
+
+class SimulationError(Rt70Error):
+    """The equations of motion cannot be integrated from the given model and state."""

@@ -30,7 +30,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from rt70.arrays import check_vector
 from rt70.errors import Rt70Error, Rt70Warning, SingularConfigurationError, UrdfError
+from rt70.resources import check_reference, run_with_stack
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
 from rt70.urdf.reader import balanced_text, prepare_text
@@ -41,8 +43,8 @@ GIMBAL_LOCK_COS = 1e-8
 
 @dataclass(frozen=True)
 class _Bushing:
-    frame1: int
-    frame2: int
+    frame1: tuple[int, pin.SE3]  # (parent joint, placement in it)
+    frame2: tuple[int, pin.SE3]
     stiffness: np.ndarray
     damping: np.ndarray
 
@@ -73,13 +75,15 @@ class ReferenceModel:
     """
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
+        check_reference(desc)  # parser depth and memory, before Pinocchio sees the model
         self.model = _parse_urdf(urdf_text, desc.source)
         self.model.gravity.linear = np.asarray(desc.gravity, dtype=float)
         self.model.armature[:] = 0.0
+        bodies = {f.name: f for f in self.model.frames if f.type == pin.BODY}
         self.bushings = [
             _Bushing(
-                self._add_frame(f"{b.name}#1", b.frame1),
-                self._add_frame(f"{b.name}#2", b.frame2),
+                self._attachment(bodies, b.frame1),
+                self._attachment(bodies, b.frame2),
                 np.asarray(b.stiffness),
                 np.asarray(b.damping),
             )
@@ -90,9 +94,9 @@ class ReferenceModel:
         self._stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6)
         self._damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6)
         self._coordinates(desc)
+        joint_id = {name: i for i, name in enumerate(self.model.names)}
         self.spring_v = np.array(
-            [self.model.idx_vs[self.model.getJointId(s.joint)] for s in desc.joint_springs],
-            dtype=int,
+            [self.model.idx_vs[joint_id[s.joint]] for s in desc.joint_springs], dtype=int
         )
         self.spring_k = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
         self.spring_d = np.array([s.damping for s in desc.joint_springs], dtype=float)
@@ -176,14 +180,18 @@ class ReferenceModel:
         """Number of book coordinates (independent generalised coordinates)."""
         return len(self.coordinate_names)
 
-    def _add_frame(self, name: str, ref: FrameRef) -> int:
-        body = self.model.getFrameId(ref.link, pin.BODY)
-        if body >= len(self.model.frames):
+    @staticmethod
+    def _attachment(bodies: dict, ref: FrameRef) -> tuple[int, pin.SE3]:
+        """Parent joint and placement in it of a frame fixed to a link.
+
+        Kept as (joint, placement) rather than added to the model: ``Model.addFrame``
+        searches every frame for a duplicate name, quadratic in the number of bushings.
+        """
+        if ref.link not in bodies:
             raise Rt70Error(f"Pinocchio has no frame for link '{ref.link}'")
-        parent = self.model.frames[body]
+        body = bodies[ref.link]
         offset = pin.SE3(pin.rpy.rpyToMatrix(*ref.rpy), np.asarray(ref.xyz, dtype=float))
-        frame = pin.Frame(name, parent.parentJoint, body, parent.placement * offset, pin.OP_FRAME)
-        return self.model.addFrame(frame, False)
+        return body.parentJoint, body.placement * offset
 
     def coordinate_index(self, names: list[str]) -> np.ndarray:
         """Index among this model's book coordinates of each named coordinate."""
@@ -195,8 +203,13 @@ class ReferenceModel:
         """Pinocchio's ``(q, v)``, the Jacobian ``J`` (``v = J q̇``) and ``J̇ q̇``.
 
         ``J`` is None when it is the identity (only 1-DOF joints in the user's order, no
-        mimic); a mere reordering of 1-DOF joints is a permutation matrix.
+        mimic); a mere reordering of 1-DOF joints is a permutation matrix. Every public
+        method passes its state through here: a wrong shape raises
+        :class:`~rt70.errors.ShapeError`, a NaN or infinity
+        :class:`~rt70.errors.NonFiniteError` (as on the textbook side).
         """
+        q = check_vector("q", q, self.nv)
+        qd = None if qd is None else check_vector("qd", qd, self.nv)
         if self.identity_map:
             return q, qd, None, None
         m = self.model
@@ -294,7 +307,8 @@ class ReferenceModel:
     def deformations(self, qp: np.ndarray, jacobian: bool = True):
         """δ of every bushing (n_b, 6) and ∂δ/∂v (n_b, 6, nv), from Pinocchio's kinematics.
 
-        Frame placements ``oMf`` and local frame Jacobians come from Pinocchio; the
+        Frame placements ``oMi · placement`` and local frame Jacobians (Pinocchio's
+        ``getFrameJacobian`` of a joint and a placement) come from Pinocchio; the
         relative placement, Pinocchio's roll-pitch-yaw of its transpose and the inverse
         world rpy Jacobian are evaluated for all bushings at once (the formulas of
         ``pin.rpy.matrixToRpy`` / ``computeRpyJacobianInverse``, checked against them in
@@ -302,16 +316,18 @@ class ReferenceModel:
         the angular velocity of frame 2 relative to frame 1 is ``ω = J_W(ρ) φ̇``.
         """
         m, d = self.model, self.data
+        qp = check_vector("qp", qp, m.nq)
         if jacobian:
             pin.computeJointJacobians(m, d, qp)
         else:
             pin.forwardKinematics(m, d, qp)
-        pin.updateFramePlacements(m, d)
         f1, f2 = self._frames1, self._frames2
-        R1 = np.array([d.oMf[i].rotation for i in f1])
-        R2 = np.array([d.oMf[i].rotation for i in f2])
-        p1 = np.array([d.oMf[i].translation for i in f1])
-        p2 = np.array([d.oMf[i].translation for i in f2])
+        M1 = [d.oMi[joint] * placement for joint, placement in f1]
+        M2 = [d.oMi[joint] * placement for joint, placement in f2]
+        R1 = np.array([M.rotation for M in M1])
+        R2 = np.array([M.rotation for M in M2])
+        p1 = np.array([M.translation for M in M1])
+        p2 = np.array([M.translation for M in M2])
         R1t = np.swapaxes(R1, -1, -2)
         c12 = R1t @ R2
         r12 = (R1t @ (p2 - p1)[..., None])[..., 0]
@@ -325,8 +341,8 @@ class ReferenceModel:
         delta = np.concatenate([r12, -np.stack([roll, pitch, yaw], axis=1)], axis=1)
         if not jacobian:
             return delta, None
-        J1 = np.array([pin.getFrameJacobian(m, d, i, pin.LOCAL) for i in f1]).reshape(-1, 6, m.nv)
-        J2 = np.array([pin.getFrameJacobian(m, d, i, pin.LOCAL) for i in f2]).reshape(-1, 6, m.nv)
+        J1 = np.array([pin.getFrameJacobian(m, d, *f, pin.LOCAL) for f in f1]).reshape(-1, 6, m.nv)
+        J2 = np.array([pin.getFrameJacobian(m, d, *f, pin.LOCAL) for f in f2]).reshape(-1, 6, m.nv)
         # J_rel = J2 − Ad(M12⁻¹) J1; δ̇_trans = c12 v_rel, φ̇ = J_W(ρ)⁻¹ ω_rel
         lin1 = J1[:, :3] - _skew(r12) @ J1[:, 3:]
         jac = np.empty_like(J2)
@@ -451,7 +467,8 @@ def _parse_urdf(text: str, source: str) -> pin.Model:
     with tempfile.TemporaryFile() as capture:
         os.dup2(capture.fileno(), 2)
         try:
-            model = pin.buildModelFromXML(text)
+            # on a large stack: urdfdom recurses per level of the tree
+            model = run_with_stack(lambda: pin.buildModelFromXML(text))
         except (RuntimeError, ValueError) as exc:
             error = exc
         finally:

@@ -10,6 +10,7 @@ from functools import cached_property
 from pathlib import Path
 
 from rt70.errors import Rt70Warning, SceneError
+from rt70.resources import check_textbook
 from rt70.textbook.data import Data
 from rt70.textbook.massless import check_moves_mass
 from rt70.textbook.model import Model, build_model
@@ -93,8 +94,10 @@ class Scene:
 
     @cached_property
     def textbook_data(self) -> Data:
-        """Work buffers for :attr:`textbook`."""
-        return Data(self.textbook)
+        """Work buffers for :attr:`textbook` (refused beyond this machine's memory)."""
+        model = self.textbook
+        check_textbook(model.nb, model.n_full, self.description.source)
+        return Data(model)
 
     @cached_property
     def reference(self):  # -> rt70.reference.ReferenceModel (imported lazily: Pinocchio)

@@ -19,12 +19,23 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.errors import Rt70Error
+from rt70.arrays import check_vector
+from rt70.errors import (
+    OutputError,
+    Rt70Error,
+    ShapeError,
+    SimulationError,
+    SingularConfigurationError,
+)
 from rt70.scene import Scene
 from rt70.textbook.spatial import check_euler_pairs
 
 #: Integration methods of scipy.integrate.solve_ivp accepted by :func:`simulate`.
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
+#: Smallest rtol solve_ivp honours (it raises smaller ones to 100 machine epsilons).
+MIN_RTOL = 100 * np.finfo(float).eps
+#: Output formats of :meth:`SimulationResult.save`, by suffix.
+OUTPUT_SUFFIXES = (".csv", ".npz")
 #: Methods that use the Jacobian of the right-hand side.
 IMPLICIT = ("Radau", "BDF", "LSODA")
 #: A drift of the energy balance larger than this many times rtol (relative to the energy
@@ -46,6 +57,9 @@ class _Backend:
     def accelerations(self, q, qd, Q_u) -> tuple[np.ndarray, np.ndarray]:  # q̈, Q_d
         raise NotImplementedError
 
+    def mass_matrix(self, q) -> np.ndarray:  # A(q) in the textbook's coordinate order
+        raise NotImplementedError
+
     def jacobian(self, q, qd, Q_u) -> np.ndarray | None:  # ∂(q̇, q̈)/∂(q, q̇) or None
         return None
 
@@ -65,6 +79,9 @@ class _PinocchioBackend(_Backend):
         self.pin = pin
         self.ref = scene.reference
         self.direct = self.ref.identity_map  # book coordinates are Pinocchio's (q, v)
+
+    def mass_matrix(self, q):
+        return self.ref.mass_matrix(q)
 
     def accelerations(self, q, qd, Q_u):
         check_euler_pairs(self.scene.textbook, self.scene.textbook.expand(q))
@@ -122,8 +139,12 @@ class _TextbookBackend(_Backend):
         super().__init__(scene)
         from rt70.textbook import structured
 
+        scene.textbook_data  # noqa: B018  (its memory guard covers the structured form too)
         self.structured = structured
         self.bdata = structured.BatchData(scene.textbook, 1)
+
+    def mass_matrix(self, q):
+        return self.structured.mass_matrix(self.scene.textbook, q, self.bdata)
 
     def accelerations(self, q, qd, Q_u):
         import scipy.linalg
@@ -206,19 +227,29 @@ class SimulationResult:
 
     def save(self, path: str | Path) -> Path:
         """Write the result atomically: ``.npz`` (all arrays) or ``.csv`` (a table)."""
-        from rt70.atomic import atomic_write, atomic_write_text
+        from rt70.atomic import atomic_write
 
-        path = Path(path)
-        if path.suffix == ".npz":
+        return atomic_write(path, self.writer(path))
+
+    def writer(self, path: str | Path) -> Callable[[Path], None]:
+        """The function that writes the result to a (temporary) file, in ``path``'s format.
+
+        For :func:`rt70.atomic.atomic_write_all`, to write it together with other files.
+
+        Raises
+        ------
+        OutputError
+            If ``path`` does not end in one of :data:`OUTPUT_SUFFIXES`.
+        """
+        suffix = check_output_suffix(path)
+        if suffix == ".npz":
             arrays = {
                 k: getattr(self, k)
                 for k in ("t", "q", "qd", "kinetic", "gravity", "elastic", "dissipated")
             }
             arrays.update(input_work=self.input_work, balance=self.balance)
             arrays["coordinates"] = np.array(self.coordinates)
-            return atomic_write(path, lambda tmp: np.savez_compressed(tmp, **arrays))
-        if path.suffix != ".csv":
-            raise Rt70Error(f"{path}: output must end in .csv or .npz")
+            return lambda tmp: np.savez_compressed(tmp, **arrays)
         names = ["t"] + [f"q:{c}" for c in self.coordinates] + [f"qd:{c}" for c in self.coordinates]
         names += ["kinetic", "gravity", "elastic", "dissipated", "input_work", "balance"]
         table = np.column_stack(
@@ -226,7 +257,16 @@ class SimulationResult:
             + [self.dissipated, self.input_work, self.balance]
         )
         lines = [",".join(names)] + [",".join(f"{x:.17g}" for x in row) for row in table]
-        return atomic_write_text(path, "\n".join(lines) + "\n")
+        text = "\n".join(lines) + "\n"
+        return lambda tmp: tmp.write_text(text, encoding="utf-8", newline="\n")
+
+
+def check_output_suffix(path: str | Path) -> str:
+    """The suffix of an output path, one of :data:`OUTPUT_SUFFIXES`, or an OutputError."""
+    suffix = Path(path).suffix
+    if suffix not in OUTPUT_SUFFIXES:
+        raise OutputError(f"{path}: output must end in {' or '.join(OUTPUT_SUFFIXES)}")
+    return suffix
 
 
 def listing_initial_state(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
@@ -286,59 +326,109 @@ def simulate(
         raise Rt70Error(f"unknown backend '{backend}' (choose from {', '.join(BACKENDS)})")
     if method not in METHODS:
         raise Rt70Error(f"unknown method '{method}' (choose from {', '.join(METHODS)})")
+    if not (np.isfinite(rtol) and MIN_RTOL <= rtol < 1.0):
+        raise Rt70Error(f"rtol must lie in [{MIN_RTOL:.3g}, 1), got {rtol!r}")
+    if atol is not None and not (np.isfinite(atol) and atol > 0.0):
+        raise Rt70Error(f"atol must be a positive finite number, got {atol!r}")
     t0, t1 = map(float, t_span)
     if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
         raise Rt70Error(f"bad time span {t_span!r}")
-    side = BACKENDS[backend](scene)
+    if t_eval is not None:
+        t_eval = np.asarray(t_eval, dtype=float)
+        if t_eval.ndim != 1 or not np.all((t_eval >= t0) & (t_eval <= t1)):
+            raise Rt70Error(f"t_eval must be a vector of times within [{t0:g}, {t1:g}]")
+        if np.any(np.diff(t_eval) <= 0.0):
+            raise Rt70Error("t_eval must be increasing")
     n = scene.textbook.nv
+    if n == 0:
+        raise SimulationError(f"{scene.name}: the model has no degree of freedom: nothing moves")
+    side = BACKENDS[backend](scene)
     if x0 is None:
         try:
             q0, qd0 = listing_initial_state(scene)
         except Rt70Error:
             q0, qd0 = np.zeros(n), np.zeros(n)
     else:
-        q0, qd0 = (np.asarray(x, dtype=float) for x in x0)
-    if q0.shape != (n,) or qd0.shape != (n,) or not np.all(np.isfinite(np.r_[q0, qd0])):
-        raise Rt70Error(f"initial state must be two finite vectors of {n} entries")
-    T0, Ug0, Uc0 = side.energies(q0, qd0)
+        q0, qd0 = x0
+    q0 = check_vector("initial state q0", q0, n)
+    qd0 = check_vector("initial state qd0", qd0, n)
+    check_euler_pairs(scene.textbook, scene.textbook.expand(q0))  # gimbal lock: named first
+    _check_mass_matrix(scene, side, q0)
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):  # checked just below
+            T0, Ug0, Uc0 = side.energies(q0, qd0)
+    except SingularConfigurationError as exc:
+        raise SimulationError(f"{scene.name}: at the initial state: {exc}") from None
+    if not np.isfinite([T0, Ug0, Uc0]).all():
+        raise SimulationError(
+            f"{scene.name}: the energy at the initial state overflows (a stiffness or mass "
+            "near the largest floating-point number?)"
+        )
     energy_scale = max(T0 + Uc0, 1e-12 * max(abs(Ug0), 1.0), 1e-300)
     atol_q = 1e-3 * rtol if atol is None else atol
     atol_vec = np.r_[np.full(2 * n, atol_q), np.full(2, rtol * energy_scale)]
     bar = _Progress(t0, t1) if progress else None
+    reached = [t0]  # the last time the right-hand side was evaluated at
+
+    def input_force(t, q, qd):
+        if inputs is None:
+            return None
+        Q_u = np.asarray(inputs(t, q, qd), dtype=float)
+        if Q_u.shape != (n,):
+            raise ShapeError(f"inputs(t, q, qd): expected shape ({n},), got shape {Q_u.shape}")
+        return Q_u
 
     def rhs(t, x):
+        reached[0] = t
         q, qd = x[:n], x[n : 2 * n]
-        Q_u = None if inputs is None else np.asarray(inputs(t, q, qd), dtype=float)
+        Q_u = input_force(t, q, qd)
         qdd, Qd = side.accelerations(q, qd, Q_u)
         if bar is not None:
             bar.update(t)
         power_u = 0.0 if Q_u is None else float(qd @ Q_u)
-        return np.concatenate([qd, qdd, [-float(qd @ Qd), power_u]])
+        out = np.concatenate([qd, qdd, [-float(qd @ Qd), power_u]])
+        if not np.isfinite(out).all():
+            raise SimulationError("the accelerations are not finite")
+        return out
 
     jac = None
-    if method in IMPLICIT and backend == "pinocchio" and side.jacobian(q0, qd0, None) is not None:
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked in jac
+        analytic = method in IMPLICIT and side.jacobian(q0, qd0, None) is not None
+    if analytic:
 
         def jac(t, x):
             q, qd = x[:n], x[n : 2 * n]
-            Q_u = None if inputs is None else np.asarray(inputs(t, q, qd), dtype=float)
             J = np.zeros((2 * n + 2, 2 * n + 2))
-            J[: 2 * n, : 2 * n] = side.jacobian(q, qd, Q_u)
+            J[: 2 * n, : 2 * n] = side.jacobian(q, qd, input_force(t, q, qd))
+            if not np.isfinite(J).all():
+                raise SimulationError("the Jacobian of the right-hand side is not finite")
             return J
 
     start = time.perf_counter()
-    sol = solve_ivp(
-        rhs,
-        (t0, t1),
-        np.r_[q0, qd0, 0.0, 0.0],
-        method=method,
-        rtol=rtol,
-        atol=atol_vec,
-        t_eval=t_eval,
-        **({} if jac is None else {"jac": jac}),
-    )
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked above
+            sol = solve_ivp(
+                rhs,
+                (t0, t1),
+                np.r_[q0, qd0, 0.0, 0.0],
+                method=method,
+                rtol=rtol,
+                atol=atol_vec,
+                t_eval=t_eval,
+                **({} if jac is None else {"jac": jac}),
+            )
+    except (Rt70Error, ValueError) as exc:
+        # Rt70Error: the model cannot be integrated beyond this state; ValueError "array
+        # must not contain infs or NaNs": scipy's difference Jacobian overflowed
+        if not isinstance(exc, Rt70Error) and "inf" not in str(exc):
+            raise
+        raise SimulationError(
+            f"{scene.name}: integration stopped at t = {reached[0]:.6g} s: {exc}"
+        ) from None
+    finally:
+        if bar is not None:
+            bar.close()
     wall = time.perf_counter() - start
-    if bar is not None:
-        bar.close()
     q, qd = sol.y[:n].T, sol.y[n : 2 * n].T
     energies = np.array([side.energies(a, b) for a, b in zip(q, qd, strict=True)])
     E_psi, W_u = sol.y[2 * n], sol.y[2 * n + 1]
@@ -374,6 +464,29 @@ def simulate(
     )
     result.drift_flagged = inputs is None and result.relative_drift > DRIFT_FACTOR * rtol
     return result
+
+
+def _check_mass_matrix(scene: Scene, side: _Backend, q0: np.ndarray) -> None:
+    """Refuse a model whose mass matrix is singular at the initial state.
+
+    A coordinate that moves no mass has a zero diagonal entry; it is named.
+    """
+    A = side.mass_matrix(q0)
+    if not np.isfinite(A).all():
+        raise SimulationError(f"{scene.name}: the mass matrix is not finite at the initial state")
+    names = scene.textbook.coordinate_names
+    massless = [c for c, a in zip(names, np.diag(A), strict=True) if not a > 0.0]
+    if massless:
+        raise SimulationError(
+            f"{scene.name}: mass matrix is singular: no mass moves with coordinate(s) "
+            f"{', '.join(massless)}"
+        )
+    try:
+        np.linalg.cholesky(A)
+    except np.linalg.LinAlgError:
+        raise SimulationError(
+            f"{scene.name}: the mass matrix is not positive definite at the initial state"
+        ) from None
 
 
 class _Progress:

@@ -125,12 +125,12 @@ def test_reference_rpy_formulas_are_pinocchios():
     q = rng.uniform(-0.4, 0.4, ref.nv)
     delta, jac = ref.deformations(q)
     d = ref.data
-    for k, (f1, f2) in enumerate(zip(ref._frames1, ref._frames2, strict=True)):
-        M12 = d.oMf[f1].actInv(d.oMf[f2])
+    for k, ((i1, P1), (i2, P2)) in enumerate(zip(ref._frames1, ref._frames2, strict=True)):
+        M12 = (d.oMi[i1] * P1).actInv(d.oMi[i2] * P2)
         rho = pin.rpy.matrixToRpy(M12.rotation.T)
         assert np.allclose(delta[k], np.r_[M12.translation, -rho], atol=1e-12)
-        J1 = pin.getFrameJacobian(ref.model, d, f1, pin.LOCAL)
-        J2 = pin.getFrameJacobian(ref.model, d, f2, pin.LOCAL)
+        J1 = pin.getFrameJacobian(ref.model, d, i1, P1, pin.LOCAL)
+        J2 = pin.getFrameJacobian(ref.model, d, i2, P2, pin.LOCAL)
         J_rel = J2 - M12.inverse().toActionMatrix() @ J1
         expected = np.r_[
             M12.rotation @ J_rel[:3],

@@ -111,6 +111,11 @@ def equilibrium(
         if np.max(np.abs(residual), initial=0.0) <= tol * scale:
             return q
         K = stiffness_matrix(scene, q)[np.ix_(free, free)]
+        if not np.isfinite(K).all():
+            raise Rt70Error(
+                f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
+                "largest floating-point number?)"
+            )
         try:
             step = scipy.linalg.solve(K, residual, assume_a="sym")
         except (np.linalg.LinAlgError, ValueError):

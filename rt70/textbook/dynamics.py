@@ -26,6 +26,7 @@ def mass_matrix(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
 
 def body_velocities(model: Model, data: Data, qd: np.ndarray) -> np.ndarray:
     """Absolute body velocities ``V⁰ = Sᵀ q̇`` (4.63), each in its own body frame."""
+    qd = check_finite("qd", qd, model.nv)
     data.V = (data.S.T @ qd).reshape(model.nb, 6)
     return data.V
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rt70.errors import NonFiniteError
+from rt70.errors import NonFiniteError, ShapeError
 from rt70.textbook.data import Data
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import (
@@ -18,10 +18,21 @@ from rt70.textbook.spatial import (
 
 
 def check_finite(name: str, x: np.ndarray, size: int) -> np.ndarray:
-    """Return ``x`` as a float vector of ``size`` entries, or raise on NaN/inf or wrong size."""
-    x = np.asarray(x, dtype=float)
+    """Return ``x`` as a float vector of ``size`` entries, or raise on NaN/inf or wrong size.
+
+    Raises
+    ------
+    ShapeError
+        (a ``ValueError`` too) if ``x`` is not a vector of ``size`` numbers.
+    NonFiniteError
+        If an entry is NaN or infinite.
+    """
+    try:
+        x = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ShapeError(f"{name}: expected a vector of {size} numbers, got {x!r:.60}") from None
     if x.shape != (size,):
-        raise ValueError(f"{name} must have shape ({size},), got {x.shape}")
+        raise ShapeError(f"{name}: expected shape ({size},), got shape {x.shape}")
     if not np.all(np.isfinite(x)):
         raise NonFiniteError(f"{name} contains NaN or infinite values")
     return x

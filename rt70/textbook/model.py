@@ -161,8 +161,13 @@ class Model:
         return path[::-1]
 
 
-def _euler6_chain(desc: RobotDescription, first: Joint, referenced: set[str]) -> list[Joint]:
-    """Return the six joints of an euler6 pair starting at ``first``, or [] if none."""
+def _euler6_chain(
+    desc: RobotDescription, first: Joint, referenced: set[str], children: dict[str, list[Joint]]
+) -> list[Joint]:
+    """Return the six joints of an euler6 pair starting at ``first``, or [] if none.
+
+    ``children`` maps a link to its child joints in file order (:func:`_child_joints`).
+    """
     chain = []
     joint = first
     for step, (jtype, axis) in enumerate(_EULER6_PATTERN):
@@ -174,11 +179,19 @@ def _euler6_chain(desc: RobotDescription, first: Joint, referenced: set[str]) ->
         if step == 5:
             return chain
         link = desc.links[joint.child]
-        children = desc.child_joints(joint.child)
-        if link.inertial is not None or len(children) != 1 or link.name in referenced:
+        below = children.get(joint.child, [])
+        if link.inertial is not None or len(below) != 1 or link.name in referenced:
             return []
-        joint = children[0]
+        joint = below[0]
     return []
+
+
+def _child_joints(desc: RobotDescription) -> dict[str, list[Joint]]:
+    """Child joints of every link, in file order (one pass: linear in the joints)."""
+    children: dict[str, list[Joint]] = {}
+    for joint in desc.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    return children
 
 
 def build_model(desc: RobotDescription) -> Model:
@@ -191,6 +204,7 @@ def build_model(desc: RobotDescription) -> Model:
         desc.root: (-1, np.zeros(3), np.eye(3))
     }
     joint_coord: dict[str, int] = {}
+    children = _child_joints(desc)
 
     # Depth-first, parents before children, siblings in file order: an explicit stack of
     # (joint, body, r_link, c_link), the joint's parent link sitting at (r_link, c_link)
@@ -199,7 +213,7 @@ def build_model(desc: RobotDescription) -> Model:
 
     def visit(link: str, body: int, r_link: np.ndarray, c_link: np.ndarray) -> None:
         """Schedule the joints below ``link``, which sits at ``(r_link, c_link)`` in ``body``."""
-        stack.extend((joint, body, r_link, c_link) for joint in desc.child_joints(link)[::-1])
+        stack.extend((joint, body, r_link, c_link) for joint in children.get(link, [])[::-1])
 
     visit(desc.root, -1, np.zeros(3), np.eye(3))
     while stack:
@@ -215,7 +229,7 @@ def build_model(desc: RobotDescription) -> Model:
             link_frames[joint.child] = (body, r_joint, c_joint)
             visit(joint.child, body, r_joint, c_joint)
             continue
-        chain = _euler6_chain(desc, joint, referenced)
+        chain = _euler6_chain(desc, joint, referenced, children)
         if chain:
             jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
             inertial = desc.links[child].inertial

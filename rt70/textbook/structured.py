@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rt70.errors import NonFiniteError
+from rt70.errors import NonFiniteError, ShapeError
+from rt70.textbook.kinematics import check_finite
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import placement
 
@@ -349,9 +350,12 @@ def _expand_batch(model: Model, Q: np.ndarray, offset: bool = True) -> np.ndarra
 
 
 def _check_batch(name: str, Q: np.ndarray, nv: int) -> np.ndarray:
-    Q = np.asarray(Q, dtype=float)
+    try:
+        Q = np.asarray(Q, dtype=float)
+    except (TypeError, ValueError):
+        raise ShapeError(f"{name}: expected a (K, {nv}) array of numbers") from None
     if Q.ndim != 2 or Q.shape[1] != nv:
-        raise ValueError(f"{name} must have shape (K, {nv}), got {Q.shape}")
+        raise ShapeError(f"{name}: expected shape (K, {nv}), got shape {Q.shape}")
     if np.isnan(Q.ravel() @ np.zeros(Q.size)):  # 0·x is NaN exactly for x = ±inf or NaN
         raise NonFiniteError(f"{name} contains NaN or infinite values")
     return Q
@@ -401,7 +405,8 @@ def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray
 
 def mass_matrix(model: Model, q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
     """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form), a new array."""
-    return mass_matrix_batch(model, np.asarray(q, dtype=float)[None, :], data)[0].copy()
+    q = check_finite("q", q, model.nv)
+    return mass_matrix_batch(model, q[None, :], data)[0].copy()
 
 
 def _crm_batch(v: np.ndarray) -> np.ndarray:
@@ -472,8 +477,8 @@ def bias_force(
     model: Model, q: np.ndarray, qd: np.ndarray, data: BatchData | None = None
 ) -> np.ndarray:
     """``B(q, q̇) q̇`` at one state (structure-exploiting form)."""
-    q, qd = np.asarray(q, dtype=float)[None, :], np.asarray(qd, dtype=float)[None, :]
-    return bias_force_batch(model, q, qd, data)[0]
+    q, qd = check_finite("q", q, model.nv), check_finite("qd", qd, model.nv)
+    return bias_force_batch(model, q[None, :], qd[None, :], data)[0]
 
 
 def gravity_force_batch(model: Model, Q: np.ndarray, data: BatchData | None = None) -> np.ndarray:

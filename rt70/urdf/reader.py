@@ -567,6 +567,7 @@ class _Reader:
     def extensions(self, root: ET.Element, desc: RobotDescription) -> None:
         ns = "{" + RT70_NS + "}"
         gravity_seen = False
+        joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
         for elem in root:
             if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
                 continue
@@ -579,7 +580,7 @@ class _Reader:
                 gravity_seen = True
                 desc.gravity[:] = self.numbers(elem, "xyz", 3)
             elif kind == "joint_spring":
-                desc.joint_springs.append(self.joint_spring(elem, desc))
+                desc.joint_springs.append(self.joint_spring(elem, joints))
             elif kind == "bushing":
                 desc.bushings.append(self.bushing(elem, desc))
             elif kind == "strut_package":
@@ -606,16 +607,15 @@ class _Reader:
             out.append(values)
         return out[0], out[1]
 
-    def joint_spring(self, elem: ET.Element, desc: RobotDescription) -> JointSpring:
+    def joint_spring(self, elem: ET.Element, joints: dict[str, Joint]) -> JointSpring:
         name = self.name_of(elem)
         where = f"<rt70:joint_spring name='{name}'>"
         jname = elem.get("joint")
         if not jname:
             raise self.fail(ExtensionError, f"{where} lacks attribute 'joint'")
-        try:
-            joint = desc.joint(jname)
-        except KeyError:
-            raise self.fail(ExtensionError, f"{where}: joint '{jname}' does not exist") from None
+        joint = joints.get(jname)
+        if joint is None:
+            raise self.fail(ExtensionError, f"{where}: joint '{jname}' does not exist")
         if joint.type not in ONE_DOF_JOINT_TYPES:
             raise self.fail(
                 ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"

@@ -1,0 +1,202 @@
+"""Command-line options checked before any work: argparse types, output paths, signals.
+
+Every bad option ends the run at once with exit code 2 and one line on stderr,
+``rt70: error: argument --rtol: ...`` — no usage block, no traceback — before a scene
+is read or a simulation started. Output paths are probed (a temporary file is created
+and removed in the directory that will receive them), so a read-only directory, a
+directory where a file should go or a wrong suffix is refused up front.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import signal
+import sys
+import tempfile
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import NoReturn
+
+from rt70.errors import OutputError
+
+#: Range of the RT-70's elevation axis, degrees: horizon to zenith (the book's tables
+#: are given at 0° and 90°; :func:`rt70.linear.linearize.rt70_pointing`).
+ELEVATION_RANGE = (0.0, 90.0)
+
+#: Smallest relative tolerance ``solve_ivp`` honours (100 machine epsilons).
+MIN_RTOL = 100 * sys.float_info.epsilon
+
+#: Largest ``rt70 bench --K``: the batched mass matrices alone take ``K nv²`` floats
+#: (1.4 GB for the RT-70 scene at this K).
+MAX_BATCH = 100_000
+
+
+class Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line, ``rt70: error: ...``, and exit 2."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print ``message`` as one line (with where to find help) and exit 2."""
+        command = self.prog.removeprefix("rt70").strip()
+        hint = f"see 'rt70 {command} --help'" if command else "see 'rt70 --help'"
+        print(f"rt70: error: {' '.join(message.split())} ({hint})", file=sys.stderr)
+        sys.exit(2)
+
+
+# --- argparse types: each raises ArgumentTypeError with the reason ---------------------
+def _number(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"'{text}' is not a finite number")
+    return value
+
+
+def _integer(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not an integer") from None
+
+
+def finite_float(text: str) -> float:
+    """A finite number."""
+    return _number(text)
+
+
+def positive_float(text: str) -> float:
+    """A finite number > 0."""
+    value = _number(text)
+    if not value > 0.0:
+        raise argparse.ArgumentTypeError(f"must be greater than 0, got {text}")
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    """A finite number ≥ 0."""
+    value = _number(text)
+    if value < 0.0:
+        raise argparse.ArgumentTypeError(f"must be at least 0, got {text}")
+    return value
+
+
+def rtol(text: str) -> float:
+    """A relative tolerance of ``solve_ivp``: ``MIN_RTOL ≤ rtol < 1``."""
+    value = _number(text)
+    if not MIN_RTOL <= value < 1.0:
+        raise argparse.ArgumentTypeError(
+            f"must lie in [{MIN_RTOL:.3g}, 1) (scipy's solve_ivp raises smaller values to "
+            f"100 machine epsilons), got {text}"
+        )
+    return value
+
+
+def positive_int(text: str) -> int:
+    """An integer ≥ 1."""
+    value = _integer(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
+    return value
+
+
+def seed(text: str) -> int:
+    """A random seed: an integer ≥ 0 (numpy's generators take no negative seed)."""
+    value = _integer(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be at least 0, got {text}")
+    return value
+
+
+def batch_size(text: str) -> int:
+    """A batch size: 1 … :data:`MAX_BATCH`."""
+    value = positive_int(text)
+    if value > MAX_BATCH:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_BATCH}, got {text}")
+    return value
+
+
+def elevation(text: str) -> float:
+    """An RT-70 elevation in degrees, within :data:`ELEVATION_RANGE`."""
+    value = _number(text)
+    low, high = ELEVATION_RANGE
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(
+            f"the RT-70 points from {low:g}° (horizon) to {high:g}° (zenith), got {text}"
+        )
+    return value
+
+
+# --- output paths ------------------------------------------------------------------------
+def check_outputs(args: argparse.Namespace) -> None:
+    """Refuse output paths the command could not write, before it starts.
+
+    ``simulate --out FILE`` (and the ``.png`` beside it unless ``--no-plot``) and
+    ``bench --out DIRECTORY``.
+
+    Raises
+    ------
+    OutputError
+        Naming the path and the reason.
+    """
+    if args.command == "simulate" and args.out:
+        from rt70.simulate import check_output_suffix
+
+        out = Path(args.out)
+        files = [out] if args.no_plot else [out, out.with_suffix(".png")]
+        for path in files:
+            if path.is_dir():
+                raise OutputError(f"{path}: is a directory, not a file")
+        check_output_suffix(out)
+        check_writable_directory(out.parent)
+    elif args.command == "bench":
+        check_writable_directory(Path(args.out))
+
+
+def check_writable_directory(directory: Path) -> None:
+    """Refuse a directory that cannot receive new files (or cannot be created).
+
+    The nearest existing ancestor is probed by creating and removing a temporary file
+    in it, so the answer is the file system's (read-only mounts, permissions, quotas).
+    """
+    probe = directory
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise OutputError(f"{directory}: '{probe}' is not a directory")
+    try:
+        fd, name = tempfile.mkstemp(dir=probe, prefix=".rt70-probe.")
+    except OSError as exc:
+        raise OutputError(
+            f"{directory}: cannot create files in '{probe}' ({exc.strerror})"
+        ) from None
+    os.close(fd)
+    os.unlink(name)
+
+
+# --- signals -----------------------------------------------------------------------------
+@contextmanager
+def sigterm_exits(code: int) -> Iterator[None]:
+    """Inside the block, SIGTERM raises ``SystemExit(code)``: ``finally`` blocks run.
+
+    Temporary output files are removed that way (:mod:`rt70.atomic`). The previous
+    handler is restored afterwards; outside the main thread nothing changes.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def terminate(signum: int, _frame: object) -> NoReturn:
+        raise SystemExit(code)
+
+    previous = signal.signal(signal.SIGTERM, terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

@@ -1,0 +1,181 @@
+"""Resource guards: refuse a model this machine cannot hold *before* building it.
+
+Two limits were measured (``python validation/resource_limits.py`` reproduces them):
+
+Memory
+    Pinocchio 4.1's ``Data`` holds four ``nv × nv × nv`` tensors (the second-order
+    RNEA derivatives ``d2tau_dqdq`` …, allocated and zeroed whether used or not), so a
+    :class:`~rt70.reference.ReferenceModel` — two ``Data`` objects, and a third,
+    transient copy while the Python binding returns the second — peaks at about
+    ``96 nv³`` bytes: 2.7 GB at nv = 300, about 100 GB at nv = 1000. The textbook side's
+    dense ``Data`` (L and Θ are ``6 nb × 6 nb``; the dense algorithms add Φ⁰, Ṡ and
+    products of the same size) peaks at ``O(nb²)``: about 0.4 GB at nb = 600, 27 GB at
+    nb = 5000. :func:`reference_peak_bytes` and :func:`textbook_peak_bytes` are fits of
+    measured peaks (resident set growth in a fresh process), rounded up; a model is
+    refused when its estimate exceeds :data:`MEMORY_FRACTION` of ``MemAvailable``.
+Parser depth
+    Pinocchio's URDF parser recurses once per level of the kinematic tree, about
+    2.2 KiB of stack per level: with the usual 8 MiB stack it segfaults at a depth of
+    about 3770 links (any joint type; a wide tree is harmless). It is therefore run in a
+    thread with a :data:`PARSER_STACK_BYTES` stack (room for about 30 000 levels) and a
+    tree deeper than :data:`PARSER_MAX_DEPTH` is refused before the parser sees it.
+
+Only the standard library and numpy are used (the textbook side may import this).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
+
+from rt70.errors import ResourceError
+from rt70.urdf.description import RobotDescription
+
+#: Share of ``MemAvailable`` a model may take: the rest is margin for the fits' error,
+#: the other side of the cross-check, the integrator's arrays and other processes.
+MEMORY_FRACTION = 0.5
+
+#: Stack of the thread that runs Pinocchio's URDF parser (virtual; only the pages the
+#: recursion touches become resident).
+PARSER_STACK_BYTES = 64 * 2**20
+
+#: Deepest kinematic tree (links from the root, the root included) handed to the
+#: parser: a third of what the measured 2.2 KiB per level allows on its stack.
+PARSER_MAX_DEPTH = 10_000
+
+_MEMINFO = Path("/proc/meminfo")
+_DOFS = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
+
+T = TypeVar("T")
+
+
+def available_memory() -> int | None:
+    """``MemAvailable`` of ``/proc/meminfo`` in bytes, or None where it is unknown."""
+    try:
+        for line in _MEMINFO.read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def reference_peak_bytes(nv: int, njoints: int) -> int:
+    """Peak memory of building a :class:`~rt70.reference.ReferenceModel`, bytes.
+
+    Three ``Data`` (two kept, one transient) of four ``nv³`` float64 tensors each are
+    ``96 nv³``; a least-squares fit of the measured peaks (nv = 100 … 350) gives
+    ``98.5 nv³ − 62 nv² + 12.7 MB``. The estimate rounds the cubic term up to ``100 nv³``
+    and adds the ``nv²`` matrices (about 40 per ``Data``), ``6 nv`` per joint
+    (``Fcrb``) and a constant for Pinocchio's model: measured peaks of chains of
+    revolute, planar and floating joints (nv = 25 … 350) lie 1–45 % below it.
+    """
+    return 100 * nv**3 + 1000 * nv**2 + 150 * nv * njoints + 4_000_000
+
+
+def textbook_peak_bytes(nb: int, n_full: int) -> int:
+    """Peak memory of the dense textbook algorithms on a fresh :class:`Data`, bytes.
+
+    ``8 (144 nb² + 24 nb n + 4 n²)``: four arrays the size of L or Θ (6 nb × 6 nb), four
+    the size of S (n × 6 nb) and four of A (n × n). It lies 10–30 % above the measured
+    peaks of every dense function of :mod:`rt70.textbook` on chains of revolute and
+    floating joints.
+    """
+    return 8 * (144 * nb**2 + 24 * nb * n_full + 4 * n_full**2)
+
+
+def pinocchio_size(desc: RobotDescription) -> tuple[int, int]:
+    """``(nv, njoints)`` of the model Pinocchio's URDF parser will build from ``desc``.
+
+    Every non-fixed joint is a Pinocchio joint (mimic joints included); ``njoints``
+    counts the universe.
+    """
+    moving = [j for j in desc.joints if j.type != "fixed"]
+    return sum(_DOFS.get(j.type, 1) for j in moving), len(moving) + 1
+
+
+def tree_depth(desc: RobotDescription) -> int:
+    """Number of links on the longest path from the root (the root counts 1)."""
+    parent = {j.child: j.parent for j in desc.joints}
+    depth = {desc.root: 1}
+    for link in desc.links:
+        path = []
+        while link not in depth:  # the reader guarantees a tree: this ends at the root
+            path.append(link)
+            link = parent[link]
+        d = depth[link]
+        for up in reversed(path):
+            d += 1
+            depth[up] = d
+    return max(depth.values())
+
+
+def check_memory(needed: int, what: str, source: str, available: int | None = None) -> None:
+    """Raise :class:`ResourceError` if ``needed`` bytes exceed the share this run may use.
+
+    ``available`` defaults to :func:`available_memory`; where that is unknown nothing is
+    checked.
+    """
+    available = available_memory() if available is None else available
+    if available is None:
+        return
+    budget = MEMORY_FRACTION * available
+    if needed > budget:
+        raise ResourceError(
+            f"{source}: {what} would need about {_gb(needed)} of memory; this run may use "
+            f"{_gb(budget)} ({MEMORY_FRACTION:.0%} of the {_gb(available)} available)"
+        )
+
+
+def check_reference(desc: RobotDescription) -> None:
+    """Refuse a model Pinocchio cannot parse (tree depth) or this machine cannot hold."""
+    depth = tree_depth(desc)
+    if depth > PARSER_MAX_DEPTH:
+        raise ResourceError(
+            f"{desc.source}: kinematic tree {depth} links deep; Pinocchio's URDF parser "
+            f"recurses once per level and is only run on trees up to {PARSER_MAX_DEPTH}"
+        )
+    nv, njoints = pinocchio_size(desc)
+    check_memory(
+        reference_peak_bytes(nv, njoints),
+        f"Pinocchio's model and data for {nv} coordinates (nv³-sized tensors)",
+        desc.source,
+    )
+
+
+def check_textbook(nb: int, n_full: int, source: str) -> None:
+    """Refuse a textbook model whose dense matrices this machine cannot hold."""
+    check_memory(
+        textbook_peak_bytes(nb, n_full),
+        f"the textbook side's dense matrices for {nb} bodies ({6 * nb} × {6 * nb})",
+        source,
+    )
+
+
+def run_with_stack(fn: Callable[[], T], stack_bytes: int = PARSER_STACK_BYTES) -> T:
+    """Call ``fn()`` in a thread with a ``stack_bytes`` stack; return or raise its outcome."""
+    outcome: list = []
+
+    def target() -> None:
+        try:
+            outcome.append((True, fn()))
+        except BaseException as exc:  # re-raised in the caller's thread below
+            outcome.append((False, exc))
+
+    previous = threading.stack_size(stack_bytes)
+    try:
+        thread = threading.Thread(target=target, name="rt70-pinocchio-parser")
+        thread.start()
+    finally:
+        threading.stack_size(previous)
+    thread.join()
+    ok, value = outcome[0]
+    if not ok:
+        raise value
+    return value
+
+
+def _gb(n: float) -> str:
+    return f"{n / 1e9:.3g} GB"
