@@ -22,7 +22,7 @@ import sys
 import warnings
 
 from rt70 import options
-from rt70.errors import Rt70Error, Rt70Warning, SingularConfigurationError
+from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
 EXIT_TERMINATED = 128 + signal.SIGTERM
@@ -179,14 +179,19 @@ def _simulate(args: argparse.Namespace) -> int:
     from rt70.simulate import simulate
 
     scene = load_scene(args.scene)
-    result = simulate(
-        scene,
-        (0.0, args.t_end),
-        backend=args.backend,
-        method=args.method,
-        rtol=args.rtol,
-        progress=args.progress or sys.stderr.isatty(),
-    )
+    try:
+        result = simulate(
+            scene,
+            (0.0, args.t_end),
+            backend=args.backend,
+            method=args.method,
+            rtol=args.rtol,
+            progress=args.progress or sys.stderr.isatty(),
+        )
+    except ResourceError as exc:  # Pinocchio's Data too large: the textbook side may do
+        if args.backend != "pinocchio":
+            raise
+        raise ResourceError(f"{exc}; '--backend textbook' does without Pinocchio") from None
     print(
         f"{scene.name}: {args.method} ({args.backend}), rtol {args.rtol:g}, "
         f"0 … {args.t_end:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"

@@ -143,6 +143,8 @@ def check_outputs(args: argparse.Namespace) -> None:
     OutputError
         Naming the path and the reason.
     """
+    if args.command == "simulate" and args.out == "":
+        raise OutputError("--out: empty path")
     if args.command == "simulate" and args.out:
         from rt70.simulate import check_output_suffix
 

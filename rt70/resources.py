@@ -6,13 +6,15 @@ Memory
     Pinocchio 4.1's ``Data`` holds four ``nv × nv × nv`` tensors (the second-order
     RNEA derivatives ``d2tau_dqdq`` …, allocated and zeroed whether used or not), so a
     :class:`~rt70.reference.ReferenceModel` — two ``Data`` objects, and a third,
-    transient copy while the Python binding returns the second — peaks at about
+    transient one while the second is created (the measured peak is 1.5 times the
+    final size: a copy on the way to Python) — peaks at about
     ``96 nv³`` bytes: 2.7 GB at nv = 300, about 100 GB at nv = 1000. The textbook side's
     dense ``Data`` (L and Θ are ``6 nb × 6 nb``; the dense algorithms add Φ⁰, Ṡ and
-    products of the same size) peaks at ``O(nb²)``: about 0.4 GB at nb = 600, 27 GB at
-    nb = 5000. :func:`reference_peak_bytes` and :func:`textbook_peak_bytes` are fits of
-    measured peaks (resident set growth in a fresh process), rounded up; a model is
-    refused when its estimate exceeds :data:`MEMORY_FRACTION` of ``MemAvailable``.
+    products of the same size) peaks at ``O(nb²)``: about 0.4 GB at nb = 600 (27 GB at
+    nb = 5000, extrapolated). :func:`reference_peak_bytes` and
+    :func:`textbook_peak_bytes` are fits of measured peaks (growth of the anonymous
+    resident set in a fresh process), rounded up; a model is refused when its estimate
+    exceeds :data:`MEMORY_FRACTION` of ``MemAvailable``.
 Parser depth
     Pinocchio's URDF parser recurses once per level of the kinematic tree, about
     2.2 KiB of stack per level: with the usual 8 MiB stack it segfaults at a depth of
@@ -20,7 +22,7 @@ Parser depth
     thread with a :data:`PARSER_STACK_BYTES` stack (room for about 30 000 levels) and a
     tree deeper than :data:`PARSER_MAX_DEPTH` is refused before the parser sees it.
 
-Only the standard library and numpy are used (the textbook side may import this).
+Nothing here imports Pinocchio.
 """
 
 from __future__ import annotations
@@ -67,10 +69,11 @@ def reference_peak_bytes(nv: int, njoints: int) -> int:
 
     Three ``Data`` (two kept, one transient) of four ``nv³`` float64 tensors each are
     ``96 nv³``; a least-squares fit of the measured peaks (nv = 100 … 350) gives
-    ``98.5 nv³ − 62 nv² + 12.7 MB``. The estimate rounds the cubic term up to ``100 nv³``
+    ``98.5 nv³ − 45 nv² + 11 MB``. The estimate rounds the cubic term up to ``100 nv³``
     and adds the ``nv²`` matrices (about 40 per ``Data``), ``6 nv`` per joint
-    (``Fcrb``) and a constant for Pinocchio's model: measured peaks of chains of
-    revolute, planar and floating joints (nv = 25 … 350) lie 1–45 % below it.
+    (``Fcrb``) and a constant for Pinocchio's model: it lies 5–28 % above the measured
+    peaks of chains of revolute, planar and floating joints with nv = 50 … 350 (twice
+    the peak at nv = 25, where the allocator's granularity dominates).
     """
     return 100 * nv**3 + 1000 * nv**2 + 150 * nv * njoints + 4_000_000
 
@@ -79,9 +82,9 @@ def textbook_peak_bytes(nb: int, n_full: int) -> int:
     """Peak memory of the dense textbook algorithms on a fresh :class:`Data`, bytes.
 
     ``8 (144 nb² + 24 nb n + 4 n²)``: four arrays the size of L or Θ (6 nb × 6 nb), four
-    the size of S (n × 6 nb) and four of A (n × n). It lies 10–30 % above the measured
-    peaks of every dense function of :mod:`rt70.textbook` on chains of revolute and
-    floating joints.
+    the size of S (n × 6 nb) and four of A (n × n). It lies 17–44 % above the measured
+    peaks of every dense function of :mod:`rt70.textbook` on chains of revolute
+    (nb = 100 … 800) and floating joints.
     """
     return 8 * (144 * nb**2 + 24 * nb * n_full + 4 * n_full**2)
 

@@ -53,6 +53,10 @@ def scene_path(target: str | Path) -> Path:
     if Path(target).suffix != ".urdf" and candidate.is_file():
         return candidate
     path = Path(target)
+    if path.is_dir():
+        raise SceneError(f"{target}: is a directory, not a URDF file or a scene name")
+    if path.exists() and not path.is_file():
+        raise SceneError(f"{target}: is not a regular file (a device or a pipe?)")
     if path.suffix == ".urdf" or path.is_file():
         return path
     known = scene_names()

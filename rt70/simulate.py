@@ -352,13 +352,13 @@ def simulate(
         q0, qd0 = x0
     q0 = check_vector("initial state q0", q0, n)
     qd0 = check_vector("initial state qd0", qd0, n)
-    check_euler_pairs(scene.textbook, scene.textbook.expand(q0))  # gimbal lock: named first
-    _check_mass_matrix(scene, side, q0)
     try:
+        check_euler_pairs(scene.textbook, scene.textbook.expand(q0))
+        _check_mass_matrix(scene, side, q0)
         with np.errstate(over="ignore", invalid="ignore"):  # checked just below
             T0, Ug0, Uc0 = side.energies(q0, qd0)
-    except SingularConfigurationError as exc:
-        raise SimulationError(f"{scene.name}: at the initial state: {exc}") from None
+    except SingularConfigurationError as exc:  # same class, with the scene's name
+        raise SingularConfigurationError(f"{scene.name}: at the initial state: {exc}") from None
     if not np.isfinite([T0, Ug0, Uc0]).all():
         raise SimulationError(
             f"{scene.name}: the energy at the initial state overflows (a stiffness or mass "
@@ -422,9 +422,8 @@ def simulate(
         # must not contain infs or NaNs": scipy's difference Jacobian overflowed
         if not isinstance(exc, Rt70Error) and "inf" not in str(exc):
             raise
-        raise SimulationError(
-            f"{scene.name}: integration stopped at t = {reached[0]:.6g} s: {exc}"
-        ) from None
+        kind = type(exc) if isinstance(exc, Rt70Error) else SimulationError
+        raise kind(f"{scene.name}: integration stopped at t = {reached[0]:.6g} s: {exc}") from None
     finally:
         if bar is not None:
             bar.close()
@@ -469,7 +468,8 @@ def simulate(
 def _check_mass_matrix(scene: Scene, side: _Backend, q0: np.ndarray) -> None:
     """Refuse a model whose mass matrix is singular at the initial state.
 
-    A coordinate that moves no mass has a zero diagonal entry; it is named.
+    A coordinate that moves no mass has a zero diagonal entry; it is named. (Euler pairs
+    at gimbal lock are refused before, by ``check_euler_pairs``.)
     """
     A = side.mass_matrix(q0)
     if not np.isfinite(A).all():

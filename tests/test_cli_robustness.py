@@ -134,6 +134,8 @@ def test_cli_refuses_a_model_too_large(monkeypatch, tmp_path, capsys):
     for argv in (["validate", str(path)], ["simulate", str(path)]):
         assert main(argv) == 2
         assert str(path) in one_error_line(capsys.readouterr().err)
+    assert main(["simulate", str(path)]) == 2
+    assert "--backend textbook" in one_error_line(capsys.readouterr().err)
 
 
 _MEASURE = r"""
@@ -306,6 +308,7 @@ def test_bad_outputs_fail_before_the_simulation(tmp_path, no_work, capsys):
         str(tmp_path / "plot.csv"): "plot.png: is a directory",
         str(_read_only_directory(tmp_path) / "run.csv"): "cannot create files",
         str(tmp_path / "file" / "run.csv"): "is not a directory",
+        "": "empty path",
     }
     for out, message in cases.items():
         assert main(["simulate", "double_pendulum", "--out", out]) == 2, out
@@ -497,7 +500,7 @@ def test_simulate_rejects_bad_python_input():
         simulate(scene, (0, 0.1), (np.zeros(3), np.zeros(2)))
     with pytest.raises(NonFiniteError, match="initial state qd0"):
         simulate(scene, (0, 0.1), (np.zeros(2), np.array([0.0, np.inf])))
-    with pytest.raises(SimulationError, match=r"inputs\(t, q, qd\): expected shape \(2,\)"):
+    with pytest.raises(ShapeError, match=r"inputs\(t, q, qd\): expected shape \(2,\)"):
         simulate(scene, (0, 0.1), inputs=lambda t, q, qd: np.zeros(3))
     with pytest.raises(Rt70Error, match="t_eval"):
         simulate(scene, (0, 0.1), t_eval=np.array([0.0, 0.2]))

@@ -188,3 +188,12 @@ def test_validate_from_another_directory(tmp_path):
 def test_samples_below_one_is_refused(two_body):
     with pytest.raises(Rt70Error, match="samples"):
         cross_check(two_body, samples=0)
+
+
+@pytest.mark.parametrize(
+    ("target", "message"), [("/dev/null", "not a regular file"), ("/tmp", "is a directory")]
+)
+def test_special_paths_are_named_as_such(target, message):
+    proc = _run("validate", target)
+    assert proc.returncode == 2 and message in proc.stderr
+    assert proc.stderr.count("\n") == 1
