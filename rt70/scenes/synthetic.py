@@ -53,8 +53,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from rt70.rotations import rpy_matrix, rpy_of_matrix
 from rt70.scenes.generate import _PAIR_JOINTS, fmt, fmt_vec
-from rt70.textbook.spatial import rpy_matrix, rpy_of_matrix
 
 #: Every joint type of the URDF standard, as :func:`random_tree` draws them.
 ALL_JOINT_TYPES = ("revolute", "prismatic", "fixed", "continuous", "floating", "planar")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from rt70.errors import SingularConfigurationError
+from rt70.rotations import c1, c2, c3, rpy_matrix, rpy_of_matrix  # noqa: F401 (the book's (1.23))
 
 #: Gimbal-lock threshold: configurations with ``|cos θ|`` below this raise
 #: :class:`~rt70.errors.SingularConfigurationError` wherever Euler-angle rates are needed.
@@ -43,40 +44,9 @@ def skew(x: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
 
 
-def c1(beta: float) -> np.ndarray:
-    """Elementary rotation about x, (1.23)."""
-    c, s = np.cos(beta), np.sin(beta)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def c2(theta: float) -> np.ndarray:
-    """Elementary rotation about y, (1.23)."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def c3(alpha: float) -> np.ndarray:
-    """Elementary rotation about z, (1.23)."""
-    c, s = np.cos(alpha), np.sin(alpha)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def euler123(phi: np.ndarray) -> np.ndarray:
     """Rotation ``c = c1(β) c2(θ) c3(α)`` of the 1–2–3 sequence, ``phi = [β, θ, α]``."""
     return c1(phi[0]) @ c2(phi[1]) @ c3(phi[2])
-
-
-def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
-    """Rotation of a URDF ``rpy`` origin: ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-    return c3(rpy[2]) @ c2(rpy[1]) @ c1(rpy[0])
-
-
-def rpy_of_matrix(rot: np.ndarray) -> np.ndarray:
-    """URDF ``rpy`` of a rotation matrix (the inverse of :func:`rpy_matrix`)."""
-    pitch = np.arctan2(-rot[2, 0], np.hypot(rot[0, 0], rot[1, 0]))
-    roll = np.arctan2(rot[2, 1], rot[2, 2])
-    yaw = np.arctan2(rot[1, 0], rot[0, 0])
-    return np.array([roll, pitch, yaw])
 
 
 def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:

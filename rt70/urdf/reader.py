@@ -25,7 +25,7 @@ from rt70.errors import (
     UrdfError,
     XacroError,
 )
-from rt70.textbook.spatial import rpy_matrix, rpy_of_matrix
+from rt70.rotations import rpy_matrix, rpy_of_matrix
 from rt70.urdf.description import (
     URDF_JOINT_TYPES,
     Bushing,

@@ -1,0 +1,101 @@
+"""Who may import whom (docs/architecture.md): the layers as an import graph, checked.
+
+The two sides of the cross-check stay independent only if the import graph says so:
+``rt70/urdf/`` (the reader) imports nothing of the textbook side nor of the reference
+side; ``rt70/textbook/`` never imports the reference side (nor Pinocchio, see
+tests/test_independence.py); both may use the shared math below them
+(``rt70.rotations``) and the small helpers every layer uses (``rt70.errors``,
+``rt70.arrays``). Every import is found statically, at any depth (inside functions too).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "rt70"
+
+#: Modules below both sides that any layer may import.
+SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations")
+
+#: layer (module prefix) → module prefixes it may import from rt70.
+RULES = {
+    "rt70.urdf": ("rt70.urdf", *SHARED),
+    "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
+    "rt70.rotations": (),
+    "rt70.errors": (),
+    "rt70.arrays": ("rt70.errors",),
+}
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path: Path) -> set[str]:
+    """Every rt70 module imported by ``path`` (absolute and relative, at any depth)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                own = _module_name(path).split(".")
+                base = own if path.name == "__init__.py" else own[:-1]
+                base = base[: len(base) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module or ""
+            found.add(module)
+    return {m for m in found if m == "rt70" or m.startswith("rt70.")}
+
+
+MODULES = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _layer(module: str) -> str | None:
+    for layer in RULES:
+        if module == layer or module.startswith(layer + "."):
+            return layer
+    return None
+
+
+def _allowed(layer: str, imported: str) -> bool:
+    return any(imported == a or imported.startswith(a + ".") for a in RULES[layer])
+
+
+def test_graph_is_found():
+    assert "rt70.urdf.reader" in MODULES and "rt70.textbook.dynamics" in MODULES
+    assert "rt70.rotations" in _imports(MODULES["rt70.urdf.reader"])
+
+
+@pytest.mark.parametrize("module", [m for m in MODULES if _layer(m)])
+def test_layer_imports_only_what_it_may(module):
+    layer = _layer(module)
+    bad = sorted(m for m in _imports(MODULES[module]) if not _allowed(layer, m))
+    assert not bad, f"{module} ({layer}) imports {bad}; allowed: {RULES[layer]}"
+
+
+def test_detector_sees_nested_imports(tmp_path):
+    sample = tmp_path / "sample.py"
+    sample.write_text(
+        "import numpy\n"
+        "def f():\n"
+        "    from rt70.textbook.spatial import rpy_matrix\n"
+        "    import rt70.reference as ref\n"
+    )
+    assert _imports(sample) == {"rt70.textbook.spatial", "rt70.reference"}
+    assert not _allowed("rt70.urdf", "rt70.textbook.spatial")
+    assert not _allowed("rt70.textbook", "rt70.reference")
+
+
+def test_reader_knows_no_textbook():
+    """The example the rules exist for: the reader once imported textbook.spatial."""
+    for module, path in MODULES.items():
+        if module.startswith("rt70.urdf"):
+            assert not any(m.startswith("rt70.textbook") for m in _imports(path)), module
