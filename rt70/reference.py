@@ -35,7 +35,8 @@ from rt70.errors import Rt70Error, Rt70Warning, SingularConfigurationError, Urdf
 from rt70.resources import check_reference, run_with_stack
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
-from rt70.urdf.reader import balanced_text, prepare_text
+from rt70.urdf.inertia import balanced_text
+from rt70.urdf.text import prepare_text
 
 #: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
 GIMBAL_LOCK_COS = 1e-8

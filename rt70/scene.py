@@ -15,7 +15,8 @@ from rt70.textbook.data import Data
 from rt70.textbook.massless import check_moves_mass
 from rt70.textbook.model import Model, build_model
 from rt70.urdf import RobotDescription, coordinate_names, read_urdf_string
-from rt70.urdf.reader import balanced_text, prepare_text, read_source
+from rt70.urdf.inertia import balanced_text
+from rt70.urdf.text import prepare_text, read_source
 
 
 def _scene_dir() -> Path:
@@ -73,7 +74,7 @@ class Scene:
     :func:`rt70.urdf.coordinate_names`): ``scene.reference.mass_matrix(q)`` and
     ``dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)`` compare directly.
     ``text`` is what both sides read: the file's text as normalised by
-    :func:`rt70.urdf.reader.prepare_text`, with the inertias repaired on request written
+    :func:`rt70.urdf.text.prepare_text`, with the inertias repaired on request written
     in (:func:`load_scene`).
     """
 
@@ -120,7 +121,7 @@ def load_scene(target: str | Path, balance_inertia: bool = False) -> Scene:
     """Read a scene by name or path (see :func:`scene_path`), validating the URDF.
 
     With ``balance_inertia`` the impossible rotational inertias of moving links are
-    repaired (:func:`rt70.urdf.reader.balanced_moments`) instead of refused, the same on
+    repaired (:func:`rt70.urdf.inertia.balanced_moments`) instead of refused, the same on
     both sides: the repaired values are written into the text Pinocchio parses.
     """
     path = scene_path(target)

@@ -6,21 +6,17 @@ starts with the source file, so the command line can print it as one readable li
 
 from __future__ import annotations
 
-import warnings
 import xml.etree.ElementTree as ET
-import xml.parsers.expat
 from pathlib import Path
 
 import numpy as np
 
 from rt70.errors import (
-    DtdError,
     ExtensionError,
     InertiaError,
     JointTypeError,
     MagnitudeError,
     NonFiniteError,
-    Rt70Warning,
     TopologyError,
     UrdfError,
     XacroError,
@@ -39,9 +35,16 @@ from rt70.urdf.description import (
     OpticalPoint,
     RobotDescription,
 )
-
-#: XML namespace of the rt70 extension elements (docs/urdf-extensions.md).
-RT70_NS = "urn:rt70:urdf-extensions:1"
+from rt70.urdf.inertia import balanced_moments, inertia_defect, principal_moments
+from rt70.urdf.text import (
+    EXPAND_XACRO,
+    RT70_NS,
+    prepare_text,
+    read_source,
+    refuse_entities,
+    refuse_xacro,
+    warn,
+)
 
 #: Joint types rt70 models on both sides (the others are rejected with a clear error).
 SUPPORTED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -54,22 +57,8 @@ ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
 #: any term of the equations of motion multiplies, so no evaluation can overflow.
 MAX_MAGNITUDE = 1e30
 
-#: Principal moments are checked to this fraction of the largest one (rounding of eigvalsh).
-INERTIA_RTOL = 1e-9
-
 _EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point")
 _ZERO3 = np.zeros(3)
-
-
-def read_source(path: str | Path) -> str:
-    """The text of a URDF file, or a :class:`~rt70.errors.UrdfError` naming the file."""
-    path = Path(path)
-    try:
-        return path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UrdfError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UrdfError(f"{path}: cannot read file ({exc})") from None
 
 
 def read_urdf(path: str | Path, balance_inertia: bool = False) -> RobotDescription:
@@ -105,151 +94,16 @@ def read_urdf_string(
     :class:`~rt70.errors.XacroError`) before anything else is read.
     """
     text = prepare_text(text, source)
-    _refuse_entities(text, source)
+    refuse_entities(text, source)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         if "unbound prefix" in str(exc) and "xacro:" in text:
             raise XacroError(
-                f"{source}: xacro elements without the xacro namespace ({exc}): {_EXPAND}"
+                f"{source}: xacro elements without the xacro namespace ({exc}): {EXPAND_XACRO}"
             ) from None
         raise UrdfError(f"{source}: malformed XML: {exc}") from None
     return _Reader(source, balance_inertia).robot(root)
-
-
-def warn(message: str) -> None:
-    """Issue ``message`` as an :class:`~rt70.errors.Rt70Warning` (one line)."""
-    warnings.warn(Rt70Warning(message), stacklevel=2)
-
-
-def prepare_text(text: str, source: str = "<string>") -> str:
-    """The URDF text as both sides read it (Pinocchio is handed this text too).
-
-    A byte-order mark is dropped. Whitespace before the ``<?xml`` declaration (which XML
-    forbids, Pinocchio's TinyXML-based parser skips) and NUL characters after the
-    document (where a C parser stops reading) are removed with an
-    :class:`~rt70.errors.Rt70Warning`. Idempotent.
-
-    Raises
-    ------
-    UrdfError
-        If a NUL character is followed by anything but NULs and whitespace.
-    """
-    text = text.removeprefix("\ufeff")
-    nul = text.find("\x00")
-    if nul >= 0:
-        if text[nul:].strip("\x00 \t\r\n"):
-            line = text.count("\n", 0, nul) + 1
-            raise UrdfError(f"{source}: malformed XML: NUL character in the document, line {line}")
-        text = text[:nul]
-        warn(f"{source}: NUL characters after the document ignored")
-    stripped = text.lstrip()
-    if len(stripped) < len(text) and stripped.startswith("<?xml"):
-        warn(f"{source}: whitespace before the XML declaration '<?xml' ignored")
-        text = stripped
-    return text
-
-
-#: How to turn a xacro template into a URDF.
-_EXPAND = (
-    "this is a xacro template, not a URDF: expand it with xacro first (xacro FILE > FILE.urdf)"
-)
-
-
-def _refuse_entities(text: str, source: str) -> None:
-    """Raise :class:`~rt70.errors.DtdError` if the document declares DTD entities.
-
-    Python's XML parser expands internal entities; Pinocchio's (TinyXML) does not, so
-    the two sides of the cross-check would read different numbers.
-    """
-    if "<!DOCTYPE" not in text:
-        return
-    parser = xml.parsers.expat.ParserCreate()
-    declared: list[str] = []
-
-    def entity(name, is_parameter, *_) -> None:
-        declared.append(("%" if is_parameter else "") + name)
-        raise _EntityFound
-
-    parser.EntityDeclHandler = entity
-    try:
-        parser.Parse(text, True)
-    except (_EntityFound, xml.parsers.expat.ExpatError):
-        pass  # malformed XML is reported by the main parse
-    if declared:
-        raise DtdError(
-            f"{source}: <!ENTITY {declared[0]}> in <!DOCTYPE>: DTD entities are not supported "
-            "(rt70's reader would expand them, Pinocchio's parser does not, so the two sides "
-            "would read different models): expand them first (xmllint --noent --dropdtd FILE)"
-        )
-
-
-class _EntityFound(Exception):
-    """Stops the entity scan at the first declaration."""
-
-
-def principal_moments(tensor: np.ndarray) -> np.ndarray:
-    """Principal moments of a rotational inertia, ascending."""
-    return np.linalg.eigvalsh(tensor)
-
-
-def inertia_defect(tensor: np.ndarray) -> str | None:
-    """Why a non-zero rotational inertia is impossible, or None if it is a rigid body's.
-
-    It must be positive definite and its principal moments must satisfy the triangle
-    inequality ``I₁ + I₂ ≥ I₃`` (to :data:`INERTIA_RTOL` of the largest moment).
-    """
-    moments = principal_moments(tensor)
-    scale = max(float(np.max(np.abs(moments))), np.finfo(float).tiny)
-    if moments[0] <= 0.0:
-        listed = ", ".join(f"{m:.6g}" for m in moments)
-        return f"inertia tensor not positive definite (principal moments {listed})"
-    if moments[2] > moments[0] + moments[1] + INERTIA_RTOL * scale:
-        return (
-            f"principal moment {moments[2]:.6g} exceeds the sum of the other "
-            f"two ({moments[0]:.6g} + {moments[1]:.6g}): triangle inequality violated"
-        )
-    return None
-
-
-def balanced_moments(tensor: np.ndarray) -> np.ndarray | None:
-    """The repair of an impossible rotational inertia: its mean principal moment times 1.
-
-    This is MuJoCo's ``<compiler balanceinertia="true">`` rule ("a valid diagonal inertia
-    matrix must satisfy A+B>=C for all permutations of the three diagonal elements ...
-    the compiler will silently set all three diagonal elements to their average value
-    whenever the above condition is violated", MuJoCo XML reference, compiler/
-    balanceinertia), applied to the principal moments and, in rt70, to every tensor
-    :func:`inertia_defect` refuses (a negative moment always breaks the triangle
-    inequality; a zero one, a rod, is refused by rt70 too). The trace — the sum of the
-    moments, ``2 ∫ |r|² dm`` — is kept; the tensor becomes isotropic, so the frame of
-    ``<inertial><origin rpy>`` no longer matters. Returns None when the trace is not
-    positive (nothing to balance).
-    """
-    mean = float(np.trace(tensor)) / 3.0
-    if not mean > 0.0:
-        return None
-    return np.full(3, mean)
-
-
-def balanced_text(text: str, repairs: list[InertiaRepair]) -> str:
-    """``text`` with each repaired link's ``<inertia>`` replaced by its balanced moments.
-
-    The balanced tensor is isotropic (:func:`balanced_moments`), so it is written as
-    ``ixx = iyy = izz``, products zero, whatever the ``<inertial><origin rpy>``: reading
-    the result gives exactly the repaired description. This is the text handed to
-    Pinocchio, so both sides read the same inertias. Comments and the XML declaration
-    are not kept.
-    """
-    ET.register_namespace("rt70", RT70_NS)
-    root = ET.fromstring(text)
-    links = {elem.get("name"): elem for elem in root.findall("link")}
-    for repair in repairs:
-        inertia = links[repair.link].find("inertial").find("inertia")
-        values = (*repair.new_moments, 0.0, 0.0, 0.0)
-        for key, value in zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), values, strict=True):
-            inertia.set(key, repr(float(value)))
-    return ET.tostring(root, encoding="unicode")
 
 
 class _Reader:
@@ -313,24 +167,8 @@ class _Reader:
         return self.numbers(o, "xyz", 3, _ZERO3, owner), self.numbers(o, "rpy", 3, _ZERO3, owner)
 
     # --- the document --------------------------------------------------------------
-    def refuse_xacro(self, root: ET.Element) -> None:
-        """Raise :class:`~rt70.errors.XacroError` at the first xacro element or substitution.
-
-        A xacro namespace declaration alone is no xacro: expanded files keep it.
-        """
-        for elem in root.iter():
-            if _is_xacro(elem.tag):
-                raise self.fail(XacroError, f"<{_qualified(elem.tag)}>: xacro element: {_EXPAND}")
-            for key, value in elem.attrib.items():
-                if _is_xacro(key) or "${" in value or "$(" in value:
-                    raise self.fail(
-                        XacroError,
-                        f'<{_qualified(elem.tag)} {_qualified(key)}="{value}">: xacro '
-                        f"substitution: {_EXPAND}",
-                    )
-
     def robot(self, root: ET.Element) -> RobotDescription:
-        self.refuse_xacro(root)
+        refuse_xacro(root, self.source)
         if root.tag != "robot":
             raise self.fail(UrdfError, f"root element is <{root.tag}>, expected <robot>")
         links: dict[str, Link] = {}
@@ -669,21 +507,6 @@ class _Reader:
         if not struts:
             raise self.fail(ExtensionError, f"{where} has no <rt70:strut>")
         return struts
-
-
-def _is_xacro(name: str) -> bool:
-    """Whether an element or attribute name is in a xacro namespace (``…/xacro``)."""
-    return name.startswith("{") and name[1 : name.find("}")].rstrip("/").endswith("xacro")
-
-
-def _qualified(name: str) -> str:
-    """``{uri}local`` as ``xacro:local``/``rt70:local`` (other URIs kept), else ``name``."""
-    if not name.startswith("{"):
-        return name
-    uri, local = name[1:].split("}", 1)
-    if _is_xacro(name):
-        return f"xacro:{local}"
-    return f"rt70:{local}" if uri == RT70_NS else name
 
 
 def _rigid_bodies(links: dict[str, Link], joints: list[Joint], root: str) -> dict[str, str]:
