@@ -3,9 +3,10 @@
 The two sides of the cross-check stay independent only if the import graph says so:
 ``rt70/urdf/`` (the reader) imports nothing of the textbook side nor of the reference
 side; ``rt70/textbook/`` never imports the reference side (nor Pinocchio, see
-tests/test_independence.py); both may use the shared math below them
-(``rt70.rotations``) and the small helpers every layer uses (``rt70.errors``,
-``rt70.arrays``). Every import is found statically, at any depth (inside functions too).
+tests/test_independence.py) and the reference side never imports the textbook; both
+may use the shared math below them (``rt70.rotations``) and the small helpers every
+layer uses (``rt70.errors``, ``rt70.arrays``). Every import is found statically, at
+any depth (inside functions too).
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations")
 RULES = {
     "rt70.urdf": ("rt70.urdf", *SHARED),
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
+    "rt70.reference": ("rt70.urdf", "rt70.resources", *SHARED),
+    "rt70.resources": ("rt70.urdf.description", *SHARED),
     "rt70.rotations": (),
     "rt70.errors": (),
     "rt70.arrays": ("rt70.errors",),
