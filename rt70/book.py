@@ -18,7 +18,8 @@ import scipy.linalg
 
 from rt70.atomic import atomic_write, atomic_write_text
 from rt70.linear import linearize as lin
-from rt70.linear import modal, topology, tree_invariant
+from rt70.linear import modal, responses, topology, tree_invariant
+from rt70.plotting.modal import plot_bode
 from rt70.scene import Scene, load_scene
 from rt70.scenes import rt70_data
 
@@ -384,7 +385,7 @@ def damping_section() -> tuple[str, float]:
     omega1 = damped.omega[first]
     v = damped.shapes[:, first]
     # principal coordinate of the first elastic mode: z̈ + 2ξΩ ż + Ω² z = vᵀ Q
-    ss = modal.state_space(
+    ss = responses.state_space(
         np.eye(1),
         np.array([[omega1**2]]),
         np.array([[2 * damped.zeta[first] * omega1]]),
@@ -393,10 +394,10 @@ def damping_section() -> tuple[str, float]:
     )
     f1 = omega1 / (2 * np.pi)
     grid = np.concatenate([[1e-4 * f1], np.linspace(0.9 * f1, 1.1 * f1, 20001)])
-    fr = modal.frequency_response(ss, grid)
+    fr = responses.frequency_response(ss, grid)
     mag = fr.magnitude_db[:, 0, 0]
     at_resonance = float(
-        modal.frequency_response(ss, np.array([f1])).magnitude_db[0, 0, 0] - mag[0]
+        responses.frequency_response(ss, np.array([f1])).magnitude_db[0, 0, 0] - mag[0]
     )
     peak = float(mag[1:].max() - mag[0])
     text = f"""## Damping: ξ = 0.05 gives +20 dB at the first resonance (§2.3)
@@ -616,7 +617,7 @@ def _bode_plot(path: Path) -> None:
     B[names.index("base"), 0] = 1.0
     C = np.zeros((1, model.n))
     C[0, names.index("main_mirror")] = 1.0
-    ss = modal.state_space(model.m, model.C, D, B, C)
-    fr = modal.frequency_response(ss, np.logspace(-0.5, 1.7, 800))
-    fig = modal.plot_bode(fr, 0, 0, label="main mirror angle / torque on the base")
+    ss = responses.state_space(model.m, model.C, D, B, C)
+    fr = responses.frequency_response(ss, np.logspace(-0.5, 1.7, 800))
+    fig = plot_bode(fr, 0, 0, label="main mirror angle / torque on the base")
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110))

@@ -212,7 +212,7 @@ def _simulate(args: argparse.Namespace) -> int:
         out = Path(args.out)
         writers = {out: result.writer(out)}
         if not args.no_plot:
-            from rt70.plots import simulation_figure
+            from rt70.plotting.simulation import simulation_figure
 
             fig = simulation_figure(result)
             writers[out.with_suffix(".png")] = lambda tmp: fig.savefig(tmp, dpi=110)

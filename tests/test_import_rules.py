@@ -7,11 +7,17 @@ tests/test_independence.py) and the reference side never imports the textbook; b
 may use the shared math below them (``rt70.rotations``) and the small helpers every
 layer uses (``rt70.errors``, ``rt70.arrays``). Every import is found statically, at
 any depth (inside functions too).
+
+Drawing is apart from the analyses: matplotlib is imported by ``rt70/plotting/`` (and
+the reports, notebooks and tests that draw), never by the core — checked by importing
+the core in a fresh interpreter.
 """
 
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -102,3 +108,37 @@ def test_reader_knows_no_textbook():
     for module, path in MODULES.items():
         if module.startswith("rt70.urdf"):
             assert not any(m.startswith("rt70.textbook") for m in _imports(path)), module
+
+
+#: Core modules that must load without matplotlib (the figures are in rt70.plotting).
+NO_MATPLOTLIB = (
+    "rt70.linear.modal",
+    "rt70.linear.responses",
+    "rt70.simulate",
+    "rt70.validate",
+    "rt70.scene",
+)
+
+
+def test_core_does_not_import_matplotlib():
+    """The analyses compute; rt70.plotting draws. Importing the core loads no matplotlib."""
+    code = (
+        "import sys\n"
+        + "".join(f"import {m}\n" for m in NO_MATPLOTLIB)
+        + "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]", f"{NO_MATPLOTLIB} imported {proc.stdout.strip()}"
+
+
+def test_plotting_is_where_matplotlib_is():
+    """The check above can fail: the plotting package does load matplotlib."""
+    code = "import sys\nimport rt70.plotting.modal\nprint('matplotlib' in sys.modules)\n"
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "True"

@@ -98,7 +98,7 @@ def test_unknown_coordinate_is_a_clear_error(rt70):
 
 def test_inputs_and_outputs_of_the_rt70(rt70):
     """Drive torque in, mirror focus out: B and C from the textbook Jacobians, checked."""
-    from rt70.linear import modal
+    from rt70.linear import responses
 
     held = lin.rt70_pointing(60.0)
     q0 = lin.equilibrium(rt70, held)
@@ -127,5 +127,5 @@ def test_inputs_and_outputs_of_the_rt70(rt70):
     moved = focus_position(q1) - focus_position(q0)
     assert np.allclose(C @ dq, moved, rtol=1e-5, atol=1e-10)  # θ² r / 2 ≈ 1e-11 is second order
     # a state-space model from the drive torque to the focus displacement
-    ss = modal.state_space(lm.M, lm.K, lm.D, b, C)
+    ss = responses.state_space(lm.M, lm.K, lm.D, b, C)
     assert ss.A.shape == (2 * len(lm.coordinates),) * 2 and ss.C.shape[0] == 3

@@ -1,4 +1,7 @@
-"""Modal analysis, principal coordinates, state space and responses (rt70.linear.modal)."""
+"""Modal analysis, principal coordinates, state space and responses, and their figures.
+
+(rt70.linear.modal, rt70.linear.responses, rt70.plotting.modal)
+"""
 
 import matplotlib
 
@@ -9,7 +12,8 @@ import pytest
 from matplotlib.figure import Figure
 
 from rt70.errors import Rt70Error
-from rt70.linear import modal
+from rt70.linear import modal, responses
+from rt70.plotting import modal as plots
 
 # --- the RT-70 elevation model of chapter 2 (rt70-data.md §B), built here with numpy ---
 
@@ -204,7 +208,7 @@ def test_state_space_matrices():
     M, K = elevation()
     D, _ = modal.stiffness_proportional_damping(K, modal.modes(M, K))
     B_in = np.eye(6)[:, [0]]
-    ss = modal.state_space(M, K, D, B_in, np.eye(6)[[2, 5]], output_names=["mirror", "cr"])
+    ss = responses.state_space(M, K, D, B_in, np.eye(6)[[2, 5]], output_names=["mirror", "cr"])
     Minv = np.diag(1 / I_ELEV)
     np.testing.assert_allclose(ss.A[6:, :6], -Minv @ K, rtol=1e-14)
     np.testing.assert_allclose(ss.A[6:, 6:], -Minv @ D, rtol=1e-14)
@@ -214,7 +218,7 @@ def test_state_space_matrices():
     assert ss.state_names[0] == "q1" and ss.state_names[6] == "q1_dot"
     assert ss.output_names == ("mirror", "cr") and ss.input_names == ("u1",)
     # eigenvalues of A: ±jω for the undamped model
-    ss0 = modal.state_space(M, K, None, B_in, np.eye(6)[0])
+    ss0 = responses.state_space(M, K, None, B_in, np.eye(6)[0])
     lam = np.sort(np.abs(np.linalg.eigvals(ss0.A).imag))[::2]
     np.testing.assert_allclose(lam[1:], modal.modes(M, K).omega[1:], rtol=1e-9)
 
@@ -225,10 +229,10 @@ def test_second_and_first_order_responses_agree():
     D = D + np.diag([0, 0, 0, 0, 0, 30.0])  # and some non-proportional damping
     B_in = np.eye(6)[:, [0, 2]]
     C_out, C_vel = np.eye(6)[[2, 5]], np.eye(6)[[5, 0]]
-    ss = modal.state_space(M, K, D, B_in, C_out, C_vel)
+    ss = responses.state_space(M, K, D, B_in, C_out, C_vel)
     f = np.geomspace(0.1, 40.0, 300)
-    fr2 = modal.frequency_response(ss, f)
-    fr1 = modal.frequency_response(ss, f, method="state_space")
+    fr2 = responses.frequency_response(ss, f)
+    fr1 = responses.frequency_response(ss, f, method="state_space")
     assert fr2.method == "second_order" and fr1.method == "state_space"
     assert fr2.H.shape == (300, 2, 2)
     np.testing.assert_allclose(fr1.H, fr2.H, rtol=1e-8, atol=1e-8 * np.abs(fr2.H).max())
@@ -241,21 +245,21 @@ def test_modal_state_space_matches_full_and_truncates():
     md = modal.modes(M, K, D)
     B_in, C_out = np.eye(6)[:, [0]], np.eye(6)[[2]]
     f = np.geomspace(0.5, 30.0, 200)
-    full = modal.frequency_response(modal.state_space(M, K, D, B_in, C_out), f)
-    ms = modal.modal_state_space(md, B_in, C_out)
+    full = responses.frequency_response(responses.state_space(M, K, D, B_in, C_out), f)
+    ms = responses.modal_state_space(md, B_in, C_out)
     assert ms.n_states == 12 and ms.state_names[0] == "z1"
-    mod = modal.frequency_response(ms, f)
+    mod = responses.frequency_response(ms, f)
     np.testing.assert_allclose(mod.H, full.H, rtol=1e-9)
-    mod1 = modal.frequency_response(ms, f, method="state_space")
+    mod1 = responses.frequency_response(ms, f, method="state_space")
     np.testing.assert_allclose(mod1.H, full.H, rtol=1e-9)
     # truncation to the lowest 4 modes (rigid, 3.27, 4.24, 6.30 Hz) keeps the response
     # below 5 Hz to 0.5 %; 3 modes do not (mode 4 carries 8 % at 3 Hz)
-    tr = modal.modal_state_space(md, B_in, C_out, n_modes=4)
+    tr = responses.modal_state_space(md, B_in, C_out, n_modes=4)
     assert tr.n_states == 8
     low = f < 5.0
-    np.testing.assert_allclose(modal.frequency_response(tr, f[low]).H, full.H[low], rtol=5e-3)
+    np.testing.assert_allclose(responses.frequency_response(tr, f[low]).H, full.H[low], rtol=5e-3)
     with pytest.raises(Rt70Error):
-        modal.modal_state_space(md, B_in, C_out, n_modes=0)
+        responses.modal_state_space(md, B_in, C_out, n_modes=0)
 
 
 # ---------------------------------------------------------------------------- responses
@@ -267,11 +271,11 @@ def test_oscillator_resonance_peak_is_20_db():
     book's "+20 dB at the first resonance"; both are checked on the computed response."""
     zeta, Omega = 0.05, 2.0 * np.pi * 1.5
     M, K, D = oscillator(Omega, zeta)
-    ss = modal.state_space(M, K, D, [1.0], [1.0])
+    ss = responses.state_space(M, K, D, [1.0], [1.0])
     f_res = Omega / (2 * np.pi)
     f = np.concatenate([[0.0], np.linspace(0.9 * f_res, 1.1 * f_res, 20001), [f_res]])
     for method in ("second_order", "state_space"):
-        db = modal.frequency_response(ss, f, method=method).magnitude_db[:, 0, 0]
+        db = responses.frequency_response(ss, f, method=method).magnitude_db[:, 0, 0]
         static = db[0]
         assert static == pytest.approx(20 * np.log10(1 / K[0, 0]), abs=1e-12)
         assert db[-1] - static == pytest.approx(20 * np.log10(1 / (2 * zeta)), abs=1e-9)
@@ -281,7 +285,7 @@ def test_oscillator_resonance_peak_is_20_db():
         assert abs(peak - 20.0) <= 0.05
         f_peak = f[1:-1][db[1:-1].argmax()]
         assert f_peak == pytest.approx(f_res * np.sqrt(1 - 2 * zeta**2), abs=2e-5 * f_res)
-    fr = modal.frequency_response(ss, [0.0, f_res, 100 * f_res])
+    fr = responses.frequency_response(ss, [0.0, f_res, 100 * f_res])
     np.testing.assert_allclose(fr.phase_deg[:, 0, 0], [0.0, -90.0, -180.0], atol=0.1)
 
 
@@ -293,17 +297,17 @@ def test_rt70_first_resonance_with_book_damping():
     assert md.zeta[1] == pytest.approx(0.05, rel=1e-12)
     # principal coordinate z_1 alone: z̈_1 + (VᵀDV)_11 ż_1 + Ω1² z_1 = u
     Omega2, Z = modal.principal_coordinates(M, K, D, md)
-    ss = modal.state_space([[1.0]], Omega2[1:2, 1:2], Z[1:2, 1:2], [1.0], [1.0])
-    db = modal.frequency_response(ss, [0.0, md.freq_hz[1]]).magnitude_db[:, 0, 0]
+    ss = responses.state_space([[1.0]], Omega2[1:2, 1:2], Z[1:2, 1:2], [1.0], [1.0])
+    db = responses.frequency_response(ss, [0.0, md.freq_hz[1]]).magnitude_db[:, 0, 0]
     assert db[1] - db[0] == pytest.approx(20.0, abs=1e-9)
 
 
 def test_step_response_of_oscillator_matches_analytic():
     zeta, Omega, m = 0.05, 2.0 * np.pi * 1.5, 3.0
     M, K, D = oscillator(Omega, zeta, m)
-    ss = modal.state_space(M, K, D, [1.0], [[1.0]], C_vel=[[0.0]])
+    ss = responses.state_space(M, K, D, [1.0], [[1.0]], C_vel=[[0.0]])
     t = np.linspace(0.0, 10.0, 2001)
-    t_out, y = modal.step_response(ss, t)
+    t_out, y = responses.step_response(ss, t)
     assert y.shape == (2001, 1, 1)
     wd = Omega * np.sqrt(1 - zeta**2)
     exact = (
@@ -314,26 +318,26 @@ def test_step_response_of_oscillator_matches_analytic():
     np.testing.assert_allclose(y[:, 0, 0], exact, rtol=0, atol=1e-12 / K[0, 0])
     # non-uniform times give the same samples
     tn = np.concatenate([t[:500], t[500::7]])
-    _, yn = modal.step_response(ss, tn)
+    _, yn = responses.step_response(ss, tn)
     np.testing.assert_allclose(yn[:, 0, 0], exact[np.isin(t, tn)], atol=1e-12 / K[0, 0])
 
 
 def test_step_response_rigid_body_is_exact():
     # a free mass: q = t²/(2m) under a unit force; A is singular, expm still exact
-    ss = modal.state_space([[2.0]], [[0.0]], None, [1.0], [1.0])
+    ss = responses.state_space([[2.0]], [[0.0]], None, [1.0], [1.0])
     t = np.linspace(0, 3, 31)
-    _, y = modal.step_response(ss, t)
+    _, y = responses.step_response(ss, t)
     np.testing.assert_allclose(y[:, 0, 0], t**2 / 4, rtol=1e-12, atol=1e-15)
 
 
 def test_free_structure_at_zero_frequency():
     M, K = elevation()
-    ss = modal.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[2])
-    fr = modal.frequency_response(ss, [0.5, 1.0])  # away from the pole: fine
+    ss = responses.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[2])
+    fr = responses.frequency_response(ss, [0.5, 1.0])  # away from the pole: fine
     assert np.isfinite(fr.H).all()
-    ss1 = modal.state_space([[1.0]], [[0.0]], None, [1.0], [1.0])
+    ss1 = responses.state_space([[1.0]], [[0.0]], None, [1.0], [1.0])
     with pytest.raises(Rt70Error, match="pole"):
-        modal.frequency_response(ss1, [0.0])
+        responses.frequency_response(ss1, [0.0])
 
 
 # -------------------------------------------------------------------------------- plots
@@ -342,16 +346,16 @@ def test_free_structure_at_zero_frequency():
 def test_plots_return_figures():
     M, K = elevation()
     md = modal.modes(M, K, modal.stiffness_proportional_damping(K, modal.modes(M, K))[0])
-    ss = modal.modal_state_space(md, np.eye(6)[:, 0], np.eye(6)[2])
-    fr = modal.frequency_response(ss, np.geomspace(1, 30, 50))
-    fig = modal.plot_bode(fr)
+    ss = responses.modal_state_space(md, np.eye(6)[:, 0], np.eye(6)[2])
+    fr = responses.frequency_response(ss, np.geomspace(1, 30, 50))
+    fig = plots.plot_bode(fr)
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     fig2 = Figure()
     axes = fig2.subplots(2, 1)
-    assert modal.plot_bode(fr, axes=tuple(axes), label="x") is fig2
-    t, y = modal.step_response(ss, np.linspace(0, 1, 11))
-    assert isinstance(modal.plot_step(t, y, labels=["mirror"]), Figure)
-    fig3 = modal.plot_mode_shapes(md, NAMES, n_modes=3)
+    assert plots.plot_bode(fr, axes=tuple(axes), label="x") is fig2
+    t, y = responses.step_response(ss, np.linspace(0, 1, 11))
+    assert isinstance(plots.plot_step(t, y, labels=["mirror"]), Figure)
+    fig3 = plots.plot_mode_shapes(md, NAMES, n_modes=3)
     assert len(fig3.axes[0].get_lines()) == 3 + 1  # three modes and the zero line
 
 
@@ -386,27 +390,27 @@ def test_bad_inputs_elsewhere_raise():
     with pytest.raises(Rt70Error, match="rigid_tol"):
         modal.modes(M, K, rigid_tol=np.nan)
     with pytest.raises(Rt70Error, match="positive definite"):
-        modal.state_space(-M, K, None, np.eye(6)[:, 0], np.eye(6)[0])
+        responses.state_space(-M, K, None, np.eye(6)[:, 0], np.eye(6)[0])
     with pytest.raises(Rt70Error, match="B_in"):
-        modal.state_space(M, K, None, np.eye(5)[:, 0], np.eye(6)[0])
+        responses.state_space(M, K, None, np.eye(5)[:, 0], np.eye(6)[0])
     with pytest.raises(Rt70Error, match="C_out"):
-        modal.state_space(M, K, None, np.eye(6)[:, 0], np.eye(5)[0])
+        responses.state_space(M, K, None, np.eye(6)[:, 0], np.eye(5)[0])
     with pytest.raises(Rt70Error, match="C_vel"):
-        modal.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0], C_vel=np.eye(6)[:2])
+        responses.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0], C_vel=np.eye(6)[:2])
     with pytest.raises(Rt70Error, match="D_ff"):
-        modal.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0], D_ff=np.ones((2, 2)))
+        responses.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0], D_ff=np.ones((2, 2)))
     with pytest.raises(Rt70Error, match="names"):
-        modal.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0], output_names=["a", "b"])
-    ss = modal.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0])
+        responses.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0], output_names=["a", "b"])
+    ss = responses.state_space(M, K, None, np.eye(6)[:, 0], np.eye(6)[0])
     with pytest.raises(Rt70Error, match="freq_hz"):
-        modal.frequency_response(ss, [1.0, np.nan])
+        responses.frequency_response(ss, [1.0, np.nan])
     with pytest.raises(Rt70Error, match="method"):
-        modal.frequency_response(ss, [1.0], method="magic")
+        responses.frequency_response(ss, [1.0], method="magic")
     with pytest.raises(Rt70Error, match="increasing"):
-        modal.step_response(ss, [0.0, 1.0, 1.0])
+        responses.step_response(ss, [0.0, 1.0, 1.0])
     with pytest.raises(Rt70Error, match="second_order|M, K, D"):
-        bare = modal.StateSpace(ss.A, ss.B, ss.C, ss.D, ss.state_names, ("u",), ("y",))
-        modal.frequency_response(bare, [1.0], method="second_order")
+        bare = responses.StateSpace(ss.A, ss.B, ss.C, ss.D, ss.state_names, ("u",), ("y",))
+        responses.frequency_response(bare, [1.0], method="second_order")
     with pytest.raises(Rt70Error, match="elastic"):
         modal.stiffness_proportional_damping(
             np.zeros((2, 2)), modal.modes(np.eye(2), np.zeros((2, 2)))

@@ -3,6 +3,8 @@
 - :mod:`rt70.linear.topology` — the topology matrix Γ and ``m q̈ + ΓᵀDΓq̇ + ΓᵀCΓq = Q``;
 - :mod:`rt70.linear.holonomic` — rigid links eliminated through a spanning tree
   (Γ*, ``L = Γ*⁻ᵀ``, mobility f, ``S = fᵀL``, reduced A*, C*, D*);
-- :mod:`rt70.linear.modal` — eigenfrequencies, mode shapes, state space, responses;
+- :mod:`rt70.linear.modal` — eigenfrequencies, mode shapes, damping, principal coordinates;
+- :mod:`rt70.linear.responses` — state space, frequency and step responses;
+- :mod:`rt70.linear.checks` — the input checks both share;
 - :mod:`rt70.linear.linearize` — equilibrium and M, K, D of a nonlinear URDF scene.
 """

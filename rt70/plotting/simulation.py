@@ -1,14 +1,17 @@
-"""Figures of results (matplotlib, Agg-safe: figures are returned, never shown)."""
+"""The figure of a simulation: coordinates, energies and the energy-balance residual.
+
+Agg-safe: the figure is returned, never shown; the caller saves it (``rt70 simulate
+--out``, :mod:`rt70.cli`).
+"""
 
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.figure import Figure
 
 
 def simulation_figure(result):
     """Coordinates, energies and the energy-balance residual of a simulation result."""
-    from matplotlib.figure import Figure
-
     fig = Figure(figsize=(9, 8), constrained_layout=True)
     ax_q, ax_e, ax_b = fig.subplots(3, 1, sharex=True)
     ax_q.plot(result.t, result.q, lw=0.8)
