@@ -77,7 +77,7 @@ def _bench(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     if args.what == "simulate":
-        from rt70 import work_precision
+        from rt70.reports import work_precision
 
         rows = work_precision.run(
             quick=args.quick, progress=lambda msg: print(f"  {msg}", file=sys.stderr, flush=True)
@@ -87,7 +87,7 @@ def _bench(args: argparse.Namespace) -> int:
             print(f"wrote {path}")
         return 0
 
-    from rt70 import bench
+    from rt70.reports import bench
 
     sizes = (10, 20, 50) if args.quick else (10, 20, 50, 100, 200, 400)
     rounds = 3 if args.quick else 7

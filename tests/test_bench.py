@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_info
 
-from rt70 import bench
 from rt70.cli import main
-from rt70.threads import pools, single_threaded
+from rt70.reports import bench
+from rt70.reports.threads import pools, single_threaded
 
 
 def test_bench_quick_writes_results(tmp_path, capsys):

@@ -6,9 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from rt70.book import azimuth_section, reproduce
 from rt70.linear import topology
 from rt70.linear.tree_invariant import model_omega2_product, printed_omega2_product
+from rt70.reports.book import reproduce
+from rt70.reports.book_azimuth import azimuth_section
 from rt70.scenes import rt70_data
 
 COMMITTED = Path(__file__).parents[1] / "validation" / "results" / "book.md"

@@ -11,6 +11,10 @@ any depth (inside functions too).
 Drawing is apart from the analyses: matplotlib is imported by ``rt70/plotting/`` (and
 the reports, notebooks and tests that draw), never by the core — checked by importing
 the core in a fresh interpreter.
+
+The reports and benchmarks (``rt70/reports/``) are built on the core and apart from it:
+no module outside ``rt70/reports/`` imports them, except the command line
+(``rt70/cli.py``), which runs them.
 """
 
 from __future__ import annotations
@@ -142,3 +146,50 @@ def test_plotting_is_where_matplotlib_is():
     )
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "True"
+
+
+#: Modules outside rt70/reports/ that may import the reports: the command line runs them.
+REPORT_USERS = ("rt70.cli",)
+
+
+def _is_report(module: str) -> bool:
+    return module == "rt70.reports" or module.startswith("rt70.reports.")
+
+
+def _report_imports(path: Path) -> set[str]:
+    """:func:`_imports`, plus ``rt70.x`` for ``from rt70 import x`` (``x`` may be a module)."""
+    found = _imports(path)
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
+        if isinstance(node, ast.ImportFrom) and not node.level and node.module == "rt70":
+            found |= {f"rt70.{a.name}" for a in node.names}
+    return found
+
+
+@pytest.mark.parametrize(
+    "module", [m for m in MODULES if not _is_report(m) and m not in REPORT_USERS]
+)
+def test_core_never_imports_the_reports(module):
+    bad = sorted(m for m in _report_imports(MODULES[module]) if _is_report(m))
+    assert not bad, f"{module} (core) imports the reports {bad}; only {REPORT_USERS} may"
+
+
+def test_report_rule_sees_the_reports():
+    """The rule has something to check: the reports exist and the command line uses them."""
+    assert "rt70.reports.book" in MODULES and "rt70.reports.stress.report" in MODULES
+    assert any(_is_report(m) for m in _imports(MODULES["rt70.cli"]))
+    assert not _is_report("rt70.reporting") and _is_report("rt70.reports.bench")
+
+
+def test_report_rule_sees_every_spelling(tmp_path):
+    sample = tmp_path / "sample.py"
+    sample.write_text(
+        "from rt70 import errors, reports\n"
+        "def f():\n"
+        "    from rt70.reports.stress import runs\n"
+        "    import rt70.reports.bench\n"
+    )
+    assert {m for m in _report_imports(sample) if _is_report(m)} == {
+        "rt70.reports",
+        "rt70.reports.stress",
+        "rt70.reports.bench",
+    }

@@ -1,4 +1,4 @@
-"""Stress cases (rt70.stress): gimbal lock, unit scaling, free-floating momentum."""
+"""Stress cases (rt70.reports.stress): gimbal lock, unit scaling, free-floating momentum."""
 
 import time
 
@@ -6,7 +6,28 @@ import numpy as np
 import pytest
 
 from rt70 import SingularConfigurationError
-from rt70 import stress as st
+from rt70.reports.stress.edits import (
+    convert_units,
+    free_floating_text,
+    rt70_text,
+    scale_springs,
+    set_gravity,
+)
+from rt70.reports.stress.measures import (
+    frequencies_hz,
+    momentum_pinocchio,
+    momentum_textbook,
+    translational,
+)
+from rt70.reports.stress.report import write_report
+from rt70.reports.stress.rt70_cases import (
+    GIMBAL_BUSHING,
+    GIMBAL_COORDINATE,
+    gimbal_mass_matrix_cases,
+    gimbal_spring_cases,
+)
+from rt70.reports.stress.runs import count_bdf_steps, run_capped
+from rt70.reports.stress.scaling_cases import free_floating_state
 from rt70.scene import load_scene, scene_from_text
 from rt70.simulate import listing_initial_state, simulate
 from rt70.textbook import forces
@@ -21,7 +42,7 @@ def rt70():
 def _gimbal_state(scene, theta):
     q, qd = listing_initial_state(scene)
     q = q.copy()
-    q[scene.textbook.coordinate_names.index(st.GIMBAL_COORDINATE)] = theta
+    q[scene.textbook.coordinate_names.index(GIMBAL_COORDINATE)] = theta
     return q, qd
 
 
@@ -31,7 +52,7 @@ def _gimbal_state(scene, theta):
 @pytest.mark.parametrize("k", [1, 2, 3, 4, 5, 6])
 def test_spring_forces_agree_before_gimbal_threshold(rt70, k):
     q, qd = _gimbal_state(rt70, np.pi / 2 - 10.0**-k)
-    assert abs(np.cos(q[rt70.textbook.coordinate_names.index(st.GIMBAL_COORDINATE)])) > (
+    assert abs(np.cos(q[rt70.textbook.coordinate_names.index(GIMBAL_COORDINATE)])) > (
         GIMBAL_LOCK_COS
     )
     Qc, Qd = forces.spring_damper_force(rt70.textbook, rt70.textbook_data, q, qd)
@@ -46,23 +67,23 @@ def test_gimbal_lock_raises_clear_error(rt70, theta):
     q, qd = _gimbal_state(rt70, theta)
     with pytest.raises(SingularConfigurationError, match="gimbal lock") as info:
         forces.spring_damper_force(rt70.textbook, rt70.textbook_data, q, qd)
-    assert st.GIMBAL_BUSHING in str(info.value)  # names the element
+    assert GIMBAL_BUSHING in str(info.value)  # names the element
     assert "1e-08" in str(info.value)  # and the threshold
     with pytest.raises(SingularConfigurationError, match="gimbal lock"):
         rt70.reference.spring_damper_force(q, qd)
     with pytest.raises(SingularConfigurationError):
         simulate(rt70, (0.0, 0.01), (q, qd))
-    run = st.run_capped(rt70, (0.0, 0.01), (q, qd))
+    run = run_capped(rt70, (0.0, 0.01), (q, qd))
     assert run.status.startswith("error: SingularConfigurationError")
 
 
 def test_gimbal_tables_report_threshold():
-    springs = st.gimbal_spring_cases(quick=True)
+    springs = gimbal_spring_cases(quick=True)
     by_k = {r["k"]: r for r in springs.rows}
     assert by_k["4"]["springs"] == "computed" and by_k["4"]["qc"] < 1e-10
     assert by_k["9"]["springs"].startswith("SingularConfigurationError")
     assert by_k["∞"]["springs"].startswith("SingularConfigurationError")
-    mass = st.gimbal_mass_matrix_cases(quick=True)
+    mass = gimbal_mass_matrix_cases(quick=True)
     rows = {r["k"]: r for r in mass.rows}
     exact = rows["∞"]
     assert exact["cond"] > 1e16
@@ -75,7 +96,7 @@ def test_gimbal_tables_report_threshold():
 
 
 def test_convert_units_factors():
-    text = st.convert_units(st.rt70_text(), 1e3, 1e3)
+    text = convert_units(rt70_text(), 1e3, 1e3)
     scene = scene_from_text(text, "mm")
     si = load_scene("rt70")
     np.testing.assert_allclose(scene.description.gravity, np.array(si.description.gravity) * 1e3)
@@ -94,14 +115,14 @@ def test_convert_units_factors():
     "length, mass", [(1e3, 1e3), (1.0, 1.0 / 9.80665)], ids=["mm-g-s", "m-kgf-s"]
 )
 def test_unit_scaling_invariance(rt70, length, mass):
-    scene = scene_from_text(st.convert_units(rt70.text, length, mass), "units")
-    f_si, f = st.frequencies_hz(rt70), st.frequencies_hz(scene)
+    scene = scene_from_text(convert_units(rt70.text, length, mass), "units")
+    f_si, f = frequencies_hz(rt70), frequencies_hz(scene)
     assert np.array_equal(f_si == 0.0, f == 0.0)  # the same rigid-body modes (2)
     elastic = f_si > 0
     np.testing.assert_allclose(f[elastic], f_si[elastic], rtol=1e-10)
 
     q0, v0 = listing_initial_state(rt70)
-    mask = st.translational(scene)
+    mask = translational(scene)
     scale = np.where(mask, length, 1.0)
     grid = np.linspace(0.0, 0.05, 11)
     kw = {"method": "BDF", "rtol": 1e-9, "t_eval": grid}
@@ -121,17 +142,17 @@ def test_unit_scaling_invariance(rt70, length, mass):
 
 @pytest.fixture(scope="module")
 def floating():
-    return scene_from_text(st.free_floating_text(2), "free_floating_2")
+    return scene_from_text(free_floating_text(2), "free_floating_2")
 
 
 def test_free_floating_model(floating):
     model = floating.textbook
     assert model.kind == ["euler6", "euler6"] and model.nv == 12
     assert not model.gravity.any() and len(model.bushings) == 1
-    assert int(np.sum(st.frequencies_hz(floating) == 0.0)) == 6  # 3 translations, 3 rotations
-    q, qd = st.free_floating_state(floating)
-    P, L = st.momentum_pinocchio(floating, q, qd)
-    P_t, L_t = st.momentum_textbook(floating, q, qd)
+    assert int(np.sum(frequencies_hz(floating) == 0.0)) == 6  # 3 translations, 3 rotations
+    q, qd = free_floating_state(floating)
+    P, L = momentum_pinocchio(floating, q, qd)
+    P_t, L_t = momentum_textbook(floating, q, qd)
     np.testing.assert_allclose(P_t, P, rtol=1e-13, atol=1e-14)
     np.testing.assert_allclose(L_t, L, rtol=1e-13, atol=1e-14)
     assert np.linalg.norm(P) > 0.1 and np.linalg.norm(L) > 0.1
@@ -139,10 +160,10 @@ def test_free_floating_model(floating):
 
 @pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
 def test_free_floating_momentum_conserved(floating, backend):
-    x0 = st.free_floating_state(floating)
+    x0 = free_floating_state(floating)
     res = simulate(floating, (0.0, 0.1), x0, backend=backend, method="DOP853", rtol=1e-10)
     assert res.success
-    moments = [st.momentum_pinocchio(floating, a, b) for a, b in zip(res.q, res.qd, strict=True)]
+    moments = [momentum_pinocchio(floating, a, b) for a, b in zip(res.q, res.qd, strict=True)]
     P = np.array([m[0] for m in moments])
     L = np.array([m[1] for m in moments])
     assert np.max(np.abs(P - P[0])) <= 1e-9 * np.linalg.norm(P[0])
@@ -153,11 +174,11 @@ def test_free_floating_momentum_conserved(floating, backend):
 
 
 def test_momentum_changes_under_gravity():
-    scene = scene_from_text(st.set_gravity(st.free_floating_text(2), (0.0, 0.0, -9.81)), "falling")
-    x0 = st.free_floating_state(scene)
+    scene = scene_from_text(set_gravity(free_floating_text(2), (0.0, 0.0, -9.81)), "falling")
+    x0 = free_floating_state(scene)
     res = simulate(scene, (0.0, 0.1), x0, method="DOP853", rtol=1e-10)
-    P0, _ = st.momentum_pinocchio(scene, res.q[0], res.qd[0])
-    P1, _ = st.momentum_pinocchio(scene, res.q[-1], res.qd[-1])
+    P0, _ = momentum_pinocchio(scene, res.q[0], res.qd[0])
+    P1, _ = momentum_pinocchio(scene, res.q[-1], res.qd[-1])
     total_mass = float(scene.textbook.mass.sum())
     np.testing.assert_allclose(P1 - P0, [0.0, 0.0, -9.81 * total_mass * 0.1], atol=1e-8)
 
@@ -169,20 +190,20 @@ def test_count_bdf_steps():
     # f0, the initial-step probe and the Jacobian at t0, then the attempts: 0.1 rejected
     # (retried at 0.05), 0.05 accepted, 0.15 rejected, 0.12 accepted, 0.2 accepted
     times = [0.0, 0.01, 0.0, 0.1, 0.1, 0.05, 0.05, 0.15, 0.12, 0.12, 0.2]
-    assert st.count_bdf_steps(times, 0.0) == (3, 2)
+    assert count_bdf_steps(times, 0.0) == (3, 2)
 
 
 def test_run_capped_counts_match_solver(rt70):
-    run = st.run_capped(rt70, (0.0, 0.01))
+    run = run_capped(rt70, (0.0, 0.01))
     assert run.ok and run.result is not None
     assert run.n_steps == run.result.n_steps and run.n_rejected is not None
 
 
 def test_run_capped_time_cap(rt70):
-    text = st.scale_springs(rt70.text, 1e6, 0.0)  # undamped, f_max ~ 3e5 Hz
+    text = scale_springs(rt70.text, 1e6, 0.0)  # undamped, f_max ~ 3e5 Hz
     scene = scene_from_text(text, "stiff")
     start = time.perf_counter()
-    run = st.run_capped(scene, (0.0, 1.0), listing_initial_state(scene), cap_s=0.5)
+    run = run_capped(scene, (0.0, 1.0), listing_initial_state(scene), cap_s=0.5)
     assert run.status == "over cap" and time.perf_counter() - start < 5.0
     assert 0.0 < run.t_reached < 1.0
 
@@ -199,7 +220,7 @@ def test_long_chain_reads_and_builds():
 
 
 def test_write_report_quick(tmp_path):
-    path = st.write_report(tmp_path, quick=True)
+    path = write_report(tmp_path, quick=True)
     assert path == tmp_path / "stress.md"
     text = path.read_text(encoding="utf-8")
     for title in (

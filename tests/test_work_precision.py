@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from rt70 import work_precision as wp
+from rt70.reports import work_precision as wp
+from rt70.reports.work_precision_problems import QUICK_PROBLEMS, light_damping_text
 from rt70.scene import load_scene, scene_from_text
 
 
@@ -21,7 +22,7 @@ def test_quick_run_writes_files(quick_rows, tmp_path):
     with open(tmp_path / "work_precision.csv", newline="") as fh:
         table = list(csv.DictReader(fh))
     assert len(table) == len(quick_rows)
-    assert {r["problem"] for r in table} == {p.name for p in wp.QUICK_PROBLEMS}
+    assert {r["problem"] for r in table} == {p.name for p in QUICK_PROBLEMS}
     assert {r["method"] for r in table} == set(wp.METHODS)
     assert (tmp_path / "work_precision.png").stat().st_size > 10_000
     text = wp.format_table(quick_rows)
@@ -29,7 +30,7 @@ def test_quick_run_writes_files(quick_rows, tmp_path):
 
 
 def test_errors_decrease_with_tolerance(quick_rows):
-    for problem in wp.QUICK_PROBLEMS:
+    for problem in QUICK_PROBLEMS:
         for method in ("DOP853", "BDF"):
             ok = sorted(
                 (r.rtol, r.error)
@@ -66,7 +67,7 @@ def test_stiff_explicit_runs_are_abandoned_at_the_cap(quick_rows):
 def test_light_damping_is_proportional():
     base = load_scene("rt70")
     delta = 0.05
-    scene = scene_from_text(wp.light_damping_text(base.text, delta), "rt70_light")
+    scene = scene_from_text(light_damping_text(base.text, delta), "rt70_light")
     old, new = base.description.bushings, scene.description.bushings
     assert [b.name for b in new] == [b.name for b in old] and len(new) == 11
     for a, b in zip(old, new, strict=True):
@@ -76,7 +77,7 @@ def test_light_damping_is_proportional():
 
 
 def test_runs_are_timed_with_pinned_threads(quick_rows):
-    from rt70.threads import pools
+    from rt70.reports.threads import pools
 
     assert {r.threads for r in quick_rows} == {1}  # read back from the worker's pools
     unpinned = {r.threads_unpinned for r in quick_rows}

@@ -2,14 +2,14 @@
 
 Run: ``python validation/stress.py [OUT_DIR] [--quick]`` (about 3 minutes; ``--quick``
 runs the reduced smoke-test set in seconds). Each simulation is capped at
-``rt70.stress.TIME_CAP_S`` seconds of wall time.
+``rt70.reports.stress.runs.TIME_CAP_S`` seconds of wall time.
 """
 
 import sys
 import time
 from pathlib import Path
 
-from rt70.stress import write_report
+from rt70.reports.stress.report import write_report
 
 if __name__ == "__main__":
     args = [a for a in sys.argv[1:] if a != "--quick"]

@@ -3,7 +3,7 @@
 Problems: the RT-70 (listing damping and the book's ξ = 0.05 variant), the double
 pendulum and a 50-body chain; methods RK45, DOP853, Radau, BDF, LSODA over rtol 1e-3 …
 1e-9, each against a reference of another method at rtol 1e-12 (see
-rt70/work_precision.py). Writes validation/results/work_precision.{csv,png}.
+rt70/reports/work_precision.py). Writes validation/results/work_precision.{csv,png}.
 Run: ``python validation/work_precision.py [--quick]`` (under 10 minutes; --quick a few
 seconds).
 """
@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from rt70 import work_precision
+from rt70.reports import work_precision
 
 OUT = Path(__file__).resolve().parent / "results"
 

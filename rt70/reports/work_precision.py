@@ -4,35 +4,9 @@ For each test problem and each ``solve_ivp`` method the run is repeated over a l
 of relative tolerances; every run gives one point (run time, error) of the method's
 work–precision curve.
 
-Problems
---------
-``rt70``
-    ``urdf/rt70.urdf`` from the §4.2.3 listing's initial state over ``T = 2 s`` with the
-    listing's damping (mostly 0.1 × stiffness; ξ = 0.105 on the first elastic mode).
-``rt70_light``
-    The same scene with every damping replaced by ``δ · stiffness``, δ = 0.1/Ω1 (the
-    book's rule (2.16), ξ = 0.05 on the first elastic mode; :func:`light_damping_text`),
-    same state and span. Ω1 is the first elastic eigenfrequency of the linear model at
-    the static equilibrium with the drives holding the listing's pointing
-    (``platform_rz = base_rx = 0.8 rad``) and the two axes locked
-    (:func:`first_elastic_mode`). The pointing matters (Ω1 = 1.91 rad/s at the zenith,
-    2.10 rad/s at the listing's pointing); the run starts at the listing's pointing, so
-    Ω1 is taken there. Locking the axes removes the rigid azimuth mode and gravity's
-    unstable elevation mode, which are not resonances of the structure.
-``double_pendulum``
-    ``urdf/double_pendulum.urdf`` (no springs) from ``q = (1.0, −0.5) rad``, ``q̇ = 0``
-    over 5 s. q = 0 is the arm stretched horizontally (gravity along −y), so this is a
-    large, chaotic swing.
-``chain``
-    ``serial_chain(50)`` (50 revolute joints, about 40 % of them with springs) from
-    ``q`` uniform in ±0.3 rad (seed 1), ``q̇ = 0``, over 1 s: the long, non-stiff chain
-    (``elastic_chain(20)`` is as stiff as the RT-70 and would add nothing). Over 2 s the
-    chain whips (|q̇| up to 75 rad/s) and is chaotic enough that the errors of all loose
-    tolerances saturate at O(1) and the two references part to 2e-9; over 1 s they agree
-    to 5e-12.
-
-Both RT-70 problems are stiff (damped eigenvalues down to −4·10⁵ s⁻¹): the explicit
-methods need steps of a few µs there and cannot finish within the time cap.
+The problems (the RT-70 with the listing's and with light damping, a double pendulum,
+a 50-body chain) are built in :mod:`rt70.reports.work_precision_problems`; the runs
+happen in a worker process (:mod:`rt70.reports.work_precision_worker`).
 
 Accuracy
 --------
@@ -59,9 +33,9 @@ worker (and starts a new one for the next run). A run over the cap is reported a
 ``over cap`` after one attempt, and the tighter tolerances of the same method on the
 same problem are not run (reported ``over cap (not run)``): a tighter tolerance is
 assumed to cost at least as much. The worker runs with BLAS and OpenMP pinned to one
-thread (:func:`rt70.threads.single_threaded`; every row records the thread count read back
-from the pools and what they would use otherwise): on this 2-core machine a threaded
-102 × 102 complex LU (Radau on the 50-body chain) takes 30 times longer than a
+thread (:func:`rt70.reports.threads.single_threaded`; every row records the thread count
+read back from the pools and what they would use otherwise): on this 2-core machine a
+threaded 102 × 102 complex LU (Radau on the 50-body chain) takes 30 times longer than a
 single-threaded one.
 
 Targets
@@ -79,12 +53,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-import multiprocessing
-import multiprocessing.connection
 import time
-import traceback
-import warnings
-import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -93,11 +62,14 @@ import numpy as np
 
 from rt70.atomic import atomic_write, atomic_write_text
 from rt70.errors import Rt70Error
-from rt70.targets import TargetCheck
+from rt70.reports.targets import TargetCheck
+from rt70.reports.work_precision_problems import PROBLEMS, QUICK_PROBLEMS, Problem
+from rt70.reports.work_precision_worker import Attempt, Worker
 
 #: Methods measured (``solve_ivp`` names).
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
-#: The tolerance ladder (relative tolerance; ``atol`` is :func:`simulate`'s default).
+#: The tolerance ladder (relative tolerance; ``atol`` is the default of
+#: :func:`~rt70.simulate.simulate`).
 RTOLS = tuple(10.0**-k for k in range(3, 10))
 #: Relative tolerance of the references.
 REFERENCE_RTOL = 1e-12
@@ -107,74 +79,11 @@ REPEATS = 3
 TIME_CAP_S = 20.0
 #: Cap of a reference run, s (a reference over it is an error).
 REFERENCE_CAP_S = 240.0
-#: Points of the output grid on which runs are compared.
-N_EVAL = 201
 #: The accuracy at which the summary compares methods (error ≤ this).
 TARGET_ERROR = 1e-6
-
 #: The target problem and its targets (issues 5 and 13): error ≤ this, real-time factor ≥ that.
 TARGET_PROBLEM = "rt70"
 REAL_TIME_TARGET = 50.0
-#: Seconds allowed beyond the cap for what follows ``solve_ivp`` (energies, transfer):
-#: ``_SLACK_S + _SLACK_FRACTION · cap``.
-_SLACK_S = 0.5
-_SLACK_FRACTION = 0.1
-#: Seconds allowed for a worker to build a problem (load URDF, Pinocchio, Ω1).
-_BUILD_TIMEOUT_S = 300.0
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One test problem.
-
-    Attributes
-    ----------
-    name : str
-        Key of the problem (``rt70``, ``rt70_light``, ``double_pendulum``, ``chain``).
-    t_end : float
-        The span is ``(0, t_end)``, s.
-    references : (str, str)
-        Primary and alternate reference methods: a run of the primary method is
-        measured against the alternate one, every other run against the primary.
-    reference_atol : float or None
-        ``atol`` of the reference runs (None: :func:`simulate`'s default).
-    chain_bodies : int
-        Bodies of the chain (``chain`` only).
-    """
-
-    name: str
-    t_end: float
-    references: tuple[str, str]
-    reference_atol: float | None = None
-    chain_bodies: int = 50
-
-    @property
-    def t_eval(self) -> np.ndarray:
-        """The output grid shared by all runs."""
-        return np.linspace(0.0, self.t_end, N_EVAL)
-
-    def reference_for(self, method: str) -> str:
-        """The reference method for runs of ``method`` (never ``method`` itself)."""
-        primary, alternate = self.references
-        return alternate if method == primary else primary
-
-
-_STIFF_REFS = ("Radau", "BDF")
-_SMOOTH_REFS = ("DOP853", "LSODA")
-
-#: The full report's problems.
-PROBLEMS = (
-    Problem("rt70", 2.0, _STIFF_REFS, 1e-12),
-    Problem("rt70_light", 2.0, _STIFF_REFS, 1e-12),
-    Problem("double_pendulum", 5.0, _SMOOTH_REFS),
-    Problem("chain", 1.0, _SMOOTH_REFS, chain_bodies=50),
-)
-#: Problems of the quick run (tests): short spans, a 10-body chain.
-QUICK_PROBLEMS = (
-    Problem("rt70", 0.05, _STIFF_REFS, 1e-12),
-    Problem("double_pendulum", 1.0, _SMOOTH_REFS),
-    Problem("chain", 0.5, _SMOOTH_REFS, chain_bodies=10),
-)
 #: Tolerances, cap and repeats of the quick run.
 QUICK_RTOLS = (1e-3, 1e-6)
 QUICK_CAP_S = 2.0
@@ -215,277 +124,6 @@ class Row:
     notes: str
     threads: int
     threads_unpinned: str
-
-
-# ---------------------------------------------------------------------------------------
-# Problems: scenes and initial states
-# ---------------------------------------------------------------------------------------
-
-
-def listing_pointing(scene) -> dict[str, float]:
-    """The RT-70 drive coordinates held at the listing's initial values (rad)."""
-    from rt70.linear import linearize as lin
-    from rt70.simulate import listing_initial_state
-
-    q0, _ = listing_initial_state(scene)
-    names = scene.textbook.coordinate_names
-    axes = (lin.AZIMUTH_COORDINATE, lin.ELEVATION_COORDINATE)
-    return {c: float(q0[names.index(c)]) for c in axes}
-
-
-def first_elastic_mode(scene) -> tuple[float, float]:
-    """Ω1 (rad/s) and its ξ of the RT-70 linearised at the listing's pointing, axes locked.
-
-    The drives hold ``platform_rz`` and ``base_rx`` at the listing's initial values
-    (:func:`listing_pointing`), the static equilibrium of the other coordinates is
-    solved (:func:`rt70.linear.linearize.equilibrium`), the linear model is taken there
-    with the two axes locked (:func:`rt70.linear.linearize.linearize`) and Ω1 is its
-    lowest elastic eigenfrequency (:func:`rt70.linear.modal.modes`).
-
-    Parameters
-    ----------
-    scene : Scene
-        An RT-70 scene (``rt70.urdf`` or an edited copy).
-
-    Returns
-    -------
-    omega1 : float
-        Ω1, rad/s.
-    zeta1 : float
-        Damping ratio of that mode (``(VᵀDV)₁₁ / 2Ω1``).
-    """
-    from rt70.linear import linearize as lin
-    from rt70.linear import modal
-
-    held = listing_pointing(scene)
-    model = lin.linearize(scene, lin.equilibrium(scene, held), locked=tuple(held))
-    result = modal.modes(model.M, model.K, model.D)
-    first = np.flatnonzero(result.elastic)[0]
-    return float(result.omega[first]), float(result.zeta[first])
-
-
-def light_damping_text(text: str, delta: float) -> str:
-    """URDF text with every damping replaced by ``delta · stiffness``.
-
-    Every rt70 element carrying a ``stiffness`` attribute (``<rt70:bushing>``,
-    ``<rt70:strut>``, ``<rt70:joint_spring>``) gets ``damping = delta · stiffness``,
-    component by component (the book's proportional damping ``D = δ C``, (2.16)).
-
-    Parameters
-    ----------
-    text : str
-        URDF text.
-    delta : float
-        δ, s (non-negative).
-
-    Returns
-    -------
-    str
-        The edited URDF text (comments dropped).
-    """
-    from rt70.scenes.generate import fmt_vec
-    from rt70.urdf import RT70_NS
-
-    if not (math.isfinite(delta) and delta >= 0.0):
-        raise Rt70Error(f"damping factor δ must be finite and non-negative, got {delta}")
-    ET.register_namespace("rt70", RT70_NS)
-    root = ET.fromstring(text)
-    for elem in root.iter():
-        if isinstance(elem.tag, str) and elem.tag.startswith("{" + RT70_NS + "}"):
-            stiffness = elem.get("stiffness")
-            if stiffness is not None:
-                k = np.array(stiffness.split(), dtype=float)
-                elem.set("damping", fmt_vec(delta * k))
-    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-
-
-def build_problem(problem: Problem) -> tuple[object, tuple[np.ndarray, np.ndarray], str]:
-    """The scene, initial state and a one-line description of a problem.
-
-    Returns
-    -------
-    scene : Scene
-    x0 : (q0, q̇0)
-    notes : str
-    """
-    from rt70.scene import load_scene, scene_from_text
-    from rt70.scenes import synthetic
-    from rt70.simulate import listing_initial_state
-
-    T = f"T = {problem.t_end:g} s"
-    if problem.name == "rt70":
-        scene = load_scene("rt70")
-        return scene, listing_initial_state(scene), f"listing state and damping, {T}"
-    if problem.name == "rt70_light":
-        from rt70.linear.topology import book_delta
-
-        base = load_scene("rt70")
-        omega1, zeta0 = first_elastic_mode(base)
-        delta = book_delta(omega1)
-        scene = scene_from_text(light_damping_text(base.text, delta), "rt70_light")
-        _, zeta1 = first_elastic_mode(scene)
-        notes = (
-            f"listing state; damping = δ·stiffness, δ = 0.1/Ω1 = {delta:.4g} s "
-            f"(Ω1 = {omega1:.4g} rad/s; ξ1 = {zeta1:.3f}, listing's {zeta0:.3f}), {T}"
-        )
-        return scene, listing_initial_state(scene), notes
-    if problem.name == "double_pendulum":
-        scene = load_scene("double_pendulum")
-        return scene, (np.array([1.0, -0.5]), np.zeros(2)), f"q = (1, -0.5) rad, q̇ = 0, {T}"
-    if problem.name == "chain":
-        n = problem.chain_bodies
-        scene = scene_from_text(synthetic.serial_chain(n), f"chain_{n}")
-        q0 = np.random.default_rng(1).uniform(-0.3, 0.3, scene.textbook.nv)
-        notes = f"serial_chain({n}), q uniform in ±0.3 rad (seed 1), q̇ = 0, {T}"
-        return scene, (q0, np.zeros(scene.textbook.nv)), notes
-    raise Rt70Error(f"unknown work-precision problem '{problem.name}'")
-
-
-# ---------------------------------------------------------------------------------------
-# The worker process
-# ---------------------------------------------------------------------------------------
-
-_CACHE: dict[Problem, tuple[object, tuple[np.ndarray, np.ndarray], str]] = {}
-
-
-def _worker_main(conn: multiprocessing.connection.Connection) -> None:
-    """Serve run requests on ``conn`` until told to stop (runs in the worker process)."""
-    from rt70.threads import single_threaded
-
-    warnings.simplefilter("ignore")  # solve_ivp warns that `jac` is unused by RK methods
-    with single_threaded() as pinning:
-        _serve(conn, pinning.unpinned)
-
-
-def _serve(conn: multiprocessing.connection.Connection, unpinned: str) -> None:
-    """The request loop of :func:`_worker_main` (thread pools already pinned)."""
-    from rt70.simulate import simulate
-    from rt70.threads import max_threads
-
-    while True:
-        try:
-            request = conn.recv()
-        except EOFError:
-            return
-        if request is None:
-            return
-        problem, method, rtol, atol = request
-        try:
-            if problem not in _CACHE:
-                scene, x0, notes = build_problem(problem)
-                _ = scene.reference, scene.textbook_data  # built outside the timing
-                _CACHE[problem] = scene, x0, notes
-            scene, x0, notes = _CACHE[problem]
-            conn.send(("ready", scene.textbook.nv, notes, max_threads(), unpinned))
-            res = simulate(
-                scene,
-                (0.0, problem.t_end),
-                x0=x0,
-                method=method,
-                rtol=rtol,
-                atol=atol,
-                t_eval=problem.t_eval,
-            )
-            x = np.hstack([res.q, res.qd]) if res.success else None
-            stats = (res.wall_time_s, res.success, res.message, res.nfev, res.njev, res.nlu)
-            conn.send(("result", stats, res.atol, x))
-        except Exception:  # reported to the parent, which decides
-            conn.send(("error", traceback.format_exc()))
-
-
-@dataclass
-class _Attempt:
-    """Outcome of one run in the worker."""
-
-    status: str  # "ok", "over cap", "failed: ..."
-    wall_s: float = math.nan
-    atol: float = math.nan
-    nfev: int = 0
-    njev: int = 0
-    nlu: int = 0
-    x: np.ndarray | None = None
-
-
-class _Worker:
-    """A worker process that runs :func:`simulate` and can be abandoned at a time cap."""
-
-    def __init__(self) -> None:
-        self.process: multiprocessing.process.BaseProcess | None = None
-        self.conn: multiprocessing.connection.Connection | None = None
-        self.nv: dict[Problem, int] = {}
-        self.notes: dict[Problem, str] = {}
-        self.threads: dict[Problem, tuple[int, str]] = {}  # (pinned, unpinned)
-
-    def _start(self) -> None:
-        ctx = multiprocessing.get_context("spawn")
-        parent, child = ctx.Pipe()
-        process = ctx.Process(target=_worker_main, args=(child,), daemon=True)
-        process.start()
-        child.close()
-        self.process, self.conn = process, parent
-
-    def kill(self) -> None:
-        """End the worker process (the one this object started) now."""
-        if self.process is not None:
-            if self.process.is_alive():
-                self.process.kill()
-            self.process.join()
-        if self.conn is not None:
-            self.conn.close()
-        self.process = self.conn = None
-
-    def close(self) -> None:
-        """Ask the worker to stop, then make sure it has."""
-        if self.process is not None and self.process.is_alive() and self.conn is not None:
-            try:
-                self.conn.send(None)
-                self.process.join(5.0)
-            except (BrokenPipeError, OSError):
-                pass
-        self.kill()
-
-    def _receive(self, timeout: float):
-        assert self.conn is not None
-        if not self.conn.poll(timeout):
-            return None
-        try:
-            return self.conn.recv()
-        except EOFError:
-            return ("error", "worker process died")
-
-    def run(self, problem: Problem, method: str, rtol: float, atol: float | None, cap: float):
-        """One run; abandoned (worker killed) when not back within ``cap`` + slack."""
-        if self.process is None or not self.process.is_alive():
-            self.kill()
-            self._start()
-        assert self.conn is not None
-        self.conn.send((problem, method, rtol, atol))
-        msg = self._receive(_BUILD_TIMEOUT_S)
-        if msg is None:
-            self.kill()
-            raise Rt70Error(f"{problem.name}: building the problem took over {_BUILD_TIMEOUT_S} s")
-        if msg[0] == "error":
-            self.kill()
-            raise Rt70Error(f"{problem.name}: worker failed:\n{msg[1]}")
-        self.nv[problem], self.notes[problem], self.threads[problem] = msg[1], msg[2], msg[3:5]
-        msg = self._receive(cap * (1.0 + _SLACK_FRACTION) + _SLACK_S)
-        if msg is None:
-            self.kill()
-            return _Attempt("over cap")
-        if msg[0] == "error":
-            self.kill()
-            return _Attempt("failed: " + msg[1].strip().splitlines()[-1])
-        (wall, success, message, nfev, njev, nlu), used_atol, x = msg[1], msg[2], msg[3]
-        if wall > cap:
-            return _Attempt("over cap", wall, used_atol, nfev, njev, nlu)
-        if not success:
-            return _Attempt(f"failed: {message}", wall, used_atol, nfev, njev, nlu)
-        return _Attempt("ok", wall, used_atol, nfev, njev, nlu, x)
-
-
-# ---------------------------------------------------------------------------------------
-# The report
-# ---------------------------------------------------------------------------------------
 
 
 def relative_error(x: np.ndarray, x_ref: np.ndarray) -> float:
@@ -544,7 +182,7 @@ def run(
     cap = cap_s if cap_s is not None else (QUICK_CAP_S if quick else TIME_CAP_S)
     repeats = repeats or (QUICK_REPEATS if quick else REPEATS)
     say = progress or (lambda _msg: None)
-    worker = _Worker()
+    worker = Worker()
     rows: list[Row] = []
     try:
         for problem in problems:
@@ -609,10 +247,10 @@ def run(
     return rows
 
 
-def _row(common: dict, status: str, attempts: list[_Attempt], error: float = math.nan) -> Row:
+def _row(common: dict, status: str, attempts: list[Attempt], error: float = math.nan) -> Row:
     ok = status == "ok"
     walls = [a.wall_s for a in attempts if not math.isnan(a.wall_s)]
-    first = attempts[0] if attempts else _Attempt(status)
+    first = attempts[0] if attempts else Attempt(status)
     rtol = common["rtol"]
     return Row(
         **common,
@@ -626,11 +264,6 @@ def _row(common: dict, status: str, attempts: list[_Attempt], error: float = mat
         njev=first.njev,
         nlu=first.nlu,
     )
-
-
-# ---------------------------------------------------------------------------------------
-# Summary, table and files
-# ---------------------------------------------------------------------------------------
 
 
 def time_to_reach(rows: list[Row], problem: str, method: str, target: float) -> Row | None:

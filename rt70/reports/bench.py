@@ -3,8 +3,9 @@
 This machine is shared and noisy, so every comparison interleaves the two sides:
 each round times the textbook call and the Pinocchio call back to back, the ratio is
 taken per round, and the median ratio is reported (with the best time of each side).
-All timing happens with BLAS and OpenMP pinned to one thread (:mod:`rt70.threads`); the
-CSV records the pinned thread count and what the pools would use otherwise.
+All timing happens with BLAS and OpenMP pinned to one thread
+(:mod:`rt70.reports.threads`); the CSV records the pinned thread count and what the pools
+would use otherwise.
 """
 
 from __future__ import annotations
@@ -19,10 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from rt70.atomic import atomic_write, atomic_write_text
+from rt70.reports.targets import TargetCheck
+from rt70.reports.threads import single_threaded
 from rt70.scene import Scene, load_scene, scene_from_text
-from rt70.targets import TargetCheck
 from rt70.textbook import dynamics, structured
-from rt70.threads import single_threaded
 
 
 @dataclass(frozen=True)
