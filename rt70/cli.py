@@ -109,20 +109,21 @@ def _modes(args: argparse.Namespace) -> int:
     from rt70.linear import linearize as lin
     from rt70.linear import modal
     from rt70.scene import load_scene
+    from rt70.scenes import rt70_state
 
     scene = load_scene(args.scene)
     names = scene.textbook.coordinate_names
     if not names:
         raise Rt70Error(f"{scene.name}: the model has no degree of freedom: no modes")
-    has_axes = lin.AZIMUTH_COORDINATE in names and lin.ELEVATION_COORDINATE in names
+    axes = (rt70_state.AZIMUTH_COORDINATE, rt70_state.ELEVATION_COORDINATE)
+    has_axes = all(axis in names for axis in axes)
     if (args.elevation is not None or args.azimuth is not None) and not has_axes:
         raise Rt70Error(
-            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes "
-            f"({lin.AZIMUTH_COORDINATE}, {lin.ELEVATION_COORDINATE})"
+            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes ({', '.join(axes)})"
         )
     elevation = 90.0 if args.elevation is None else args.elevation
     azimuth = 0.0 if args.azimuth is None else args.azimuth
-    held = lin.rt70_pointing(elevation, azimuth) if has_axes else {}
+    held = rt70_state.rt70_pointing(elevation, azimuth) if has_axes else {}
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
             q0 = lin.equilibrium(scene, held)
@@ -176,6 +177,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from rt70.scene import load_scene
+    from rt70.scenes.rt70_state import start_state
     from rt70.simulate import simulate
 
     scene = load_scene(args.scene)
@@ -183,6 +185,7 @@ def _simulate(args: argparse.Namespace) -> int:
         result = simulate(
             scene,
             (0.0, args.t_end),
+            start_state(scene),
             backend=args.backend,
             method=args.method,
             rtol=args.rtol,

@@ -24,7 +24,7 @@ from typing import NoReturn
 from rt70.errors import OutputError
 
 #: Range of the RT-70's elevation axis, degrees: horizon to zenith (the book's tables
-#: are given at 0° and 90°; :func:`rt70.linear.linearize.rt70_pointing`).
+#: are given at 0° and 90°; :func:`rt70.scenes.rt70_state.rt70_pointing`).
 ELEVATION_RANGE = (0.0, 90.0)
 
 #: Smallest relative tolerance ``solve_ivp`` honours (100 machine epsilons).

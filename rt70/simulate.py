@@ -269,19 +269,6 @@ def check_output_suffix(path: str | Path) -> str:
     return suffix
 
 
-def listing_initial_state(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
-    """The §4.2.3 listing's Q_NU, dQ_NU for the RT-70 scene (by coordinate name)."""
-    from rt70.scenes import rt70_data
-    from rt70.scenes.generate import pair_joint_names
-
-    names = [n for body in rt70_data.LISTING_BODIES for n in pair_joint_names(body["name"])]
-    model = scene.textbook
-    if sorted(names) != sorted(model.coordinate_names):
-        raise Rt70Error(f"{scene.name}: the listing's initial state is for the rt70 scene")
-    order = [names.index(c) for c in model.coordinate_names]
-    return np.asarray(rt70_data.LISTING_Q0)[order], np.asarray(rt70_data.LISTING_V0)[order]
-
-
 def simulate(
     scene: Scene,
     t_span: tuple[float, float],
@@ -303,7 +290,8 @@ def simulate(
     t_span : (t0, t1)
         Time interval, s.
     x0 : (q0, q̇0), optional
-        Initial state; default the listing's state for the RT-70 scene, else rest.
+        Initial state; default rest (q = 0, q̇ = 0). The RT-70 listing's state is
+        :func:`rt70.scenes.rt70_state.listing_initial_state`.
     backend : {"pinocchio", "textbook"}
         Which implementation evaluates q̈ (and, for "pinocchio", the analytic Jacobian
         ``∂q̈/∂(q, q̇)`` of ``computeABADerivatives`` plus the springs' ``Σ JᵀCJ``,
@@ -343,13 +331,7 @@ def simulate(
     if n == 0:
         raise SimulationError(f"{scene.name}: the model has no degree of freedom: nothing moves")
     side = BACKENDS[backend](scene)
-    if x0 is None:
-        try:
-            q0, qd0 = listing_initial_state(scene)
-        except Rt70Error:
-            q0, qd0 = np.zeros(n), np.zeros(n)
-    else:
-        q0, qd0 = x0
+    q0, qd0 = (np.zeros(n), np.zeros(n)) if x0 is None else x0
     q0 = check_vector("initial state q0", q0, n)
     qd0 = check_vector("initial state qd0", qd0, n)
     try:

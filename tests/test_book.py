@@ -6,11 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from rt70.linear import topology
 from rt70.linear.tree_invariant import model_omega2_product, printed_omega2_product
 from rt70.reports.book import reproduce
 from rt70.reports.book_azimuth import azimuth_section
-from rt70.scenes import rt70_data
+from rt70.scenes import rt70_chapter2, rt70_data
 
 COMMITTED = Path(__file__).parents[1] / "validation" / "results" / "book.md"
 
@@ -62,7 +61,7 @@ def test_azimuth_invariant_is_stated_with_tables_and_printed_products(report):
         math.prod((2 * math.pi * f) ** 2 for f in rt70_data.AZIMUTH_SPECTRUM_EL0_HZ[1:])
     )
     for key, label in (("0", "0° columns"), ("90", "90° columns")):
-        tables = model_omega2_product(topology.azimuth_model(key))
+        tables = model_omega2_product(rt70_chapter2.azimuth_model(key))
         assert f"{label}{' (the printed spectrum' if key == '0' else ''}" in section
         assert f"| {tables:.5e} | {printed / tables:.4g} |" in section
     assert f"| {printed:.5e} | 1 |" in section

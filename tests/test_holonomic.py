@@ -25,10 +25,8 @@ from rt70.errors import NonFiniteError, Rt70Error, TopologyError
 from rt70.linear.holonomic import eliminate, gamma_star, spanning_tree
 from rt70.linear.topology import (
     LinearModelError,
-    azimuth_model,
     book_delta,
     edges_from_topology,
-    elevation_model,
     from_graph,
     from_scene,
     proportional_damping,
@@ -36,6 +34,7 @@ from rt70.linear.topology import (
 )
 from rt70.scene import load_scene
 from rt70.scenes import rt70_data
+from rt70.scenes.rt70_chapter2 import azimuth_model, elevation_model
 
 RTOL = 1e-12
 KGF = 9.80665

@@ -5,8 +5,9 @@ The two sides of the cross-check stay independent only if the import graph says 
 side; ``rt70/textbook/`` never imports the reference side (nor Pinocchio, see
 tests/test_independence.py) and the reference side never imports the textbook; both
 may use the shared math below them (``rt70.rotations``) and the small helpers every
-layer uses (``rt70.errors``, ``rt70.arrays``). Every import is found statically, at
-any depth (inside functions too).
+layer uses (``rt70.errors``, ``rt70.arrays``). The generic analyses and the simulation
+load no RT-70 module (:data:`RT70_MODULES`), not even through another module. Every
+import is found statically, at any depth (inside functions too).
 
 Drawing is apart from the analyses: matplotlib is imported by ``rt70/plotting/`` (and
 the reports, notebooks and tests that draw), never by the core — checked by importing
@@ -193,3 +194,74 @@ def test_report_rule_sees_every_spelling(tmp_path):
         "rt70.reports.stress",
         "rt70.reports.bench",
     }
+
+
+# --- generic analyses know no telescope (issue 9) ---------------------------------------
+
+#: The RT-70's own modules: the book's tables and what is built from them.
+RT70_MODULES = ("rt70.scenes.rt70_data", "rt70.scenes.rt70_chapter2", "rt70.scenes.rt70_state")
+
+#: Generic analyses and simulation: they take what they need of a scene as arguments.
+GENERIC = (
+    "rt70.linear",
+    "rt70.simulate",
+    "rt70.validate",
+    "rt70.scene",
+    "rt70.reference",
+    "rt70.textbook",
+    "rt70.urdf",
+)
+
+
+def _imported_modules(path: Path) -> set[str]:
+    """:func:`_imports`, plus ``a.b.c`` for ``from a.b import c`` when c is a module."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found = set(_imports(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            found |= {f"{node.module}.{a.name}" for a in node.names} & MODULES.keys()
+    return found
+
+
+def _loaded_with(module: str) -> set[str]:
+    """Every rt70 module that importing ``module`` may load (packages' __init__ included)."""
+    seen: set[str] = set()
+    todo = [module]
+    while todo:
+        m = todo.pop()
+        parts = m.split(".")
+        for k in range(1, len(parts) + 1):
+            name = ".".join(parts[:k])
+            if name in MODULES and name not in seen:
+                seen.add(name)
+                todo.extend(_imported_modules(MODULES[name]))
+    return seen
+
+
+def _generic_modules() -> list[str]:
+    return [m for m in MODULES if any(m == g or m.startswith(g + ".") for g in GENERIC)]
+
+
+def test_rt70_modules_are_all_listed():
+    """A new RT-70 module under rt70/scenes/ must join RT70_MODULES to be guarded."""
+    assert set(RT70_MODULES) <= MODULES.keys()
+    own = {m for m in MODULES if m.startswith("rt70.scenes.rt70_")}
+    assert own == set(RT70_MODULES)
+    assert len(_generic_modules()) > len(GENERIC)  # the packages' modules are found
+
+
+@pytest.mark.parametrize("module", _generic_modules())
+def test_generic_analysis_knows_no_telescope(module):
+    """No generic analysis loads the RT-70's tables, chapter-2 models or states, even
+    through another module: the RT-70 comes in as arguments (a scene, held coordinates,
+    a start state) chosen by the command line or the reports."""
+    bad = sorted(_loaded_with(module) & set(RT70_MODULES))
+    assert not bad, f"{module} loads {bad}"
+
+
+def test_detector_follows_from_package_imports(tmp_path):
+    """``from rt70.scenes import rt70_data`` (how topology.py once imported the tables)."""
+    sample = tmp_path / "sample.py"
+    sample.write_text("def f():\n    from rt70.scenes import rt70_data, synthetic\n")
+    assert _imported_modules(sample) >= {"rt70.scenes.rt70_data", "rt70.scenes.synthetic"}
+    assert "rt70.scenes.rt70_data" in _loaded_with("rt70.scenes.rt70_chapter2")

@@ -6,6 +6,7 @@ import pytest
 
 from rt70.linear import linearize as lin
 from rt70.scene import load_scene
+from rt70.scenes import rt70_state
 
 
 @pytest.fixture(scope="module")
@@ -14,7 +15,7 @@ def rt70():
 
 
 def test_equilibrium_balances_gravity_and_springs(rt70):
-    held = lin.rt70_pointing(45.0, 30.0)
+    held = rt70_state.rt70_pointing(45.0, 30.0)
     q0 = lin.equilibrium(rt70, held)
     free = np.setdiff1d(np.arange(rt70.textbook.nv), lin.coordinate_indices(rt70, list(held)))
     Q = lin.static_force(rt70, q0)
@@ -80,7 +81,7 @@ def test_locked_coordinates_equal_pinocchio_reduced_model(rt70):
 
 
 def test_sag_reports_mm_and_arcsec(rt70):
-    held = lin.rt70_pointing(90.0)
+    held = rt70_state.rt70_pointing(90.0)
     q0 = lin.equilibrium(rt70, held)
     sags = {s.body: s for s in lin.sag(rt70, q0, held)}
     assert set(sags) == set(rt70.textbook.body_names)
@@ -100,9 +101,9 @@ def test_inputs_and_outputs_of_the_rt70(rt70):
     """Drive torque in, mirror focus out: B and C from the textbook Jacobians, checked."""
     from rt70.linear import responses
 
-    held = lin.rt70_pointing(60.0)
+    held = rt70_state.rt70_pointing(60.0)
     q0 = lin.equilibrium(rt70, held)
-    lm = lin.linearize(rt70, q0, locked=(lin.ELEVATION_COORDINATE,))
+    lm = lin.linearize(rt70, q0, locked=(rt70_state.ELEVATION_COORDINATE,))
     # azimuth drive: a torque about the ground z axis on the platform acts on platform_rz
     b = lin.force_input(lm, rt70, "platform", [0, 0, 1], torque=True)
     assert b[lm.coordinates.index("platform_rz")] == pytest.approx(1.0)

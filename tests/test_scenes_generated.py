@@ -10,7 +10,8 @@ import pinocchio as pin
 import pytest
 
 from rt70.scenes import mechanisms, rt70_data
-from rt70.scenes.generate import RT70_NS, SCENES, pair_joint_names, write_all
+from rt70.scenes.generate import RT70_NS, SCENES, write_all
+from rt70.scenes.pairs import pair_joint_names
 
 URDF_DIR = Path(__file__).resolve().parents[1] / "urdf"
 NS = {"rt70": RT70_NS}

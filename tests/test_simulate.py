@@ -6,7 +6,8 @@ import pytest
 from rt70.cli import main
 from rt70.errors import Rt70Error
 from rt70.scene import load_scene
-from rt70.simulate import listing_initial_state, simulate
+from rt70.scenes.rt70_state import listing_initial_state, start_state
+from rt70.simulate import simulate
 
 
 def test_backends_agree_on_trajectories():
@@ -29,8 +30,9 @@ def test_backends_agree_on_trajectories():
 def test_rt70_backends_agree_from_the_listing_state():
     scene = load_scene("rt70")
     t = np.linspace(0.0, 0.05, 11)
-    a = simulate(scene, (0.0, 0.05), backend="pinocchio", method="BDF", rtol=1e-8, t_eval=t)
-    b = simulate(scene, (0.0, 0.05), backend="textbook", method="BDF", rtol=1e-8, t_eval=t)
+    x0 = listing_initial_state(scene)
+    a = simulate(scene, (0.0, 0.05), x0, backend="pinocchio", method="BDF", rtol=1e-8, t_eval=t)
+    b = simulate(scene, (0.0, 0.05), x0, backend="textbook", method="BDF", rtol=1e-8, t_eval=t)
     assert a.success and b.success
     assert np.abs(a.q - b.q).max() <= 1e-6 * np.abs(a.q).max()
 
@@ -70,13 +72,22 @@ def test_input_work_enters_the_balance():
     assert r.relative_drift <= 1e-8
 
 
-def test_listing_initial_state_is_the_default():
+def test_listing_initial_state_is_the_command_lines_start_for_the_rt70(capsys):
+    """simulate() starts at rest unless told; ``rt70 simulate`` gives the RT-70 the listing's."""
     scene = load_scene("rt70")
     q0, qd0 = listing_initial_state(scene)
     i = scene.textbook.coordinate_names.index("platform_rz")
     assert q0[i] == 0.8 and qd0[i] == 0.003
+    start = start_state(scene)
+    assert start is not None and np.array_equal(start[0], q0) and np.array_equal(start[1], qd0)
+    assert start_state(load_scene("double_pendulum")) is None
+    with pytest.raises(Rt70Error, match="for the rt70 scene"):
+        listing_initial_state(load_scene("double_pendulum"))
     r = simulate(scene, (0.0, 0.01), method="BDF")
-    assert np.array_equal(r.q[0], q0)
+    assert not r.q[0].any() and not r.qd[0].any()
+    assert main(["simulate", "rt70", "--t-end", "0.01"]) == 0
+    # the listing's state: 10898.2 J of kinetic energy (at rest it would be 0)
+    assert "T0 = 10898.2 J" in capsys.readouterr().out
 
 
 def test_cli_simulate_writes_outputs_atomically(tmp_path, capsys):

@@ -18,6 +18,7 @@ from rt70.linear.tree_invariant import (
     model_omega2_product,
     printed_omega2_product,
 )
+from rt70.scenes import rt70_chapter2
 
 #: Relative agreement asked of eigh's product. The values span two decades: eigh's error
 #: is absolute (ε·λ_max), so a wider spread costs the smallest eigenvalues relative digits
@@ -109,12 +110,12 @@ def test_rows_scaled_by_a_ratio_act_as_stiffness_times_its_square():
     assert product == pytest.approx(free_tree_omega2_product(inertias, r**2 * stiffness), rel=RTOL)
 
 
-@pytest.mark.parametrize("key", topology.AZIMUTH_ELEVATIONS)
+@pytest.mark.parametrize("key", rt70_chapter2.AZIMUTH_ELEVATIONS)
 def test_book_azimuth_model_is_a_free_tree_and_obeys_it(key):
-    model = topology.azimuth_model(key)
+    model = rt70_chapter2.azimuth_model(key)
     w = np.sort(scipy.linalg.eigh(model.C, model.m, eigvals_only=True))
     assert model_omega2_product(model) == pytest.approx(math.prod(w[1:]), rel=1e-12)
-    free_tree_check(topology.elevation_model())
+    free_tree_check(rt70_chapter2.elevation_model())
 
 
 def test_units_cancel():

@@ -12,9 +12,9 @@ springs (formalism §4.3–§4.4):
   rest against the exact ``Σ Jᵀ C J``;
 - ``D = −∂Q_d/∂q̇`` at q0 — exact (Q_d is linear in q̇): its columns are ``−Q_d(q0, e_i)``.
 
-Coordinates held by drives (the azimuth and elevation axes of the RT-70) can be held at
-given values while the equilibrium is solved, and locked (removed) or left free in the
-linear model.
+Coordinates held by drives (for the RT-70 its azimuth and elevation axes,
+:func:`rt70.scenes.rt70_state.rt70_pointing`) are given by name: held at given values
+while the equilibrium is solved, and locked (removed) or left free in the linear model.
 """
 
 from __future__ import annotations
@@ -30,10 +30,6 @@ from rt70.textbook import dynamics, forces
 
 #: Finite-difference step of the stiffness matrix, per coordinate (m or rad).
 FD_STEP = 1e-6
-
-#: RT-70 pointing axes: the coordinates the drives turn (rt70-data §D).
-AZIMUTH_COORDINATE = "platform_rz"
-ELEVATION_COORDINATE = "base_rx"
 
 
 def static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
@@ -177,19 +173,6 @@ def _gravity_stiffness(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.nd
     return _negative_jacobian(
         lambda x: dynamics.gravity_force(model, data, x), np.asarray(q, dtype=float), h
     )
-
-
-def rt70_pointing(elevation_deg: float, azimuth_deg: float = 0.0) -> dict[str, float]:
-    """Held coordinates of the RT-70 drives for a pointing.
-
-    q = 0 is the listing's construction, the dish looking at the zenith (the mirror axis
-    along z): elevation E sets the base's rotation ``base_rx = π/2 − E``, azimuth A the
-    platform's ``platform_rz = A``.
-    """
-    return {
-        AZIMUTH_COORDINATE: np.radians(azimuth_deg),
-        ELEVATION_COORDINATE: np.pi / 2 - np.radians(elevation_deg),
-    }
 
 
 #: Arc seconds per radian (the listing's TURNE0 output unit).

@@ -9,11 +9,10 @@ the ground), so the deformations are ``Γ α`` with the topology matrix Γ, and 
 For 3-D point masses every entry of Γ is a 3 × 3 block (``dim=3``): the coordinates are
 ordered node by node, x, y, z within a node, and a link's stiffness acts per axis.
 
-The builders :func:`azimuth_model` and :func:`elevation_model` type the book's RT-70
-chapter-2 models from :mod:`rt70.scenes.rt70_data` (technical units: inertia kgf·s²·m,
-stiffness kgf·m/rad; the frequencies do not depend on the unit), and
-:func:`from_scene` reads the same models back from their URDF scenes (SI), so that the
-tables and the files can be compared.
+:func:`from_graph` builds a model from inertias, links and stiffnesses (the book's
+RT-70 tables are typed this way in :mod:`rt70.scenes.rt70_chapter2`), and
+:func:`from_scene` reads such a model back from a torsional URDF scene (SI), so that
+tables and files can be compared.
 """
 
 from __future__ import annotations
@@ -27,16 +26,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rt70.errors import NonFiniteError, Rt70Error, TopologyError
-from rt70.scenes import rt70_data
 
 if TYPE_CHECKING:
     from rt70.scene import Scene
 
 #: An elastic (or rigid) link: ``(i, j)``, 1-based node numbers, 0 = the ground.
 Edge = tuple[int, int]
-
-#: Elevations (degrees, as strings) of the azimuth model's two table columns.
-AZIMUTH_ELEVATIONS = ("0", "90")
 
 
 class LinearModelError(Rt70Error):
@@ -391,60 +386,6 @@ def book_delta(omega1: float) -> float:
     if not (math.isfinite(omega1) and omega1 > 0):
         raise LinearModelError(f"first resonance Ω1 must be positive and finite, got {omega1}")
     return 0.1 / omega1
-
-
-# ---------------------------------------------------------------------------------------
-# The book's RT-70 chapter-2 models
-# ---------------------------------------------------------------------------------------
-
-
-def azimuth_model(elevation: str | int = "0") -> LinearModel:
-    """The 7-mass azimuth model of the RT-70 (§2.3, Tables 2.1–2.2, Γα (2.14)).
-
-    Parameters
-    ----------
-    elevation : {"0", "90"}
-        Which columns of the tables to use: the antenna at elevation 0° or 90°.
-
-    Returns
-    -------
-    LinearModel
-        Technical units: inertia kgf·s²·m, stiffness kgf·m/rad; no damping (see
-        :func:`proportional_damping`). No link to the ground: one zero frequency.
-
-    Raises
-    ------
-    LinearModelError
-        If ``elevation`` is not 0 or 90.
-    """
-    key = str(elevation)
-    if key not in AZIMUTH_ELEVATIONS:
-        raise LinearModelError(f"azimuth model elevation must be '0' or '90', got {elevation!r}")
-    d = rt70_data
-    return from_graph(
-        [node[f"I_el{key}"] for node in d.AZIMUTH_NODES],
-        edges_from_topology(np.array(d.GAMMA_ALPHA)),
-        [link[f"C_el{key}"] for link in d.AZIMUTH_LINKS],
-        names=[node["name"] for node in d.AZIMUTH_NODES],
-    )
-
-
-def elevation_model() -> LinearModel:
-    """The 6-mass elevation model of the RT-70 (§2.4, Tables 2.3–2.4, Γβ (2.26)).
-
-    Returns
-    -------
-    LinearModel
-        Technical units: inertia kgf·s²·m, stiffness kgf·m/rad; no damping. Its
-        spectrum is the printed one, 0, 3.2700, 4.2424, 6.3041, 7.2579, 19.6420 Hz.
-    """
-    d = rt70_data
-    return from_graph(
-        [node["I"] for node in d.ELEVATION_NODES],
-        edges_from_topology(np.array(d.GAMMA_BETA)),
-        [link["C"] for link in d.ELEVATION_LINKS],
-        names=[node["name"] for node in d.ELEVATION_NODES],
-    )
 
 
 def _rpy_z_only(rpy: np.ndarray) -> bool:

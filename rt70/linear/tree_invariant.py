@@ -136,7 +136,7 @@ def model_omega2_product(model: LinearModel) -> float:
     Parameters
     ----------
     model : LinearModel
-        E.g. :func:`rt70.linear.topology.azimuth_model`.
+        E.g. :func:`rt70.scenes.rt70_chapter2.azimuth_model`.
 
     Returns
     -------

@@ -14,7 +14,7 @@ import numpy as np
 
 from rt70.atomic import atomic_write, atomic_write_text
 from rt70.linear import linearize as lin
-from rt70.linear import modal, responses, topology
+from rt70.linear import modal, responses
 from rt70.plotting.modal import plot_bode
 from rt70.reports.book_azimuth import azimuth_section
 from rt70.reports.book_format import (
@@ -24,7 +24,7 @@ from rt70.reports.book_format import (
     spectrum_table,
 )
 from rt70.scene import Scene, load_scene
-from rt70.scenes import rt70_data
+from rt70.scenes import rt70_chapter2, rt70_data, rt70_state
 
 #: Bodies of the listing in the order of the chapter-2 azimuth nodes (Table 2.1).
 AZIMUTH_BODIES = (
@@ -53,7 +53,7 @@ ELEVATION_BODIES = (
 def elevation_section() -> tuple[str, bool]:
     """The elevation model (§2.4): printed spectrum against Tables 2.3–2.4 and Γβ."""
     printed = list(rt70_data.ELEVATION_SPECTRUM_HZ)
-    model = topology.elevation_model()
+    model = rt70_chapter2.elevation_model()
     freqs = frequencies(model.m, model.C)
     scene = load_scene("rt70_elevation")
     lm = lin.linearize(scene, np.zeros(scene.textbook.nv))
@@ -74,7 +74,7 @@ From the URDF scene: {", ".join(f"{f:.4f}" for f in from_urdf)} Hz.
 
 def damping_section() -> tuple[str, float]:
     """ξ = 0.05 (δ = 0.1/Ω1) gives +20 dB at the first resonance (§2.3, §4.2.2)."""
-    model = topology.elevation_model()
+    model = rt70_chapter2.elevation_model()
     undamped = modal.modes(model.m, model.C)
     D, delta = modal.stiffness_proportional_damping(model.C, undamped, zeta1=0.05)
     damped = modal.modes(model.m, model.C, D)
@@ -163,7 +163,7 @@ def reduction_section(scene: Scene) -> str:
             AZIMUTH_BODIES,
             [n["I_el90"] for n in rt70_data.AZIMUTH_NODES],
             [(c["name"], c["C_el90"]) for c in rt70_data.AZIMUTH_LINKS],
-            topology.azimuth_model("90"),
+            rt70_chapter2.azimuth_model("90"),
             "azimuth (rotations about z; Tables 2.1–2.2, 90° columns: the dish at the zenith)",
         ),
         (
@@ -171,7 +171,7 @@ def reduction_section(scene: Scene) -> str:
             ELEVATION_BODIES,
             [n["I"] for n in rt70_data.ELEVATION_NODES],
             [(c["name"], c["C"]) for c in rt70_data.ELEVATION_LINKS],
-            topology.elevation_model(),
+            rt70_chapter2.elevation_model(),
             "elevation (rotations about x; Tables 2.3–2.4)",
         ),
     ):
@@ -235,7 +235,7 @@ def sweep_section(scene: Scene, elevations=(0, 15, 30, 45, 60, 75, 90)) -> str:
     """Spectrum of the full 42-DOF model against elevation, and the static sag."""
     rows_locked, rows_free, sag_rows = [], [], []
     for e in elevations:
-        held = lin.rt70_pointing(float(e))
+        held = rt70_state.rt70_pointing(float(e))
         q0 = lin.equilibrium(scene, held)
         locked = lin.linearize(scene, q0, locked=tuple(held))
         m_locked = modal.modes(locked.M, locked.K)
@@ -313,7 +313,7 @@ def reproduce(out_dir: str | Path) -> Path:
 
 def _bode_plot(path: Path) -> None:
     """The book's ЛАХ/ЛФХ: elevation model with ξ1 = 0.05, torque on the base to mirror angle."""
-    model = topology.elevation_model()
+    model = rt70_chapter2.elevation_model()
     undamped = modal.modes(model.m, model.C)
     D, _ = modal.stiffness_proportional_damping(model.C, undamped, zeta1=0.05)
     names = list(model.names)

@@ -16,13 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from rt70.linear import topology, tree_invariant
+from rt70.linear import tree_invariant
 from rt70.reports.book_format import (
     frequencies,
     markdown_table,
     spectrum_table,
 )
-from rt70.scenes import rt70_data
+from rt70.scenes import rt70_chapter2, rt70_data
 
 
 @dataclass(frozen=True)
@@ -124,7 +124,7 @@ def _invariant_text(
             np.array([n[f"I_el{key}"] for n in d.AZIMUTH_NODES]),
             np.array([c[f"C_el{key}"] for c in d.AZIMUTH_LINKS]),
         )
-        for key in topology.AZIMUTH_ELEVATIONS
+        for key in rt70_chapter2.AZIMUTH_ELEVATIONS
     }
     p_printed = tree_invariant.printed_omega2_product(printed)
     bound = _rounding_bound(printed)
@@ -139,7 +139,7 @@ def _invariant_text(
         value = tree_invariant.free_tree_omega2_product(cols[i_key][0], cols[c_key][1])
         invariants[(i_key, c_key)] = value
         rows.append([label, f"{value:.5e}", f"{p_printed / value:.4g}"])
-    m0 = topology.azimuth_model("0")
+    m0 = rt70_chapter2.azimuth_model("0")
     w = np.sort(scipy.linalg.eigh(m0.C, m0.m, eigvals_only=True))
     eig_check = abs(float(np.prod(w[1:])) / tree_invariant.model_omega2_product(m0) - 1)
     ratio0 = p_printed / invariants[("0", "0")]
@@ -147,7 +147,7 @@ def _invariant_text(
     shortfall = f"{ratio0 - 1:.1%}".replace("-", "−")
     eig_agrees = "to within 1e-12" if eig_check <= 1e-12 else f"only to {eig_check:.1e}"
     e_printed = tree_invariant.printed_omega2_product(rt70_data.ELEVATION_SPECTRUM_HZ)
-    e_ratio = e_printed / tree_invariant.model_omega2_product(topology.elevation_model())
+    e_ratio = e_printed / tree_invariant.model_omega2_product(rt70_chapter2.elevation_model())
     e_bound = _rounding_bound(rt70_data.ELEVATION_SPECTRUM_HZ)
 
     inertia, C = cols["0"]
@@ -243,7 +243,7 @@ No single changed value, whatever its size, reproduces the printed spectrum with
 def azimuth_section() -> tuple[str, dict]:
     """The azimuth model (§2.3): what is reproduced and what is not, with the search."""
     printed = np.array(rt70_data.AZIMUTH_SPECTRUM_EL0_HZ)
-    m0, m90 = topology.azimuth_model("0"), topology.azimuth_model("90")
+    m0, m90 = rt70_chapter2.azimuth_model("0"), rt70_chapter2.azimuth_model("90")
     f0, f90 = frequencies(m0.m, m0.C), frequencies(m90.m, m90.C)
     inertia = np.diag(m0.m).copy()
     C = np.asarray(m0.c_links, dtype=float)

@@ -100,12 +100,15 @@ QUICK_PROBLEMS = (
 
 def listing_pointing(scene) -> dict[str, float]:
     """The RT-70 drive coordinates held at the listing's initial values (rad)."""
-    from rt70.linear import linearize as lin
-    from rt70.simulate import listing_initial_state
+    from rt70.scenes.rt70_state import (
+        AZIMUTH_COORDINATE,
+        ELEVATION_COORDINATE,
+        listing_initial_state,
+    )
 
     q0, _ = listing_initial_state(scene)
     names = scene.textbook.coordinate_names
-    axes = (lin.AZIMUTH_COORDINATE, lin.ELEVATION_COORDINATE)
+    axes = (AZIMUTH_COORDINATE, ELEVATION_COORDINATE)
     return {c: float(q0[names.index(c)]) for c in axes}
 
 
@@ -186,7 +189,7 @@ def build_problem(problem: Problem) -> tuple[object, tuple[np.ndarray, np.ndarra
     """
     from rt70.scene import load_scene, scene_from_text
     from rt70.scenes import synthetic
-    from rt70.simulate import listing_initial_state
+    from rt70.scenes.rt70_state import listing_initial_state
 
     T = f"T = {problem.t_end:g} s"
     if problem.name == "rt70":

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from rt70.atomic import atomic_write_text
 from rt70.scenes import mechanisms, rt70_data
+from rt70.scenes.pairs import PAIR_JOINTS, pair_joint_names
 
 #: Namespace of the rt70 URDF extension elements.
 RT70_NS = "urn:rt70:urdf-extensions:1"
@@ -35,16 +36,6 @@ ROOT_LINK = "world"
 # Wide joint limits: pinocchio's URDF parser requires <limit> on revolute and prismatic
 # joints; these never bind.
 _LIMIT = (("lower", -1.0e3), ("upper", 1.0e3), ("effort", 1.0e12), ("velocity", 1.0e6))
-
-# The six 1-DOF joints of an elastic pair, in the book's coordinate order [x, y, z, β, θ, α].
-_PAIR_JOINTS = (
-    ("x", "prismatic", (1, 0, 0)),
-    ("y", "prismatic", (0, 1, 0)),
-    ("z", "prismatic", (0, 0, 1)),
-    ("rx", "revolute", (1, 0, 0)),
-    ("ry", "revolute", (0, 1, 0)),
-    ("rz", "revolute", (0, 0, 1)),
-)
 
 _ZERO3 = (0.0, 0.0, 0.0)
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -235,23 +226,6 @@ def _massive_link(
     w.close("link")
 
 
-def pair_joint_names(body: str) -> list[str]:
-    """Return the names of the six joints of a body's elastic pair.
-
-    Parameters
-    ----------
-    body : str
-        The body (child link) name.
-
-    Returns
-    -------
-    list of str
-        ``<body>_x, <body>_y, <body>_z, <body>_rx, <body>_ry, <body>_rz``: the book's
-        pair coordinates ``[x, y, z, β, θ, α]`` in order.
-    """
-    return [f"{body}_{axis}" for axis, _, _ in _PAIR_JOINTS]
-
-
 def _six_dof_body(
     w: _Writer,
     body: str,
@@ -270,8 +244,8 @@ def _six_dof_body(
     """
     w.comment(f"{body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}]")
     previous = parent
-    for k, (axis, jtype, direction) in enumerate(_PAIR_JOINTS):
-        last = k == len(_PAIR_JOINTS) - 1
+    for k, (axis, jtype, direction) in enumerate(PAIR_JOINTS):
+        last = k == len(PAIR_JOINTS) - 1
         child = body if last else f"{body}_{axis}_link"
         _joint(
             w,

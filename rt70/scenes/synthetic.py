@@ -54,7 +54,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from rt70.rotations import rpy_matrix, rpy_of_matrix
-from rt70.scenes.generate import _PAIR_JOINTS, fmt, fmt_vec
+from rt70.scenes.generate import fmt, fmt_vec
+from rt70.scenes.pairs import PAIR_JOINTS
 
 #: Every joint type of the URDF standard, as :func:`random_tree` draws them.
 ALL_JOINT_TYPES = ("revolute", "prismatic", "fixed", "continuous", "floating", "planar")
@@ -443,8 +444,8 @@ def elastic_chain(n_bodies: int, seed: int = 0) -> str:
         offset_rpy = rng.uniform(-0.3, 0.3, 3)
         w.add(f"<!-- {body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}] -->")
         previous = parent
-        for step, (suffix, jtype, axis) in enumerate(_PAIR_JOINTS):
-            last = step == len(_PAIR_JOINTS) - 1
+        for step, (suffix, jtype, axis) in enumerate(PAIR_JOINTS):
+            last = step == len(PAIR_JOINTS) - 1
             child = body if last else f"{body}_{suffix}_link"
             link = _Body(child, f"{body}_{suffix}", jtype, previous)
             if step == 0:

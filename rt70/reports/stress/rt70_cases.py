@@ -30,7 +30,8 @@ from rt70.reports.stress.measures import (
 from rt70.reports.stress.runs import SIM_RTOL, RunOutcome, Settings, run_capped
 from rt70.reports.stress.tables import SIM_COLUMNS, Table, short_error, sim_fields, worst_value
 from rt70.scene import Scene, load_scene, scene_from_text
-from rt70.simulate import BACKENDS, listing_initial_state
+from rt70.scenes.rt70_state import listing_initial_state
+from rt70.simulate import BACKENDS
 from rt70.textbook import dynamics, forces
 from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, GIMBAL_LOCK_COS, euler_matrix
 

@@ -27,7 +27,7 @@ from rt70.reports.stress.measures import (
 from rt70.reports.stress.runs import Settings, run_capped
 from rt70.reports.stress.tables import SIM_COLUMNS, Table, sim_fields, worst_value
 from rt70.scene import Scene, load_scene, scene_from_text
-from rt70.simulate import listing_initial_state
+from rt70.scenes.rt70_state import listing_initial_state
 from rt70.textbook import dynamics, forces, structured
 from rt70.validate import random_state
 
