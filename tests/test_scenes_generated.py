@@ -10,8 +10,9 @@ import pinocchio as pin
 import pytest
 
 from rt70.scenes import mechanisms, rt70_data
-from rt70.scenes.generate import RT70_NS, SCENES, write_all
+from rt70.scenes.generate import SCENES, write_all
 from rt70.scenes.pairs import pair_joint_names
+from rt70.scenes.urdf_writer import RT70_NS
 
 URDF_DIR = Path(__file__).resolve().parents[1] / "urdf"
 NS = {"rt70": RT70_NS}

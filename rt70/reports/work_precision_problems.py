@@ -162,7 +162,7 @@ def light_damping_text(text: str, delta: float) -> str:
     str
         The edited URDF text (comments dropped).
     """
-    from rt70.scenes.generate import fmt_vec
+    from rt70.scenes.urdf_writer import fmt_vec
     from rt70.urdf import RT70_NS
 
     if not (math.isfinite(delta) and delta >= 0.0):

@@ -3,7 +3,10 @@
 The data live in :mod:`rt70.scenes.rt70_data` (the RT-70 listing of §4.2.3 and the
 chapter-2 tables) and :mod:`rt70.scenes.mechanisms` (small test mechanisms);
 :mod:`rt70.scenes.generate` turns them into the URDF files under ``urdf/``
-(``python -m rt70.scenes.generate [DIR]``).
+(``python -m rt70.scenes.generate [DIR]``) with :mod:`rt70.scenes.urdf_writer`.
+What the analyses are told about the RT-70 is built here too:
+:mod:`rt70.scenes.rt70_chapter2` (the chapter-2 models from the tables) and
+:mod:`rt70.scenes.rt70_state` (pointing axes, the listing's start state).
 
 ``SCENES`` and ``write_all`` are re-exported lazily, so that running the generator
 with ``python -m`` does not import it twice.

@@ -1,11 +1,10 @@
 """Build the rt70 scene URDF files from the book's data.
 
 Every scene is a function returning the URDF text; :data:`SCENES` maps scene names to
-them and :func:`write_all` writes ``<name>.urdf`` files. The output is deterministic:
-fixed element and attribute order, two-space indentation, numbers written as the
-shortest text that reads back as the same float (``repr``, with a trailing ``.0``
-dropped), and a final newline. The extension elements follow
-``docs/urdf-extensions.md``.
+them and :func:`write_all` writes ``<name>.urdf`` files. The output is deterministic
+(:mod:`rt70.scenes.urdf_writer`: fixed element and attribute order, two-space
+indentation, numbers written as the shortest text that reads back as the same float,
+and a final newline). The extension elements follow ``docs/urdf-extensions.md``.
 
 Run ``python -m rt70.scenes.generate [DIR]`` to regenerate the files (default: the
 repository's ``urdf/`` directory).
@@ -14,282 +13,18 @@ repository's ``urdf/`` directory).
 from __future__ import annotations
 
 import argparse
-import math
-import re
 import sys
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from rt70.atomic import atomic_write_text
 from rt70.scenes import mechanisms, rt70_data
-from rt70.scenes.pairs import PAIR_JOINTS, pair_joint_names
-
-#: Namespace of the rt70 URDF extension elements.
-RT70_NS = "urn:rt70:urdf-extensions:1"
+from rt70.scenes import urdf_writer as uw
+from rt70.scenes.pairs import pair_joint_names
+from rt70.scenes.urdf_writer import ROOT_LINK, ZERO3, check_name, fmt, fmt_vec
 
 #: Default output directory: ``urdf/`` at the repository root.
 DEFAULT_DIRECTORY = Path(__file__).resolve().parents[2] / "urdf"
-
-#: Name of the root (ground) link of every scene.
-ROOT_LINK = "world"
-
-# Wide joint limits: pinocchio's URDF parser requires <limit> on revolute and prismatic
-# joints; these never bind.
-_LIMIT = (("lower", -1.0e3), ("upper", 1.0e3), ("effort", 1.0e12), ("velocity", 1.0e6))
-
-_ZERO3 = (0.0, 0.0, 0.0)
-_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
-
-
-# ---------------------------------------------------------------------------------------
-# Formatting
-# ---------------------------------------------------------------------------------------
-
-
-def fmt(value: float) -> str:
-    """Format a number exactly and deterministically.
-
-    Parameters
-    ----------
-    value : float
-        A finite number.
-
-    Returns
-    -------
-    str
-        The shortest decimal text that reads back as the same float: for
-        1e-4 ≤ |x| < 1e6 Python's ``repr`` without a trailing ``.0`` (``25``,
-        ``13.45``), otherwise scientific notation with the fewest digits
-        (``5e+10``, ``5.35e+11``, ``1e-06``); zero (also ``-0.0``) is written ``0``.
-
-    Raises
-    ------
-    ValueError
-        If the value is NaN or infinite.
-    """
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"non-finite number {x!r} in a scene")
-    if x == 0.0:
-        return "0"
-    if 1e-4 <= abs(x) < 1e6:
-        text = repr(x)
-        return text[:-2] if text.endswith(".0") else text
-    for digits in range(17):
-        text = format(x, f".{digits}e")
-        if float(text) == x:
-            return text
-    return repr(x)  # pragma: no cover - 17 significant digits always round-trip
-
-
-def fmt_vec(values: Iterable[float]) -> str:
-    """Format a sequence of numbers as a space-separated attribute value.
-
-    Parameters
-    ----------
-    values : iterable of float
-        The numbers.
-
-    Returns
-    -------
-    str
-        The numbers formatted by :func:`fmt`, separated by single spaces.
-    """
-    return " ".join(fmt(v) for v in values)
-
-
-def _name(name: str) -> str:
-    if not _NAME.match(name):
-        raise ValueError(f"invalid name {name!r} in a scene")
-    return name
-
-
-class _Writer:
-    """Line-oriented XML writer with fixed attribute order and 2-space indentation."""
-
-    def __init__(self) -> None:
-        self.lines: list[str] = []
-        self.depth = 0
-
-    @staticmethod
-    def _attrs(attrs: Sequence[tuple[str, str]]) -> str:
-        for _, value in attrs:
-            if any(c in value for c in '<>&"'):
-                raise ValueError(f"attribute value {value!r} needs escaping")
-        return "".join(f' {key}="{value}"' for key, value in attrs)
-
-    def empty(self, tag: str, *attrs: tuple[str, str]) -> None:
-        self.lines.append("  " * self.depth + f"<{tag}{self._attrs(attrs)}/>")
-
-    def open(self, tag: str, *attrs: tuple[str, str]) -> None:
-        self.lines.append("  " * self.depth + f"<{tag}{self._attrs(attrs)}>")
-        self.depth += 1
-
-    def close(self, tag: str) -> None:
-        self.depth -= 1
-        self.lines.append("  " * self.depth + f"</{tag}>")
-
-    def comment(self, text: str) -> None:
-        if "--" in text:
-            raise ValueError("'--' is not allowed in an XML comment")
-        self.lines.append("  " * self.depth + f"<!-- {text} -->")
-
-    def blank(self) -> None:
-        self.lines.append("")
-
-    def text(self) -> str:
-        if self.depth != 0:
-            raise RuntimeError("unbalanced XML elements")
-        return "\n".join(self.lines) + "\n"
-
-
-# ---------------------------------------------------------------------------------------
-# Building blocks
-# ---------------------------------------------------------------------------------------
-
-
-def _check_inertia(link: str, mass: float, moments: Sequence[float]) -> None:
-    if not mass > 0.0:
-        raise ValueError(f"link {link!r}: mass must be positive, got {mass!r}")
-    if any(not m > 0.0 for m in moments):
-        raise ValueError(f"link {link!r}: principal moments must be positive, got {moments}")
-    if 2.0 * max(moments) > sum(moments):
-        raise ValueError(
-            f"link {link!r}: principal moments {moments} violate the triangle inequality"
-        )
-
-
-def _begin(w: _Writer, name: str, description: str) -> None:
-    w.lines.append('<?xml version="1.0"?>')
-    w.comment(f"{description}")
-    w.comment("Generated by rt70.scenes.generate; do not edit by hand.")
-    w.open("robot", ("name", _name(name)), ("xmlns:rt70", RT70_NS))
-    w.empty("link", ("name", ROOT_LINK))
-
-
-def _end(w: _Writer) -> str:
-    w.close("robot")
-    return w.text()
-
-
-def _joint(
-    w: _Writer,
-    name: str,
-    jtype: str,
-    parent: str,
-    child: str,
-    xyz: Sequence[float] = _ZERO3,
-    rpy: Sequence[float] = _ZERO3,
-    axis: Sequence[int] = (0, 0, 1),
-) -> None:
-    if jtype not in ("revolute", "prismatic", "fixed"):
-        raise ValueError(f"joint type {jtype!r} is not used in rt70 scenes")
-    w.open("joint", ("name", _name(name)), ("type", jtype))
-    w.empty("parent", ("link", _name(parent)))
-    w.empty("child", ("link", _name(child)))
-    w.empty("origin", ("xyz", fmt_vec(xyz)), ("rpy", fmt_vec(rpy)))
-    if jtype != "fixed":
-        w.empty("axis", ("xyz", " ".join(str(int(a)) for a in axis)))
-        w.empty("limit", *((key, fmt(value)) for key, value in _LIMIT))
-    w.close("joint")
-
-
-def _massless_link(w: _Writer, name: str) -> None:
-    w.empty("link", ("name", _name(name)))
-
-
-def _massive_link(
-    w: _Writer,
-    name: str,
-    mass: float,
-    moments: Sequence[float],
-    com: Sequence[float] = _ZERO3,
-    rpy: Sequence[float] = _ZERO3,
-) -> None:
-    """Write a link whose inertia has principal ``moments`` on axes rotated by ``rpy``."""
-    _check_inertia(name, mass, moments)
-    ixx, iyy, izz = moments
-    w.open("link", ("name", _name(name)))
-    w.open("inertial")
-    w.empty("origin", ("xyz", fmt_vec(com)), ("rpy", fmt_vec(rpy)))
-    w.empty("mass", ("value", fmt(mass)))
-    w.empty(
-        "inertia",
-        ("ixx", fmt(ixx)),
-        ("ixy", "0"),
-        ("ixz", "0"),
-        ("iyy", fmt(iyy)),
-        ("iyz", "0"),
-        ("izz", fmt(izz)),
-    )
-    w.close("inertial")
-    w.close("link")
-
-
-def _six_dof_body(
-    w: _Writer,
-    body: str,
-    parent: str,
-    offset: Sequence[float],
-    mass: float,
-    moments: Sequence[float],
-    com: Sequence[float] = _ZERO3,
-    inertia_rpy: Sequence[float] = _ZERO3,
-) -> None:
-    """Write a body joined to ``parent`` by six 1-DOF joints in series (a 6-DOF pair).
-
-    The first joint's origin is the construction offset; the other five have zero
-    origin. Intermediate links are massless; the body's inertia sits on the last link,
-    named after the body.
-    """
-    w.comment(f"{body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}]")
-    previous = parent
-    for k, (axis, jtype, direction) in enumerate(PAIR_JOINTS):
-        last = k == len(PAIR_JOINTS) - 1
-        child = body if last else f"{body}_{axis}_link"
-        _joint(
-            w,
-            f"{body}_{axis}",
-            jtype,
-            previous,
-            child,
-            xyz=offset if k == 0 else _ZERO3,
-            axis=direction,
-        )
-        if last:
-            _massive_link(w, child, mass, moments, com, inertia_rpy)
-        else:
-            _massless_link(w, child)
-        previous = child
-
-
-def _gravity(w: _Writer, g: Sequence[float]) -> None:
-    w.empty("rt70:gravity", ("xyz", fmt_vec(g)))
-
-
-def _bushing(
-    w: _Writer,
-    name: str,
-    stiffness: Sequence[float],
-    damping: Sequence[float],
-    link1: str,
-    link2: str,
-    xyz1: Sequence[float] = _ZERO3,
-    rpy1: Sequence[float] = _ZERO3,
-    xyz2: Sequence[float] = _ZERO3,
-    rpy2: Sequence[float] = _ZERO3,
-) -> None:
-    if len(stiffness) != 6 or len(damping) != 6:
-        raise ValueError(f"bushing {name!r} needs six stiffness and six damping values")
-    w.open(
-        "rt70:bushing",
-        ("name", _name(name)),
-        ("stiffness", fmt_vec(stiffness)),
-        ("damping", fmt_vec(damping)),
-    )
-    w.empty("rt70:frame1", ("link", _name(link1)), ("xyz", fmt_vec(xyz1)), ("rpy", fmt_vec(rpy1)))
-    w.empty("rt70:frame2", ("link", _name(link2)), ("xyz", fmt_vec(xyz2)), ("rpy", fmt_vec(rpy2)))
-    w.close("rt70:bushing")
 
 
 def _gamma_ends(row: Sequence[int], what: str) -> tuple[int | None, int]:
@@ -318,15 +53,15 @@ def rt70_scene() -> str:
     """
     d = rt70_data
     bodies = {b["name"]: b for b in d.LISTING_BODIES}
-    w = _Writer()
-    _begin(
+    w = uw.Writer()
+    uw.begin(
         w,
         "rt70",
         "RT-70 radio telescope, 42-DOF nonlinear model (Dubarenko 2007, "
         "listing of section 4.2.3, errata in docs/rt70-errata.md)",
     )
     for body in d.LISTING_BODIES:
-        _six_dof_body(
+        uw.six_dof_body(
             w,
             body["name"],
             body["parent"],
@@ -337,11 +72,11 @@ def rt70_scene() -> str:
         )
     w.blank()
     w.comment("Gravity (erratum 2: z up)")
-    _gravity(w, d.LISTING_GRAVITY)
+    uw.gravity(w, d.LISTING_GRAVITY)
     w.comment("Direct elastic pairs: frame 1 = construction frame, frame 2 = body frame")
     for pair in d.LISTING_DIRECT_PAIRS:
         child = bodies[pair["child"]]
-        _bushing(
+        uw.bushing(
             w,
             pair["name"],
             pair["stiffness"],
@@ -355,16 +90,16 @@ def rt70_scene() -> str:
         child = bodies[package["child"]]
         w.open(
             "rt70:strut_package",
-            ("name", _name(package["name"])),
-            ("parent", _name(child["parent"])),
-            ("child", _name(child["name"])),
+            ("name", check_name(package["name"])),
+            ("parent", check_name(child["parent"])),
+            ("child", check_name(child["name"])),
             ("xyz", fmt_vec(child["offset"])),
-            ("rpy", fmt_vec(_ZERO3)),
+            ("rpy", fmt_vec(ZERO3)),
         )
         for strut in package["struts"]:
             w.empty(
                 "rt70:strut",
-                ("name", _name(strut["name"])),
+                ("name", check_name(strut["name"])),
                 ("xyz", fmt_vec(strut["xyz"])),
                 ("rpy", fmt_vec(strut["rpy"])),
                 ("stiffness", fmt_vec(strut["stiffness"])),
@@ -375,11 +110,11 @@ def rt70_scene() -> str:
     for point in d.LISTING_OPTICAL_POINTS:
         w.empty(
             "rt70:optical_point",
-            ("name", _name(point["name"])),
-            ("link", _name(point["link"])),
+            ("name", check_name(point["name"])),
+            ("link", check_name(point["link"])),
             ("xyz", fmt_vec(point["xyz"])),
         )
-    return _end(w)
+    return uw.end(w)
 
 
 def _torsional_scene(
@@ -396,14 +131,14 @@ def _torsional_scene(
     """
     if len(links) != len(gamma) or any(len(row) != len(nodes) for row in gamma):
         raise ValueError(f"{name}: topology matrix does not match the tables")
-    w = _Writer()
-    _begin(w, name, description)
+    w = uw.Writer()
+    uw.begin(w, name, description)
     for k, (node, inertia) in enumerate(nodes, start=1):
         izz = inertia * rt70_data.KGF
-        _joint(w, f"node{k}", "revolute", ROOT_LINK, node, axis=(0, 0, 1))
-        _massive_link(w, node, rt70_data.CHAPTER2_NODE_MASS, (izz, izz, izz))
+        uw.joint(w, f"node{k}", "revolute", ROOT_LINK, node, axis=(0, 0, 1))
+        uw.massive_link(w, node, rt70_data.CHAPTER2_NODE_MASS, (izz, izz, izz))
     w.blank()
-    _gravity(w, (0.0, 0.0, -9.81))
+    uw.gravity(w, (0.0, 0.0, -9.81))
     w.comment("Torsion springs about z, one per row of the topology matrix")
     for (link, stiffness), row in zip(links, gamma, strict=True):
         i, j = _gamma_ends(row, f"{name} link {link}")
@@ -411,8 +146,8 @@ def _torsional_scene(
         second = nodes[j][0]
         if link != f"{first}_{second}":
             raise ValueError(f"{name}: link {link!r} does not join {first!r} and {second!r}")
-        _bushing(w, link, (0.0,) * 5 + (stiffness * rt70_data.KGF,), (0.0,) * 6, first, second)
-    return _end(w)
+        uw.bushing(w, link, (0.0,) * 5 + (stiffness * rt70_data.KGF,), (0.0,) * 6, first, second)
+    return uw.end(w)
 
 
 def rt70_elevation_scene() -> str:
@@ -483,20 +218,20 @@ def double_pendulum_scene() -> str:
         end of the first rod, gravity along −y.
     """
     d = mechanisms.DOUBLE_PENDULUM
-    w = _Writer()
-    _begin(
+    w = uw.Writer()
+    uw.begin(
         w, "double_pendulum", "Planar 2R arm (double pendulum) in the x-y plane, gravity along -y"
     )
-    parent, offset = ROOT_LINK, _ZERO3
+    parent, offset = ROOT_LINK, ZERO3
     for link in d["links"]:
         m, length = link["mass"], link["length"]
         i_c = m * length**2 / 12.0
-        _joint(w, link["joint"], "revolute", parent, link["name"], xyz=offset, axis=(0, 0, 1))
-        _massive_link(w, link["name"], m, (d["I_axial"], i_c, i_c), com=(length / 2.0, 0.0, 0.0))
+        uw.joint(w, link["joint"], "revolute", parent, link["name"], xyz=offset, axis=(0, 0, 1))
+        uw.massive_link(w, link["name"], m, (d["I_axial"], i_c, i_c), com=(length / 2.0, 0.0, 0.0))
         parent, offset = link["name"], (length, 0.0, 0.0)
     w.blank()
-    _gravity(w, d["gravity"])
-    return _end(w)
+    uw.gravity(w, d["gravity"])
+    return uw.end(w)
 
 
 def three_masses_scene() -> str:
@@ -510,21 +245,21 @@ def three_masses_scene() -> str:
     """
     d = mechanisms.THREE_MASSES
     masses = d["masses"]
-    w = _Writer()
-    _begin(
+    w = uw.Writer()
+    uw.begin(
         w,
         "three_masses",
         "Three point masses with elastic links (Dubarenko 2007, "
         "section 2.1, Fig. 2.1, eq. 2.3), motion along x",
     )
     for mass in masses:
-        _joint(
+        uw.joint(
             w, mass["joint"], "prismatic", ROOT_LINK, mass["name"], xyz=mass["rest"], axis=(1, 0, 0)
         )
         moment = d["point_moment"]
-        _massive_link(w, mass["name"], mass["mass"], (moment, moment, moment))
+        uw.massive_link(w, mass["name"], mass["mass"], (moment, moment, moment))
     w.blank()
-    _gravity(w, d["gravity"])
+    uw.gravity(w, d["gravity"])
     w.comment("Springs along x; frame 1 sits at the rest position of the second end")
     for row, stiffness in zip(d["gamma"], d["stiffness"], strict=True):
         i, j = _gamma_ends(row, "three_masses")
@@ -537,7 +272,7 @@ def three_masses_scene() -> str:
             first_link, name = first["name"], f"{first['name']}_{second['name']}"
             xyz1 = tuple(b - a for a, b in zip(first["rest"], second["rest"], strict=True))
         damping = d["damping_ratio"] * stiffness
-        _bushing(
+        uw.bushing(
             w,
             name,
             (stiffness,) + (0.0,) * 5,
@@ -546,7 +281,7 @@ def three_masses_scene() -> str:
             second["name"],
             xyz1=xyz1,
         )
-    return _end(w)
+    return uw.end(w)
 
 
 def two_body_gravity_scene() -> str:
@@ -562,14 +297,14 @@ def two_body_gravity_scene() -> str:
     d = mechanisms.TWO_BODY_GRAVITY
     bodies = {b["name"]: b for b in d["bodies"]}
     ratio = d["damping_ratio"]
-    w = _Writer()
-    _begin(
+    w = uw.Writer()
+    uw.begin(
         w,
         "two_body_gravity",
         "Two 6-DOF bodies with springs in gravity (Dubarenko 2007, section 4.2.3, exercises 1-2)",
     )
     for body in d["bodies"]:
-        _six_dof_body(
+        uw.six_dof_body(
             w,
             body["name"],
             body["parent"],
@@ -580,7 +315,7 @@ def two_body_gravity_scene() -> str:
             body["inertia_rpy"],
         )
     w.blank()
-    _gravity(w, d["gravity"])
+    uw.gravity(w, d["gravity"])
     w.comment("C01, D01: springs on body 1's pair coordinates")
     ground = d["ground_springs"]
     for joint, stiffness in zip(pair_joint_names(ground["body"]), ground["stiffness"], strict=True):
@@ -594,7 +329,7 @@ def two_body_gravity_scene() -> str:
     w.comment("C12, D12: bushing between body 1 and body 2")
     bushing = d["bushing"]
     child = bodies[bushing["child"]]
-    _bushing(
+    uw.bushing(
         w,
         bushing["name"],
         bushing["stiffness"],
@@ -603,7 +338,7 @@ def two_body_gravity_scene() -> str:
         child["name"],
         xyz1=child["offset"],
     )
-    return _end(w)
+    return uw.end(w)
 
 
 #: Scene name → function returning the scene's URDF text.

@@ -54,8 +54,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from rt70.rotations import rpy_matrix, rpy_of_matrix
-from rt70.scenes.generate import fmt, fmt_vec
 from rt70.scenes.pairs import PAIR_JOINTS
+from rt70.scenes.urdf_writer import ROOT_LINK, RT70_NS, fmt, fmt_vec
 
 #: Every joint type of the URDF standard, as :func:`random_tree` draws them.
 ALL_JOINT_TYPES = ("revolute", "prismatic", "fixed", "continuous", "floating", "planar")
@@ -65,12 +65,6 @@ ONE_DOF_JOINT_TYPES = ("revolute", "prismatic", "continuous")
 
 #: Joint types that get a random ``<rt70:joint_spring>`` (the reader accepts 1-DOF joints).
 SPRING_JOINT_TYPES = ONE_DOF_JOINT_TYPES
-
-#: Namespace of the rt70 URDF extension elements.
-RT70_NS = "urn:rt70:urdf-extensions:1"
-
-#: Name of the root (ground) link of every generated scene.
-ROOT_LINK = "world"
 
 # Joint types whose child may be massless (see the module docstring).
 _MASSLESS_JOINT_TYPES = ("fixed", *ONE_DOF_JOINT_TYPES)

@@ -13,7 +13,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.scene import load_scene
-from rt70.scenes.generate import fmt_vec
+from rt70.scenes.urdf_writer import fmt_vec
 
 #: Namespace of the rt70 URDF extension elements (docs/urdf-extensions.md).
 RT70_NS = "urn:rt70:urdf-extensions:1"
