@@ -195,7 +195,7 @@ def test_count_bdf_steps():
 
 
 def test_run_capped_counts_match_solver(rt70):
-    run = run_capped(rt70, (0.0, 0.01))
+    run = run_capped(rt70, (0.0, 0.01), listing_initial_state(rt70))
     assert run.ok and run.result is not None
     assert run.n_steps == run.result.n_steps and run.n_rejected is not None
 
