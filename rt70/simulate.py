@@ -144,7 +144,7 @@ class _TextbookBackend(_Backend):
         self.bdata = structured.BatchData(scene.textbook, 1)
 
     def mass_matrix(self, q):
-        return self.structured.mass_matrix(self.scene.textbook, q, self.bdata)
+        return self.structured.mass_matrix(self.scene.textbook, self.bdata, q)
 
     def accelerations(self, q, qd, Q_u):
         import scipy.linalg
@@ -153,10 +153,10 @@ class _TextbookBackend(_Backend):
 
         st, model = self.structured, self.scene.textbook
         check_euler_pairs(model, model.expand(q))
-        A = st.mass_matrix(model, q, self.bdata)
+        A = st.mass_matrix(model, self.bdata, q)
         Qc, Qd = forces.spring_damper_force(model, self.scene.textbook_data, q, qd)
-        rhs = st.gravity_force_batch(model, q[None], self.bdata)[0] + Qc + Qd
-        rhs -= st.bias_force(model, q, qd, self.bdata)
+        rhs = st.gravity_force_batch(model, self.bdata, q[None])[0] + Qc + Qd
+        rhs -= st.bias_force(model, self.bdata, q, qd)
         if Q_u is not None:
             rhs += Q_u
         try:

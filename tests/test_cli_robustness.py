@@ -546,8 +546,12 @@ def _textbook_calls(scene):
         "forces.spring_damper_force": lambda q, qd: forces.spring_damper_force(m, d, q, qd),
         "forces.kinetic_energy": lambda q, qd: forces.kinetic_energy(m, d, q, qd),
         "forces.spring_potential": lambda q, qd: forces.spring_potential(m, d, q),
-        "structured.mass_matrix": lambda q, qd: structured.mass_matrix(m, q),
-        "structured.bias_force": lambda q, qd: structured.bias_force(m, q, qd),
+        "structured.mass_matrix": lambda q, qd: structured.mass_matrix(
+            m, structured.BatchData(m), q
+        ),
+        "structured.bias_force": lambda q, qd: structured.bias_force(
+            m, structured.BatchData(m), q, qd
+        ),
     }
 
 
@@ -576,7 +580,9 @@ def test_every_public_function_names_a_wrong_shape(scene):
             with pytest.raises(ValueError, match=rf"^qd: expected shape \({n},\)"):  # compat
                 call(np.zeros(n), np.zeros(n - 1))
     with pytest.raises(ShapeError, match=r"Q: expected shape \(K, \d+\), got shape \(3,\)"):
-        structured.mass_matrix_batch(scene.textbook, np.zeros(3))
+        structured.mass_matrix_batch(
+            scene.textbook, structured.BatchData(scene.textbook), np.zeros(3)
+        )
 
 
 @pytest.mark.parametrize("side", ["textbook", "reference"])

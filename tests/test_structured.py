@@ -23,15 +23,27 @@ def test_structured_equals_dense(target):
     m, d = scene.textbook, scene.textbook_data
     rng = np.random.default_rng(4)
     Q, Qd = rng.uniform(-0.5, 0.5, (4, m.nv)), rng.uniform(-1, 1, (4, m.nv))
-    A_batch = structured.mass_matrix_batch(m, Q)
-    b_batch = structured.bias_force_batch(m, Q, Qd)
-    g_batch = structured.gravity_force_batch(m, Q)
+    data = structured.BatchData(m, 4)
+    A_batch = structured.mass_matrix_batch(m, data, Q).copy()
+    b_batch = structured.bias_force_batch(m, data, Q, Qd)
+    g_batch = structured.gravity_force_batch(m, data, Q)
     assert A_batch.shape == (4, m.nv, m.nv)
     for k in range(4):
         assert rel(A_batch[k], dynamics.mass_matrix(m, d, Q[k])) <= 1e-13
         assert rel(b_batch[k], dynamics.bias_force(m, d, Q[k], Qd[k])) <= 1e-12
         assert rel(g_batch[k], dynamics.gravity_force(m, d, Q[k])) <= 1e-13
-        assert np.array_equal(structured.mass_matrix(m, Q[k]), A_batch[k])
+        assert np.array_equal(structured.mass_matrix(m, structured.BatchData(m), Q[k]), A_batch[k])
+
+
+def test_data_of_another_model_or_size_is_refused():
+    from rt70.errors import ShapeError
+
+    m = load_scene("double_pendulum").textbook
+    other = load_scene("three_masses").textbook
+    with pytest.raises(ShapeError, match="K = 1"):
+        structured.mass_matrix_batch(m, structured.BatchData(m, 1), np.zeros((3, m.nv)))
+    with pytest.raises(ShapeError, match="BatchData of this model"):
+        structured.mass_matrix(m, structured.BatchData(other), np.zeros(m.nv))
 
 
 def test_all_joint_types_scene_agrees_with_pinocchio():

@@ -87,7 +87,7 @@ def per_call(scene: Scene, rounds: int, budget_s: float) -> Row:
     q = np.random.default_rng(0).uniform(-0.5, 0.5, model.nv)
     bdata = structured.BatchData(model, 1)
     t_tb, t_pin, ratio = compare(
-        lambda: structured.mass_matrix(model, q, bdata), _pin_crba(scene, q), rounds, budget_s
+        lambda: structured.mass_matrix(model, bdata, q), _pin_crba(scene, q), rounds, budget_s
     )
     return Row("per_call", scene.name, model.nv, 1, t_tb, t_pin, ratio)
 
@@ -108,7 +108,7 @@ def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
             pin.crba(pm, pd, qp)
 
     t_tb, t_pin, ratio = compare(
-        lambda: structured.mass_matrix_batch(model, Q, bdata), pin_loop, rounds, budget_s
+        lambda: structured.mass_matrix_batch(model, bdata, Q), pin_loop, rounds, budget_s
     )
     return Row("batched", scene.name, model.nv, K, t_tb / K, t_pin / K, ratio)
 

@@ -48,8 +48,8 @@ def probe_configuration(model: Model) -> np.ndarray:
 
 def _term_scale(model: Model, q: np.ndarray) -> np.ndarray:
     """``B_i``: the size of the terms summed into each diagonal entry ``A_ii``."""
-    topo = structured.topology(model)
-    work = structured.Work(model, 1)
+    bdata = structured.BatchData(model, 1)
+    topo, work = bdata.topology, bdata.work(1)
     structured.forward_kinematics_batch(model, work, model.expand(q)[None, :])
     theta0 = structured.ground_inertias(model, work)[0]
     theta_c = (topo.anc @ theta0.reshape(model.nb, 36)).reshape(model.nb, 6, 6)
@@ -80,7 +80,7 @@ def singular_coordinates(model: Model) -> tuple[list[str], list[str]]:
     if model.nv == 0:
         return [], []
     q = probe_configuration(model)
-    A = structured.mass_matrix(model, q)
+    A = structured.mass_matrix(model, structured.BatchData(model, 1), q)
     diag = np.diag(A).copy()
     names = model.coordinate_names
     massless = diag <= MASSLESS_RTOL * _term_scale(model, q)

@@ -19,8 +19,11 @@ a batch of K configurations; only the forward pass of the absolute placements lo
 over the depth of the tree. Pairs are grouped by their number of coordinates (1, 3 or
 6), so the 6×6 work is done once per pair, not once per coordinate.
 
-Work buffers live in :class:`BatchData` (as Pinocchio's ``Data``): reuse one for
-repeated calls — fresh multi-megabyte temporaries cost more than the arithmetic.
+Every algorithm is called as ``algorithm(model, data, q, …)``, Pinocchio's convention:
+the Model is constant, the work buffers (and the tree's :class:`Topology`, built once)
+live in :class:`BatchData` — reuse one for repeated calls: fresh multi-megabyte
+temporaries cost more than the arithmetic. ``mass_matrix_batch`` returns ``data.A``,
+overwritten by the next call with the same data (as ``pin.crba`` fills ``data.M``).
 """
 
 from __future__ import annotations
@@ -149,11 +152,8 @@ def _as_slice(index: np.ndarray) -> np.ndarray | slice:
 
 
 def topology(model: Model) -> Topology:
-    """The :class:`Topology` of ``model`` (computed once, kept on the model object)."""
-    topo = model.__dict__.get("_topology")
-    if topo is None:
-        topo = model.__dict__["_topology"] = _build_topology(model)
-    return topo
+    """The :class:`Topology` of ``model`` (kept by :class:`BatchData`, built once there)."""
+    return _build_topology(model)
 
 
 #: Work arrays of one chunk of the batched mass matrix stay below this many bytes, so
@@ -167,9 +167,10 @@ _SMALL = 1 << 16
 class Work:
     """Work buffers of the structured algorithms for ``size`` configurations."""
 
-    def __init__(self, model: Model, size: int) -> None:
+    def __init__(self, model: Model, size: int, topo: Topology | None = None) -> None:
         nb, n = model.nb, model.n_full
-        topo = topology(model)
+        topo = topology(model) if topo is None else topo
+        self.topo = topo
         self.size = size
         self.M_rel = np.zeros((size, nb, 6, 6))  # T(r_j)[c_j]: the pairs' own motion
         self.M_rel[..., :3, :3] = _E3
@@ -201,8 +202,9 @@ class BatchData:
         The last mass matrices computed, (K, nv, nv).
     """
 
-    def __init__(self, model: Model, K: int, chunk: int | None = None) -> None:
+    def __init__(self, model: Model, K: int = 1, chunk: int | None = None) -> None:
         n = max(model.n_full, 1)
+        self.topology = topology(model)
         self.K = K
         self.chunk = chunk or max(1, min(K, CHUNK_BYTES // (24 * n * n)))
         self.A = np.empty((K, model.nv, model.nv))
@@ -212,13 +214,16 @@ class BatchData:
     def work(self, size: int) -> Work:
         """The work buffers for ``size`` configurations (made once, then reused)."""
         if size not in self._works:
-            self._works[size] = Work(self._model, size)
+            self._works[size] = Work(self._model, size, self.topology)
         return self._works[size]
 
 
-def _data_for(model: Model, K: int, data: BatchData | None) -> BatchData:
-    if data is None or data.K != K:
-        return BatchData(model, K)
+def _data_for(model: Model, K: int, data: BatchData) -> BatchData:
+    """``data`` if it was made for ``model`` and K configurations (a ShapeError if not)."""
+    if not isinstance(data, BatchData) or data._model is not model:
+        raise ShapeError("data: expected the BatchData of this model (BatchData(model, K))")
+    if data.K != K:
+        raise ShapeError(f"data: made for K = {data.K} configurations, got {K}")
     return data
 
 
@@ -265,7 +270,7 @@ def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
     the tree with the chain property ``L_0^j = L_0^i L_i^j`` (§4.2), one batched
     product per level; then ``σ = (L_0^j)⁻ᵀ M_j f_j`` per group of equal-width pairs.
     """
-    topo = topology(model)
+    topo = data.topo
     c_rel, r_rel = data.c_rel, data.r_rel  # views into data.M_rel
     bodies, dofs = topo.revolute_bodies, topo.revolute_dofs
     if topo.revolute_k.size:
@@ -361,7 +366,7 @@ def _check_batch(name: str, Q: np.ndarray, nv: int) -> np.ndarray:
     return Q
 
 
-def mass_matrix_batch(model: Model, Q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
+def mass_matrix_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarray:
     """``A = S Θ Sᵀ`` for K configurations ``Q`` (K, nv) at once; returns ``data.A``.
 
     ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` and its transpose (the
@@ -382,7 +387,7 @@ def mass_matrix_batch(model: Model, Q: np.ndarray, data: BatchData | None = None
 
 
 def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray) -> None:
-    topo = topology(model)
+    topo = work.topo
     forward_kinematics_batch(model, work, Qf)
     theta0 = ground_inertias(model, work)
     K, nb = theta0.shape[:2]
@@ -403,10 +408,13 @@ def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray
     out += work.GmT
 
 
-def mass_matrix(model: Model, q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
-    """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form), a new array."""
+def mass_matrix(model: Model, data: BatchData, q: np.ndarray) -> np.ndarray:
+    """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form), a new array.
+
+    ``data`` is a ``BatchData(model, 1)``.
+    """
     q = check_finite("q", q, model.nv)
-    return mass_matrix_batch(model, q[None, :], data)[0].copy()
+    return mass_matrix_batch(model, data, q[None, :])[0].copy()
 
 
 def _crm_batch(v: np.ndarray) -> np.ndarray:
@@ -450,15 +458,13 @@ def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray,
     return out
 
 
-def bias_force_batch(
-    model: Model, Q: np.ndarray, Qd: np.ndarray, data: BatchData | None = None
-) -> np.ndarray:
+def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarray) -> np.ndarray:
     """``B(q, q̇) q̇`` (4.80) for K states, shape (K, nv) (composite form, module docstring)."""
     Q = _check_batch("Q", Q, model.nv)
     Qd = _check_batch("Qd", Qd, model.nv)
-    topo = topology(model)
     Qf, Vf = _expand_batch(model, Q), _expand_batch(model, Qd, offset=False)
     data = _data_for(model, Q.shape[0], data).work(Q.shape[0])
+    topo = data.topo
     forward_kinematics_batch(model, data, Qf)
     u = topo.incidence @ (data.sigma * Vf[..., None])  # Σ_a σ_a q̇_a per pair, (K, nb, 6)
     V = topo.anc.T @ u  # V⁰_j = Σ_{k ⪯ j} u_k
@@ -473,19 +479,17 @@ def bias_force_batch(
     return tau if model.G is None else tau @ model.G
 
 
-def bias_force(
-    model: Model, q: np.ndarray, qd: np.ndarray, data: BatchData | None = None
-) -> np.ndarray:
-    """``B(q, q̇) q̇`` at one state (structure-exploiting form)."""
+def bias_force(model: Model, data: BatchData, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``B(q, q̇) q̇`` at one state (structure-exploiting form); ``data = BatchData(model, 1)``."""
     q, qd = check_finite("q", q, model.nv), check_finite("qd", qd, model.nv)
-    return bias_force_batch(model, q[None, :], qd[None, :], data)[0]
+    return bias_force_batch(model, data, q[None, :], qd[None, :])[0]
 
 
-def gravity_force_batch(model: Model, Q: np.ndarray, data: BatchData | None = None) -> np.ndarray:
+def gravity_force_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarray:
     """``Q_g = S G`` (4.113)–(4.128) for K configurations: ``σ_aᵀ Θᶜ_body(a) [g0; 0]``."""
     Q = _check_batch("Q", Q, model.nv)
-    topo = topology(model)
     data = _data_for(model, Q.shape[0], data).work(Q.shape[0])
+    topo = data.topo
     forward_kinematics_batch(model, data, _expand_batch(model, Q))
     theta0 = ground_inertias(model, data)
     w = topo.anc @ (theta0[..., :, :3] @ model.gravity)  # Σ_{j ⪰ k} Θ⁰_j [g0; 0]

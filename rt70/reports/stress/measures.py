@@ -36,7 +36,7 @@ def condition_number(scene: Scene, q: np.ndarray) -> float:
     model = scene.textbook
     if model.nv <= 2000:
         return float(np.linalg.cond(dynamics.mass_matrix(model, scene.textbook_data, q)))
-    A = structured.mass_matrix(model, q)
+    A = structured.mass_matrix(model, structured.BatchData(model, 1), q)
     anorm = float(np.max(np.sum(np.abs(A), axis=0)))
     c, info = scipy.linalg.lapack.dpotrf(A, lower=False)
     if info != 0:

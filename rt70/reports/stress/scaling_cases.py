@@ -92,13 +92,13 @@ def long_chain_cases(quick: bool = False) -> Table:
         else:
             row["xerr"] = "not built (memory)"
         bdata = structured.BatchData(model, 1)
-        A_s = structured.mass_matrix(model, q, bdata)
+        A_s = structured.mass_matrix(model, bdata, q)
         A_d = dynamics.mass_matrix(model, data, q)
         row["sA"] = rel_error(A_s, A_d)
-        G_s = structured.gravity_force_batch(model, q[None], bdata)[0]
+        G_s = structured.gravity_force_batch(model, bdata, q[None])[0]
         row["sG"] = rel_error(G_s, dynamics.gravity_force(model, data, q))
         if model.nv <= MAX_DENSE_BIAS_NV:
-            b_s = structured.bias_force(model, q, qd, bdata)
+            b_s = structured.bias_force(model, bdata, q, qd)
             row["sB"] = rel_error(b_s, dynamics.bias_force(model, data, q, qd))
             Qc, Qd = forces.spring_damper_force(model, data, q, qd)
             a_d = dynamics.forward_dynamics(model, data, q, qd, Qc + Qd)
