@@ -287,11 +287,16 @@ class ReferenceModel:
     def spring_damper_force(self, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Spring and damper generalised forces from Pinocchio's frame kinematics."""
         qp, vp, J, _ = self.to_pinocchio(q, qd)
-        Qc, Qd = self._joint_space_forces(qp, vp, q, qd, J)
+        Qc, Qd = self.element_torques(qp, vp)
         return (Qc, Qd) if J is None else (J.T @ Qc, J.T @ Qd)
 
-    def _joint_space_forces(self, qp, vp, q, qd, J) -> tuple[np.ndarray, np.ndarray]:
-        """Spring/damper forces as Pinocchio joint torques τ (velocity space)."""
+    def element_torques(self, qp: np.ndarray, vp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Spring and damper forces as Pinocchio joint torques τ_c, τ_d.
+
+        ``qp``, ``vp`` are Pinocchio's own configuration and velocity (see
+        :meth:`to_pinocchio`), and so are the results (its velocity space): the form
+        ``pin.aba`` takes as ``tau``, used by the simulation's fast path.
+        """
         nv = self.model.nv
         Qc, Qd = np.zeros(nv), np.zeros(nv)
         if self.spring_v.size:
@@ -304,6 +309,23 @@ class ReferenceModel:
             Qc -= np.einsum("bin,bi->n", jac, self._stiffness * delta)
             Qd -= np.einsum("bin,bi->n", jac, self._damping * rate)
         return Qc, Qd
+
+    def element_gains(self, qp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``Σ Jᵀ C J`` and ``Σ Jᵀ D J`` of the springs and dampers, in Pinocchio's space.
+
+        ``−∂τ_c/∂v`` without the term of the deformation's second derivative (the
+        Gauss–Newton part) and ``−∂τ_d/∂v`` exactly: what an implicit integrator's
+        Jacobian needs besides ``pin.computeABADerivatives``.
+        """
+        n = self.model.nv
+        K, D = np.zeros((n, n)), np.zeros((n, n))
+        K[self.spring_v, self.spring_v] += self.spring_k
+        D[self.spring_v, self.spring_v] += self.spring_d
+        if self.bushings:
+            _, jac = self.deformations(qp)
+            K += np.einsum("bin,bi,bim->nm", jac, self._stiffness, jac)
+            D += np.einsum("bin,bi,bim->nm", jac, self._damping, jac)
+        return K, D
 
     def deformations(self, qp: np.ndarray, jacobian: bool = True):
         """δ of every bushing (n_b, 6) and ∂δ/∂v (n_b, 6, nv), from Pinocchio's kinematics.
@@ -375,7 +397,7 @@ class ReferenceModel:
         ``Jᵀ A J q̈ = Jᵀ (τ − rnea(q, v, J̇ q̇))`` are solved with Pinocchio's CRBA and RNEA.
         """
         qp, vp, J, Jdqd = self.to_pinocchio(q, qd)
-        Qc, Qd = self._joint_space_forces(qp, vp, q, qd, J)
+        Qc, Qd = self.element_torques(qp, vp)
         tau = Qc + Qd
         if J is None:
             return pin.aba(self.model, self.data, qp, vp, tau)

@@ -93,7 +93,7 @@ class _PinocchioBackend(_Backend):
                 a = a + np.linalg.solve(ref.mass_matrix(q), Q_u)
             return a, Qd
         ref, pin = self.ref, self.pin
-        Qc, Qd = ref._joint_space_forces(q, qd, q, qd, None)
+        Qc, Qd = ref.element_torques(q, qd)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
         return pin.aba(ref.model, ref.data, q, qd, tau), Qd
 
@@ -101,10 +101,10 @@ class _PinocchioBackend(_Backend):
         if not self.direct:
             return None
         ref, pin = self.ref, self.pin
-        Qc, Qd = ref._joint_space_forces(q, qd, q, qd, None)
+        Qc, Qd = ref.element_torques(q, qd)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
         dq, dv, Minv = pin.computeABADerivatives(ref.model, ref.data, q, qd, tau)
-        Kc, Dc = self._spring_jacobians(q)
+        Kc, Dc = ref.element_gains(q)
         n = self.nv
         J = np.zeros((2 * n, 2 * n))
         J[:n, n:] = np.eye(n)
@@ -112,18 +112,6 @@ class _PinocchioBackend(_Backend):
         J[n:, :n] = dq - Minv @ Kc
         J[n:, n:] = dv - Minv @ Dc
         return J
-
-    def _spring_jacobians(self, q) -> tuple[np.ndarray, np.ndarray]:
-        """``Σ Jᵀ C J`` and ``Σ Jᵀ D J`` at q: −∂τ/∂q (Gauss–Newton part) and −∂τ/∂q̇ (exact)."""
-        ref, n = self.ref, self.nv
-        K, D = np.zeros((n, n)), np.zeros((n, n))
-        K[ref.spring_v, ref.spring_v] += ref.spring_k
-        D[ref.spring_v, ref.spring_v] += ref.spring_d
-        if ref.bushings:
-            _, jac = ref.deformations(q)
-            K += np.einsum("bin,bi,bim->nm", jac, ref._stiffness, jac)
-            D += np.einsum("bin,bi,bim->nm", jac, ref._damping, jac)
-        return K, D
 
     def energies(self, q, qd):
         ref = self.ref
