@@ -51,3 +51,20 @@ def test_all_joint_types_scene_agrees_with_pinocchio():
 
     for r in cross_check(load_scene(ALL_TYPES), samples=3, seed=1, repeat=1):
         assert r.max_rel_err <= 1e-10, (r.quantity, r.max_rel_err)
+
+
+def test_model_is_constant_after_build():
+    """Model constant, Data the work buffers: no algorithm may write into the Model."""
+    import dataclasses
+
+    scene = load_scene("double_pendulum")
+    m = scene.textbook
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        m.G = None
+    before = {k: np.copy(v) for k, v in vars(m).items() if isinstance(v, np.ndarray)}
+    data = structured.BatchData(m, 3)
+    structured.mass_matrix_batch(m, data, np.zeros((3, m.nv)))
+    dynamics.forward_dynamics(m, scene.textbook_data, np.ones(m.nv), np.ones(m.nv), np.zeros(m.nv))
+    assert "_topology" not in vars(m)
+    for k, v in before.items():
+        assert np.array_equal(getattr(m, k), v), k

@@ -72,9 +72,12 @@ class BushingModel:
     damping: np.ndarray
 
 
-@dataclass
+@dataclass(frozen=True)
 class Model:
     """Plain model data of the textbook algorithm (no work buffers; see :class:`Data`).
+
+    Constant once :func:`build_model` has made it (a frozen dataclass): every algorithm
+    reads it, none writes it — the work buffers are in :class:`~rt70.textbook.data.Data`.
 
     Attributes
     ----------
@@ -261,7 +264,13 @@ def build_model(desc: RobotDescription) -> Model:
         for t, m in zip(thetas, masses, strict=True)
     ]
     ndof_arr = np.array(ndof, dtype=int)
-    model = Model(
+    bushings = []
+    for b in desc.bushings:
+        body1, r1, c1 = _frame_on_body(link_frames, b.frame1.link, b.frame1.xyz, b.frame1.rpy)
+        body2, r2, c2 = _frame_on_body(link_frames, b.frame2.link, b.frame2.xyz, b.frame2.rpy)
+        bushings.append(BushingModel(b.name, body1, r1, c1, body2, r2, c2, b.stiffness, b.damping))
+    G, q_offset, independent = _mimic_constraints(coord_names, desc)
+    return Model(
         name=desc.name,
         parent=np.array(parent, dtype=int),
         kind=kind,
@@ -274,30 +283,29 @@ def build_model(desc: RobotDescription) -> Model:
         q_start=np.concatenate([[0], np.cumsum(ndof_arr)[:-1]]).astype(int),
         ndof=ndof_arr,
         body_names=body_names,
-        coordinate_names=coord_names,
+        coordinate_names=independent,
         gravity=np.array(desc.gravity, dtype=float),
+        full_coordinate_names=list(coord_names),
         link_frames=link_frames,
+        bushings=bushings,
+        spring_coords=np.array([joint_coord[s.joint] for s in desc.joint_springs], dtype=int),
+        spring_stiffness=np.array([s.stiffness for s in desc.joint_springs], dtype=float),
+        spring_damping=np.array([s.damping for s in desc.joint_springs], dtype=float),
+        G=G,
+        q_offset=q_offset,
     )
-    for b in desc.bushings:
-        body1, r1, c1 = _frame_on_body(model, b.frame1.link, b.frame1.xyz, b.frame1.rpy)
-        body2, r2, c2 = _frame_on_body(model, b.frame2.link, b.frame2.xyz, b.frame2.rpy)
-        model.bushings.append(
-            BushingModel(b.name, body1, r1, c1, body2, r2, c2, b.stiffness, b.damping)
-        )
-    model.full_coordinate_names = list(coord_names)
-    _add_mimic_constraints(model, desc)
-    model.spring_coords = np.array([joint_coord[s.joint] for s in desc.joint_springs], dtype=int)
-    model.spring_stiffness = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
-    model.spring_damping = np.array([s.damping for s in desc.joint_springs], dtype=float)
-    return model
 
 
-def _add_mimic_constraints(model: Model, desc: RobotDescription) -> None:
-    """Build ``q_full = G q + q_offset`` from the URDF ``<mimic>`` elements (chapter 3)."""
+def _mimic_constraints(
+    full_names: list[str], desc: RobotDescription
+) -> tuple[np.ndarray | None, np.ndarray | None, list[str]]:
+    """``q_full = G q + q_offset`` from the URDF ``<mimic>`` elements (chapter 3).
+
+    Returns G, q_offset (None, None without mimics) and the independent coordinates.
+    """
     mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
     if not mimics:
-        return
-    full_names = list(model.coordinate_names)
+        return None, None, list(full_names)
     independent = [n for n in full_names if n not in mimics]
     column = {name: c for c, name in enumerate(independent)}
     G = np.zeros((len(full_names), len(independent)))
@@ -309,8 +317,7 @@ def _add_mimic_constraints(model: Model, desc: RobotDescription) -> None:
             offset[row] = m.offset
         else:
             G[row, column[name]] = 1.0
-    model.G, model.q_offset = G, offset
-    model.coordinate_names = independent
+    return G, offset, independent
 
 
 def _unskew(m: np.ndarray) -> np.ndarray:
@@ -319,7 +326,7 @@ def _unskew(m: np.ndarray) -> np.ndarray:
 
 
 def _frame_on_body(
-    model: Model, link: str, xyz: np.ndarray, rpy: np.ndarray
+    link_frames: dict, link: str, xyz: np.ndarray, rpy: np.ndarray
 ) -> tuple[int, np.ndarray, np.ndarray]:
-    body, r_link, c_link = model.link_frames[link]
+    body, r_link, c_link = link_frames[link]
     return body, r_link + c_link @ xyz, c_link @ rpy_matrix(rpy)
