@@ -4,9 +4,8 @@ One cheap test per state vector: its shape, then one ``np.isfinite`` over it, co
 (about 1.5 µs; the dot product with zeros of :mod:`rt70.textbook.structured` is faster
 but warns on the very inputs it rejects). A wrong shape is a :class:`~rt70.errors.ShapeError` (also
 a ``ValueError``), a NaN or infinite entry a :class:`~rt70.errors.NonFiniteError`; both
-name the argument. The textbook side has its own copy
-(``rt70.textbook.kinematics.check_finite``), raising the same classes: the two sides
-share no code but behave the same.
+name the argument. Both sides call it (it checks arguments, it computes no dynamics), so
+they refuse bad input identically.
 """
 
 from __future__ import annotations

@@ -110,6 +110,7 @@ def _modes(args: argparse.Namespace) -> int:
     from rt70.linear import modal
     from rt70.scene import load_scene
     from rt70.scenes import rt70_state
+    from rt70.textbook.massless import require_diagonal
 
     scene = load_scene(args.scene)
     names = scene.textbook.coordinate_names
@@ -130,12 +131,7 @@ def _modes(args: argparse.Namespace) -> int:
             model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
     except SingularConfigurationError as exc:  # a state on the way: name the scene
         raise SingularConfigurationError(f"{scene.name}: {exc}") from None
-    massless = [c for c, m in zip(model.coordinates, np.diag(model.M), strict=True) if not m > 0]
-    if massless:
-        raise Rt70Error(
-            f"{scene.name}: mass matrix is singular: no mass moves with coordinate(s) "
-            f"{', '.join(massless)}"
-        )
+    require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
     result = modal.modes(model.M, model.K, model.D)
     rows = []
     energy = result.shapes * (model.M @ result.shapes)  # kinetic-energy share per coordinate

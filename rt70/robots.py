@@ -22,6 +22,7 @@ import numpy as np
 from rt70.errors import Rt70Error, SceneError
 from rt70.scene import Scene, load_scene, require_coordinates
 from rt70.textbook import dynamics
+from rt70.textbook.massless import require_diagonal
 
 #: Distribution that ships the robots.
 DISTRIBUTION = "example-robot-data"
@@ -213,11 +214,7 @@ def _try_both_sides(scene: Scene, rng: np.random.Generator) -> None:
     q, qd = rng.uniform(-0.5, 0.5, model.nv), rng.uniform(-1.0, 1.0, model.nv)
     A = dynamics.mass_matrix(model, data, q)
     ref.mass_matrix(q)
-    massless = [n for n, a in zip(model.coordinate_names, np.diag(A), strict=True) if a <= 0.0]
-    if massless:
-        raise Rt70Error(
-            f"mass matrix is singular: no mass moves with coordinate(s) {', '.join(massless)}"
-        )
+    require_diagonal(A, model.coordinate_names, "")
     dynamics.forward_dynamics(model, data, q, qd, np.zeros(model.nv))
 
 

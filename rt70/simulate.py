@@ -28,6 +28,7 @@ from rt70.errors import (
     SingularConfigurationError,
 )
 from rt70.scene import Scene
+from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import check_euler_pairs
 
 #: Integration methods of scipy.integrate.solve_ivp accepted by :func:`simulate`.
@@ -444,13 +445,7 @@ def _check_mass_matrix(scene: Scene, side: _Backend, q0: np.ndarray) -> None:
     A = side.mass_matrix(q0)
     if not np.isfinite(A).all():
         raise SimulationError(f"{scene.name}: the mass matrix is not finite at the initial state")
-    names = scene.textbook.coordinate_names
-    massless = [c for c, a in zip(names, np.diag(A), strict=True) if not a > 0.0]
-    if massless:
-        raise SimulationError(
-            f"{scene.name}: mass matrix is singular: no mass moves with coordinate(s) "
-            f"{', '.join(massless)}"
-        )
+    require_diagonal(A, scene.textbook.coordinate_names, f"{scene.name}: ", SimulationError)
     try:
         np.linalg.cholesky(A)
     except np.linalg.LinAlgError:

@@ -10,9 +10,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
+from rt70.arrays import check_vector
 from rt70.errors import Rt70Error
 from rt70.textbook.data import Data
-from rt70.textbook.kinematics import check_finite, pair_motion_rate, update_structure
+from rt70.textbook.kinematics import pair_motion_rate, update_structure
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import check_euler_pairs, crf
 
@@ -26,7 +27,7 @@ def mass_matrix(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
 
 def body_velocities(model: Model, data: Data, qd: np.ndarray) -> np.ndarray:
     """Absolute body velocities ``V⁰ = Sᵀ q̇`` (4.63), each in its own body frame."""
-    qd = check_finite("qd", qd, model.nv)
+    qd = check_vector("qd", qd, model.nv)
     data.V = (data.S.T @ qd).reshape(model.nb, 6)
     return data.V
 
@@ -59,8 +60,8 @@ def structure_matrix_rate(model: Model, data: Data, q: np.ndarray, qd: np.ndarra
 
 def bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
     """Matrix ``B = S Θ Ṡᵀ + S Φ⁰ Θ Sᵀ`` (4.80), ``Φ⁰ = diag(Φ(V_k⁰))``."""
-    q = check_finite("q", q, model.nv)
-    qd = check_finite("qd", qd, model.nv)
+    q = check_vector("q", q, model.nv)
+    qd = check_vector("qd", qd, model.nv)
     update_structure(model, data, q)
     return _bias_matrix(model, data, q, qd)
 
@@ -108,9 +109,9 @@ def forward_dynamics(
     within ``DYNAMICS_GIMBAL_COS`` of gimbal lock a
     :class:`~rt70.errors.SingularConfigurationError`.
     """
-    Q = check_finite("Q", Q, model.nv)
-    q = check_finite("q", q, model.nv)
-    qd = check_finite("qd", qd, model.nv)
+    Q = check_vector("Q", Q, model.nv)
+    q = check_vector("q", q, model.nv)
+    qd = check_vector("qd", qd, model.nv)
     check_euler_pairs(model, model.expand(q))
     update_structure(model, data, q)  # one forward pass for A, B q̇ and S G
     rhs = Q + _gravity_force(model, data) - _bias_matrix(model, data, q, qd) @ qd

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rt70.arrays import check_vector
 from rt70.errors import SingularConfigurationError
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import (
-    check_finite,
     frame_jacobian,
     frame_pose,
     update_structure,
@@ -61,8 +61,8 @@ def spring_damper_force(
     model: Model, data: Data, q: np.ndarray, qd: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Generalised spring force ``Q_c`` and damper force ``Q_d`` of all elements."""
-    q = check_finite("q", q, model.nv)
-    qd = check_finite("qd", qd, model.nv)
+    q = check_vector("q", q, model.nv)
+    qd = check_vector("qd", qd, model.nv)
     update_structure(model, data, q)
     q_full, qd_full = data.q_full, model.expand(qd, offset=False)
     idx = model.spring_coords
@@ -80,7 +80,7 @@ def spring_damper_force(
 
 def spring_potential(model: Model, data: Data, q: np.ndarray) -> float:
     """Elastic potential ``Σ ½ δᵀ C δ`` of all springs."""
-    q = check_finite("q", q, model.nv)
+    q = check_vector("q", q, model.nv)
     update_structure(model, data, q)
     idx = model.spring_coords
     U = 0.5 * float(np.sum(model.spring_stiffness * data.q_full[idx] ** 2))
@@ -106,5 +106,5 @@ def kinetic_energy(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> f
     """Kinetic energy ``½ q̇ᵀ A q̇`` (1.61)."""
     from rt70.textbook.dynamics import mass_matrix
 
-    qd = check_finite("qd", qd, model.nv)
+    qd = check_vector("qd", qd, model.nv)
     return 0.5 * float(qd @ mass_matrix(model, data, q) @ qd)

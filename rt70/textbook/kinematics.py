@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rt70.errors import NonFiniteError, ShapeError
+from rt70.arrays import check_vector
 from rt70.textbook.data import Data
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import (
@@ -15,27 +15,6 @@ from rt70.textbook.spatial import (
     placement,
     skew,
 )
-
-
-def check_finite(name: str, x: np.ndarray, size: int) -> np.ndarray:
-    """Return ``x`` as a float vector of ``size`` entries, or raise on NaN/inf or wrong size.
-
-    Raises
-    ------
-    ShapeError
-        (a ``ValueError`` too) if ``x`` is not a vector of ``size`` numbers.
-    NonFiniteError
-        If an entry is NaN or infinite.
-    """
-    try:
-        x = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ShapeError(f"{name}: expected a vector of {size} numbers, got {x!r:.60}") from None
-    if x.shape != (size,):
-        raise ShapeError(f"{name}: expected shape ({size},), got shape {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise NonFiniteError(f"{name} contains NaN or infinite values")
-    return x
 
 
 def pair_motion(model: Model, j: int, qj: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -142,7 +121,7 @@ def structure_matrix(model: Model, data: Data) -> np.ndarray:
 
 def update_structure(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
     """Run forward kinematics and fill L and S for configuration q; return S."""
-    q = check_finite("q", q, model.nv)
+    q = check_vector("q", q, model.nv)
     data.q_full = model.expand(q)
     forward_kinematics(model, data, data.q_full)
     configuration_matrix(model, data)

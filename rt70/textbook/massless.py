@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from rt70.errors import MasslessCoordinateError
+from rt70.errors import MasslessCoordinateError, Rt70Error
 from rt70.textbook import structured
 from rt70.textbook.model import Model
 
@@ -117,4 +117,21 @@ def check_moves_mass(model: Model, source: str) -> None:
             f"{source}: a combination of joint coordinates {', '.join(combination)} moves no "
             "mass (redundant joints, e.g. coaxial joints with no mass between them): the "
             "mass matrix is singular; remove or fix one of them"
+        )
+
+
+def require_diagonal(
+    A: np.ndarray, names: list[str], where: str, error: type[Rt70Error] = Rt70Error
+) -> None:
+    """Raise ``error`` naming every coordinate whose diagonal entry of ``A`` is not > 0.
+
+    The check at one given configuration (a simulation's start, a linearisation's
+    equilibrium), beside the model-wide :func:`check_moves_mass`: a zero (or NaN)
+    ``A_ii`` means no mass moves with coordinate i there.
+    """
+    massless = [n for n, a in zip(names, np.diag(A), strict=True) if not a > 0.0]
+    if massless:
+        raise error(
+            f"{where}mass matrix is singular: no mass moves with coordinate(s) "
+            f"{', '.join(massless)}"
         )

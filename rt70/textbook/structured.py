@@ -32,8 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rt70.arrays import check_vector
 from rt70.errors import NonFiniteError, ShapeError
-from rt70.textbook.kinematics import check_finite
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import placement
 
@@ -413,7 +413,7 @@ def mass_matrix(model: Model, data: BatchData, q: np.ndarray) -> np.ndarray:
 
     ``data`` is a ``BatchData(model, 1)``.
     """
-    q = check_finite("q", q, model.nv)
+    q = check_vector("q", q, model.nv)
     return mass_matrix_batch(model, data, q[None, :])[0].copy()
 
 
@@ -481,7 +481,7 @@ def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarra
 
 def bias_force(model: Model, data: BatchData, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
     """``B(q, q̇) q̇`` at one state (structure-exploiting form); ``data = BatchData(model, 1)``."""
-    q, qd = check_finite("q", q, model.nv), check_finite("qd", qd, model.nv)
+    q, qd = check_vector("q", q, model.nv), check_vector("qd", qd, model.nv)
     return bias_force_batch(model, data, q[None, :], qd[None, :])[0]
 
 
