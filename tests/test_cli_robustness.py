@@ -140,7 +140,7 @@ def test_cli_refuses_a_model_too_large(monkeypatch, tmp_path, capsys):
 
 _MEASURE = r"""
 import json
-from rt70.reference import ReferenceModel
+from rt70.reference import ReferenceData, ReferenceModel
 from rt70.scene import scene_from_text
 from rt70.scenes.synthetic import serial_chain
 
@@ -151,7 +151,7 @@ def status():  # resident memory: peak (VmHWM), anonymous, file-backed (librarie
 
 scene = scene_from_text(serial_chain(100), "chain")
 base = status()
-ReferenceModel(scene.description, scene.text)
+ReferenceData(ReferenceModel(scene.description, scene.text))
 end = status()
 # peak growth of anonymous memory: library pages evicted and read back in (a loaded
 # machine) must not count; VmHWM, not ru_maxrss, which keeps the parent's peak (fork)

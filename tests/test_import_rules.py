@@ -37,7 +37,7 @@ SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations")
 RULES = {
     "rt70.urdf": ("rt70.urdf", *SHARED),
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
-    "rt70.reference": ("rt70.urdf", "rt70.resources", *SHARED),
+    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED),
     "rt70.resources": ("rt70.urdf.description", *SHARED),
     "rt70.rotations": (),
     "rt70.errors": (),

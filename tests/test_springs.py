@@ -125,7 +125,7 @@ def test_reference_rpy_formulas_are_pinocchios():
     q = rng.uniform(-0.4, 0.4, ref.nv)
     delta, jac = ref.deformations(q)
     d = ref.data
-    for k, ((i1, P1), (i2, P2)) in enumerate(zip(ref._frames1, ref._frames2, strict=True)):
+    for k, ((i1, P1), (i2, P2)) in enumerate(zip(ref.frames1, ref.frames2, strict=True)):
         M12 = (d.oMi[i1] * P1).actInv(d.oMi[i2] * P2)
         rho = pin.rpy.matrixToRpy(M12.rotation.T)
         assert np.allclose(delta[k], np.r_[M12.translation, -rho], atol=1e-12)

@@ -1,0 +1,105 @@
+"""Equations of motion from Pinocchio's recursive algorithms, in the book's coordinates.
+
+``algorithm(model, data, q, …)`` as on the textbook side (:mod:`rt70.textbook.dynamics`):
+CRBA for A, RNEA for ``B q̇`` and gravity, ABA for ``q̈``, Pinocchio's energies — each
+mapped back through ``J`` of :func:`rt70.reference.coordinates.to_pinocchio`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from rt70.reference.coordinates import to_pinocchio
+from rt70.reference.forces import element_torques
+from rt70.reference.model import ReferenceData, ReferenceModel
+
+
+def _crba(model: ReferenceModel, data: ReferenceData, qp: np.ndarray) -> np.ndarray:
+    """Pinocchio's CRBA, symmetrised (it fills the upper triangle)."""
+    A = pin.crba(model.pin_model, data.pin_data, qp)
+    return np.triu(A) + np.triu(A, 1).T
+
+
+def mass_matrix(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np.ndarray:
+    """``A = Jᵀ crba J`` (``J`` includes the map to the user's order)."""
+    qp, _, J, _ = to_pinocchio(model, q)
+    A = _crba(model, data, qp)
+    return A if J is None else J.T @ A @ J
+
+
+def bias_force(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
+) -> np.ndarray:
+    """``B(q, q̇) q̇ = Jᵀ rnea(q, v, J̇ q̇)`` with gravity switched off."""
+    qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
+    pm, pd = model.pin_model_no_gravity, data.pin_data_no_gravity
+    if J is None:
+        return pin.rnea(pm, pd, qp, vp, np.zeros(model.nv))
+    return J.T @ pin.rnea(pm, pd, qp, vp, Jdqd)
+
+
+def gravity_force(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np.ndarray:
+    """Generalised gravity force on the right-hand side: ``−Jᵀ g(q)``."""
+    qp, _, J, _ = to_pinocchio(model, q)
+    g = pin.computeGeneralizedGravity(model.pin_model, data.pin_data, qp)
+    return -g if J is None else -(J.T @ g)
+
+
+def forward_dynamics(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
+) -> np.ndarray:
+    """``q̈`` under gravity and the scene's springs and dampers: ``pin.aba`` with them as τ.
+
+    Unlike the textbook side's ``forward_dynamics(model, data, q, q̇, Q)`` the spring
+    and damper forces are the reference side's own (:func:`element_torques`, in
+    Pinocchio's velocity space), so that the comparison checks them too. With mimic
+    joints (a constraint ABA cannot take) the reduced equations
+    ``Jᵀ A J q̈ = Jᵀ (τ − rnea(q, v, J̇ q̇))`` are solved with Pinocchio's CRBA and RNEA.
+    """
+    qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
+    Qc, Qd = element_torques(model, data, qp, vp)
+    tau = Qc + Qd
+    pm, pd = model.pin_model, data.pin_data
+    if J is None:
+        return pin.aba(pm, pd, qp, vp, tau)
+    if J.shape[0] == J.shape[1]:
+        vdot = pin.aba(pm, pd, qp, vp, tau)
+        return np.linalg.solve(J, vdot - Jdqd)
+    A = _crba(model, data, qp)
+    rhs = J.T @ (tau - pin.rnea(pm, pd, qp, vp, Jdqd))
+    return np.linalg.solve(J.T @ A @ J, rhs)
+
+
+def kinetic_energy(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
+) -> float:
+    """``pin.computeKineticEnergy``."""
+    qp, vp, _, _ = to_pinocchio(model, q, qd)
+    return float(pin.computeKineticEnergy(model.pin_model, data.pin_data, qp, vp))
+
+
+def gravity_potential(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> float:
+    """``pin.computePotentialEnergy`` (gravity only)."""
+    qp, _, _, _ = to_pinocchio(model, q)
+    return float(pin.computePotentialEnergy(model.pin_model, data.pin_data, qp))
+
+
+def weight_moment(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> float:
+    """``G₀ = Σ_b m_b |g| |c_b|``: the moment of the weights about the ground origin.
+
+    ``c_b`` is body b's centre of mass in the ground frame (Pinocchio's joint placements
+    ``oMi`` and inertia levers). It is the size of the terms that gravity torques and
+    the gravity potential are sums and differences of (the natural scale of
+    :func:`rt70.validate.natural_scales`), in N·m = J.
+    """
+    qp, _, _, _ = to_pinocchio(model, q)
+    pm, pd = model.pin_model, data.pin_data
+    pin.forwardKinematics(pm, pd, qp)
+    g = float(np.linalg.norm(pm.gravity.linear))
+    total = 0.0
+    for i in range(1, pm.njoints):
+        inertia = pm.inertias[i]
+        com = pd.oMi[i].act(inertia.lever)
+        total += inertia.mass * g * float(np.linalg.norm(com))
+    return total

@@ -1,0 +1,211 @@
+"""The reference side's constant Model and its work buffers (Data), as in Pinocchio.
+
+:class:`ReferenceModel` is built once from a scene (Pinocchio parses the URDF text
+itself) and never changed afterwards: Pinocchio's model, a copy without gravity (for
+the velocity-product force), the map of every Pinocchio joint to the book's
+coordinates, and the scene's spring elements. :class:`ReferenceData` holds Pinocchio's
+``Data`` objects that the algorithms fill (:mod:`rt70.reference.dynamics`,
+:mod:`rt70.reference.forces`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from rt70.errors import Rt70Error
+from rt70.reference.legacy import LegacyMethods
+from rt70.reference.parse import parse_urdf
+from rt70.resources import check_reference
+from rt70.urdf.coordinates import SUFFIXES, coordinate_names
+from rt70.urdf.description import FrameRef, RobotDescription
+from rt70.urdf.inertia import balanced_text
+from rt70.urdf.text import prepare_text
+
+
+@dataclass(frozen=True)
+class Bushing:
+    """A bushing's two frames, each as (parent joint, placement in it), and its gains."""
+
+    frame1: tuple[int, pin.SE3]
+    frame2: tuple[int, pin.SE3]
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+
+@dataclass(frozen=True)
+class Coordinate:
+    """One Pinocchio joint seen in book coordinates."""
+
+    joint: int
+    kind: str  # "1dof", "continuous", "floating", "planar", "mimic", "mimic-continuous"
+    names: tuple[str, ...]
+    iq: int
+    iv: int
+    book: int  # first book coordinate (for a mimic joint: the source's book coordinate)
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+class ReferenceModel(LegacyMethods):
+    """Pinocchio's model of one scene and its spring elements; constant once built.
+
+    Parameters
+    ----------
+    desc : RobotDescription
+        The scene as read by :func:`rt70.urdf.read_urdf` (validated).
+    urdf_text : str
+        The URDF text itself, handed to Pinocchio's own parser.
+
+    Attributes
+    ----------
+    pin_model, pin_model_no_gravity : pinocchio.Model
+        Pinocchio's model with the scene's gravity, and a copy without gravity.
+    coords : list of Coordinate
+        Every Pinocchio joint's book coordinates, in Pinocchio's joint order.
+    coordinate_names : list of str
+        The book coordinates in the user's order (:func:`rt70.urdf.coordinate_names`).
+    identity_map : bool
+        True when book coordinates are Pinocchio's ``(q, v)`` unchanged.
+    bushings : list of Bushing
+        Attachment frames and gains of every bushing and strut.
+    spring_v, spring_k, spring_d : numpy.ndarray
+        Velocity index, stiffness and damping of every joint spring.
+    """
+
+    def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
+        check_reference(desc)  # parser depth and memory, before Pinocchio sees the model
+        model = parse_urdf(urdf_text, desc.source)
+        model.gravity.linear = np.asarray(desc.gravity, dtype=float)
+        model.armature[:] = 0.0
+        self.pin_model = model
+        self.pin_model_no_gravity = model.copy()
+        self.pin_model_no_gravity.gravity.setZero()
+        bodies = {f.name: f for f in model.frames if f.type == pin.BODY}
+        self.bushings = [
+            Bushing(
+                _attachment(bodies, b.frame1),
+                _attachment(bodies, b.frame2),
+                np.asarray(b.stiffness),
+                np.asarray(b.damping),
+            )
+            for b in desc.bushings
+        ]
+        self.frames1 = [b.frame1 for b in self.bushings]
+        self.frames2 = [b.frame2 for b in self.bushings]
+        self.stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6)
+        self.damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6)
+        self.coords, self.coordinate_names = _coordinates(model, desc)
+        self.identity_map = all(c.kind == "1dof" and c.book == c.iv for c in self.coords)
+        joint_id = {name: i for i, name in enumerate(model.names)}
+        self.spring_v = np.array(
+            [model.idx_vs[joint_id[s.joint]] for s in desc.joint_springs], dtype=int
+        )
+        self.spring_k = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
+        self.spring_d = np.array([s.damping for s in desc.joint_springs], dtype=float)
+
+    @classmethod
+    def from_file(cls, desc: RobotDescription, path: str | Path) -> ReferenceModel:
+        """Build from a URDF file already read into ``desc`` (its repairs written in)."""
+        text = Path(path).read_text(encoding="utf-8")
+        if desc.inertia_repairs:  # read the repaired inertias, as the textbook side does
+            text = balanced_text(prepare_text(text, desc.source), desc.inertia_repairs)
+        return cls(desc, text)
+
+    @property
+    def nv(self) -> int:
+        """Number of book coordinates (independent generalised coordinates)."""
+        return len(self.coordinate_names)
+
+    def coordinate_index(self, names: list[str]) -> np.ndarray:
+        """Index among this model's book coordinates of each named coordinate."""
+        position = {n: i for i, n in enumerate(self.coordinate_names)}
+        return np.array([position[n] for n in names], dtype=int)
+
+
+class ReferenceData:
+    """Work buffers of the reference algorithms for one :class:`ReferenceModel`.
+
+    Attributes
+    ----------
+    pin_data, pin_data_no_gravity : pinocchio.Data
+        Pinocchio's buffers for ``model.pin_model`` and ``model.pin_model_no_gravity``.
+    """
+
+    def __init__(self, model: ReferenceModel) -> None:
+        self.pin_data = model.pin_model.createData()
+        self.pin_data_no_gravity = model.pin_model_no_gravity.createData()
+
+
+def _attachment(bodies: dict, ref: FrameRef) -> tuple[int, pin.SE3]:
+    """Parent joint and placement in it of a frame fixed to a link.
+
+    Kept as (joint, placement) rather than added to the model: ``Model.addFrame``
+    searches every frame for a duplicate name, quadratic in the number of bushings.
+    """
+    if ref.link not in bodies:
+        raise Rt70Error(f"Pinocchio has no frame for link '{ref.link}'")
+    body = bodies[ref.link]
+    offset = pin.SE3(pin.rpy.rpyToMatrix(*ref.rpy), np.asarray(ref.xyz, dtype=float))
+    return body.parentJoint, body.placement * offset
+
+
+def _coordinates(m: pin.Model, desc: RobotDescription) -> tuple[list[Coordinate], list[str]]:
+    """Book coordinates of every Pinocchio joint, numbered in the user's order.
+
+    Pinocchio numbers sibling joints its own way; every result of the reference side is
+    in the order of :func:`rt70.urdf.coordinate_names` (the file's depth-first order,
+    the same as the textbook side's), so ``c.book`` is the user index of the joint's
+    first coordinate.
+    """
+    mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
+    names = coordinate_names(desc)
+    user = {n: i for i, n in enumerate(names)}
+    coords: list[Coordinate] = []
+    seen: list[str] = []
+    for i in range(1, m.njoints):
+        name, jm = m.names[i], m.joints[i]
+        short = jm.shortname()
+        if short == "JointModelFreeFlyer":
+            kind = "floating"
+        elif short == "JointModelPlanar":
+            kind = "planar"
+        elif jm.nq == 2 and jm.nv == 1:
+            kind = "continuous"
+        elif jm.nq == 1 and jm.nv == 1:
+            kind = "1dof"
+        else:
+            raise Rt70Error(f"{desc.source}: joint '{name}': Pinocchio joint {short} unsupported")
+        if name in mimics:
+            mimic = mimics[name]
+            coords.append(
+                Coordinate(
+                    i,
+                    "mimic-continuous" if kind == "continuous" else "mimic",
+                    (),
+                    jm.idx_q,
+                    jm.idx_v,
+                    user[mimic.joint],
+                    mimic.multiplier,
+                    mimic.offset,
+                )
+            )
+            continue
+        labels = tuple(name + sfx for sfx in SUFFIXES.get(kind, ("",)))
+        first = user.get(labels[0], -1)
+        if [user.get(label) for label in labels] != list(range(first, first + len(labels))):
+            raise Rt70Error(
+                f"{desc.source}: joint '{name}': Pinocchio's coordinates "
+                f"{', '.join(labels)} are not those rt70 reads from the file"
+            )
+        coords.append(Coordinate(i, kind, labels, jm.idx_q, jm.idx_v, first))
+        seen.extend(labels)
+    if sorted(seen) != sorted(names):
+        raise Rt70Error(
+            f"{desc.source}: Pinocchio's coordinates differ from the file's: "
+            f"{', '.join(sorted(set(seen) ^ set(names))[:5])}"
+        )
+    return coords, names
