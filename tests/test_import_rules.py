@@ -4,7 +4,8 @@ The two sides of the cross-check stay independent only if the import graph says 
 ``rt70/urdf/`` (the reader) imports nothing of the textbook side nor of the reference
 side; ``rt70/textbook/`` never imports the reference side (nor Pinocchio, see
 tests/test_independence.py) and the reference side never imports the textbook; both
-may use the shared math below them (``rt70.rotations``) and the small helpers every
+may use the shared math below them (``rt70.rotations``; the textbook also
+``rt70.constraints``) and the small helpers every
 layer uses (``rt70.errors``, ``rt70.arrays``). The generic analyses and the simulation
 load no RT-70 module (:data:`RT70_MODULES`), not even through another module. Every
 import is found statically, at any depth (inside functions too).
@@ -31,17 +32,20 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "rt70"
 
 #: Modules below both sides that any layer may import.
-SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations")
+SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations", "rt70.constraints")
 
 #: layer (module prefix) → module prefixes it may import from rt70.
 RULES = {
     "rt70.urdf": ("rt70.urdf", *SHARED),
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
-    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED),
+    # not rt70.constraints: the reference side maps mimic joints on its own, so the
+    # cross-check also checks the textbook's constraint matrix G
+    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED[:3]),
     "rt70.resources": ("rt70.urdf.description", *SHARED),
     "rt70.rotations": (),
     "rt70.errors": (),
     "rt70.arrays": ("rt70.errors",),
+    "rt70.constraints": ("rt70.errors",),
 }
 
 

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rt70.constraints import HolonomicMap, rigid_link_map
 from rt70.errors import TopologyError
 from rt70.linear.topology import (
     Edge,
@@ -340,6 +341,9 @@ class Reduction:
         Names of the coordinates α**: a root's own coordinate, or ``child-parent``.
     dropped_rigid_edges : tuple of (int, int)
         Rigid links left out of the tree because they close a rigid loop.
+    constraint : HolonomicMap
+        The rigid links as a constraint map ``α = S*ᵀ α**`` (:mod:`rt70.constraints`),
+        which reduces A*, C*, D*.
     """
 
     tree: SpanningTree
@@ -354,6 +358,7 @@ class Reduction:
     D_star: np.ndarray
     names: tuple[str, ...]
     dropped_rigid_edges: tuple[Edge, ...]
+    constraint: HolonomicMap
 
     @property
     def n(self) -> int:
@@ -468,6 +473,7 @@ def eliminate(model: LinearModel, rigid_edges: Sequence[Sequence[int]], root: in
         for a in range(dim):
             own = model.names[(k - 1) * dim + a]
             names.append(own if p == 0 else f"{own}-{model.names[(p - 1) * dim + a]}")
+    rigid = rigid_link_map(S_star, model.names, names)  # α = S*ᵀ α** (3.17)
     return Reduction(
         tree=tree,
         gamma_star=gs,
@@ -476,9 +482,10 @@ def eliminate(model: LinearModel, rigid_edges: Sequence[Sequence[int]], root: in
         S=S,
         f_star=f_star,
         S_star=S_star,
-        A_star=S_star @ model.m @ S_star.T,
-        C_star=S_star @ model.C @ S_star.T,
-        D_star=S_star @ model.D @ S_star.T,
+        A_star=rigid.reduce_matrix(model.m),
+        C_star=rigid.reduce_matrix(model.C),
+        D_star=rigid.reduce_matrix(model.D),
         names=tuple(names),
         dropped_rigid_edges=tree.dropped_rigid_edges,
+        constraint=rigid,
     )

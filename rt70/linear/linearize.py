@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
+from rt70.constraints import HolonomicMap, locking
 from rt70.errors import Rt70Error
 from rt70.scene import Scene
 from rt70.textbook import dynamics, forces
@@ -74,6 +75,16 @@ def coordinate_indices(scene: Scene, names: list[str] | tuple[str, ...]) -> np.n
     return np.array([known.index(n) for n in names], dtype=int)
 
 
+def locking_map(scene: Scene, locked: dict[str, float] | list[str]) -> HolonomicMap:
+    """The coordinates held or locked by the drives as a constraint map (chapter 3).
+
+    :func:`rt70.constraints.locking`, with the scene's name in the error for an
+    unknown coordinate.
+    """
+    coordinate_indices(scene, list(locked))  # the error names the scene
+    return locking(scene.textbook.coordinate_names, locked)
+
+
 def equilibrium(
     scene: Scene,
     held: dict[str, float] | None = None,
@@ -95,18 +106,16 @@ def equilibrium(
         If the free coordinates have no stiffness against some direction (singular K),
         or Newton does not converge.
     """
-    held = held or {}
+    hold = locking_map(scene, held or {})
     nv = scene.textbook.nv
     q = np.zeros(nv) if q_start is None else np.array(q_start, dtype=float)
-    fixed = coordinate_indices(scene, list(held))
-    q[fixed] = list(held.values())
-    free = np.setdiff1d(np.arange(nv), fixed)
+    q = hold.expand(hold.T.T @ q)  # the free values kept, the held ones set
     scale = max(float(np.max(np.abs(static_force(scene, q)))), 1.0)
     for _ in range(max_iter):
-        residual = static_force(scene, q)[free]
+        residual = hold.reduce_force(static_force(scene, q))
         if np.max(np.abs(residual), initial=0.0) <= tol * scale:
             return q
-        K = stiffness_matrix(scene, q)[np.ix_(free, free)]
+        K = hold.reduce_matrix(stiffness_matrix(scene, q))
         if not np.isfinite(K).all():
             raise Rt70Error(
                 f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
@@ -119,7 +128,7 @@ def equilibrium(
                 f"{scene.name}: no static equilibrium: the free coordinates have no "
                 "stiffness in some direction (hold or lock it)"
             ) from None
-        q[free] += step
+        q += hold.expand(step, offset=False)
     raise Rt70Error(f"{scene.name}: static equilibrium not found in {max_iter} Newton steps")
 
 
@@ -146,23 +155,19 @@ def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Lin
 
     Locking a coordinate of the pair structure is the book's holonomic constraint in 3-D:
     its column of the mobility matrix f is deleted, so its rows and columns of A, K and
-    D are deleted.
+    D are deleted — ``Tᵀ M T`` of :func:`locking_map` (:mod:`rt70.constraints`).
     """
     model, data = scene.textbook, scene.textbook_data
-    keep = np.setdiff1d(np.arange(model.nv), coordinate_indices(scene, list(locked)))
-    ix = np.ix_(keep, keep)
-    M = dynamics.mass_matrix(model, data, q0).copy()
-    K = stiffness_matrix(scene, q0)
-    D = damping_matrix(scene, q0)
-    K_g = _gravity_stiffness(scene, q0)
+    lock = locking_map(scene, list(locked))
+    M = dynamics.mass_matrix(model, data, q0)
     return Linearization(
         scene=scene.name,
         q0=np.array(q0, dtype=float),
-        coordinates=[model.coordinate_names[i] for i in keep],
-        M=M[ix],
-        K=K[ix],
-        D=D[ix],
-        K_gravity=K_g[ix],
+        coordinates=list(lock.names),
+        M=lock.reduce_matrix(M),
+        K=lock.reduce_matrix(stiffness_matrix(scene, q0)),
+        D=lock.reduce_matrix(damping_matrix(scene, q0)),
+        K_gravity=lock.reduce_matrix(_gravity_stiffness(scene, q0)),
         locked=list(locked),
     )
 

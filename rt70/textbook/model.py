@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rt70.constraints import mimic_map
 from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
 from rt70.urdf.description import Joint, RobotDescription
 
@@ -301,23 +302,19 @@ def _mimic_constraints(
 ) -> tuple[np.ndarray | None, np.ndarray | None, list[str]]:
     """``q_full = G q + q_offset`` from the URDF ``<mimic>`` elements (chapter 3).
 
-    Returns G, q_offset (None, None without mimics) and the independent coordinates.
+    Built by :func:`rt70.constraints.mimic_map`, where every eliminated constraint is
+    defined. Returns G, q_offset (None, None without mimics) and the independent
+    coordinates.
     """
-    mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
+    mimics = {
+        j.name: (j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
+        for j in desc.joints
+        if j.mimic is not None
+    }
     if not mimics:
         return None, None, list(full_names)
-    independent = [n for n in full_names if n not in mimics]
-    column = {name: c for c, name in enumerate(independent)}
-    G = np.zeros((len(full_names), len(independent)))
-    offset = np.zeros(len(full_names))
-    for row, name in enumerate(full_names):
-        if name in mimics:
-            m = mimics[name]
-            G[row, column[m.joint]] = m.multiplier
-            offset[row] = m.offset
-        else:
-            G[row, column[name]] = 1.0
-    return G, offset, independent
+    constraint = mimic_map(full_names, mimics)
+    return constraint.T, constraint.offset, list(constraint.names)
 
 
 def _unskew(m: np.ndarray) -> np.ndarray:
