@@ -5,7 +5,8 @@ Two limits were measured (``python validation/resource_limits.py`` reproduces th
 Memory
     Pinocchio 4.1's ``Data`` holds four ``nv × nv × nv`` tensors (the second-order
     RNEA derivatives ``d2tau_dqdq`` …, allocated and zeroed whether used or not), so a
-    :class:`~rt70.reference.ReferenceModel` — two ``Data`` objects, and a third,
+    :class:`~rt70.reference.ReferenceModel` with its
+    :class:`~rt70.reference.ReferenceData` — two ``Data`` objects, and a third,
     transient one while the second is created (the measured peak is 1.5 times the
     final size: a copy on the way to Python) — peaks at about
     ``96 nv³`` bytes: 2.7 GB at nv = 300, about 100 GB at nv = 1000. The textbook side's
@@ -65,7 +66,7 @@ def available_memory() -> int | None:
 
 
 def reference_peak_bytes(nv: int, njoints: int) -> int:
-    """Peak memory of building a :class:`~rt70.reference.ReferenceModel`, bytes.
+    """Peak memory of a :class:`~rt70.reference.ReferenceModel` and its ``ReferenceData``, bytes.
 
     Three ``Data`` (two kept, one transient) of four ``nv³`` float64 tensors each are
     ``96 nv³``; a least-squares fit of the measured peaks (nv = 100 … 350) gives

@@ -208,12 +208,14 @@ def _try_both_sides(scene: Scene, rng: np.random.Generator) -> None:
     The textbook's forward dynamics is evaluated too: a singular mass matrix (a
     coordinate that moves no mass) makes the robot unusable for the cross-check.
     """
+    from rt70 import reference
+
     model, data, ref = scene.textbook, scene.textbook_data, scene.reference
     require_coordinates(scene)
     _check_coordinates(scene)
     q, qd = rng.uniform(-0.5, 0.5, model.nv), rng.uniform(-1.0, 1.0, model.nv)
     A = dynamics.mass_matrix(model, data, q)
-    ref.mass_matrix(q)
+    reference.mass_matrix(ref, scene.reference_data, q)
     require_diagonal(A, model.coordinate_names, "")
     dynamics.forward_dynamics(model, data, q, qd, np.zeros(model.nv))
 

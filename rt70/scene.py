@@ -71,7 +71,9 @@ class Scene:
 
     Both sides take and return every per-coordinate vector and matrix in the same
     order, :attr:`coordinate_names` (the file's depth-first order,
-    :func:`rt70.urdf.coordinate_names`): ``scene.reference.mass_matrix(q)`` and
+    :func:`rt70.urdf.coordinate_names`), in one convention (a constant model, its
+    work buffers, ``algorithm(model, data, q)``):
+    ``reference.mass_matrix(scene.reference, scene.reference_data, q)`` and
     ``dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)`` compare directly.
     ``text`` is what both sides read: the file's text as normalised by
     :func:`rt70.urdf.text.prepare_text`, with the inertias repaired on request written
@@ -110,6 +112,13 @@ class Scene:
         from rt70.reference import ReferenceModel
 
         return ReferenceModel(self.description, self.text)
+
+    @cached_property
+    def reference_data(self):  # -> rt70.reference.ReferenceData
+        """Work buffers of :attr:`reference` (:class:`rt70.reference.ReferenceData`)."""
+        from rt70.reference import ReferenceData
+
+        return ReferenceData(self.reference)
 
     @cached_property
     def coordinate_names(self) -> list[str]:

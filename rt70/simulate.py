@@ -77,35 +77,36 @@ class _PinocchioBackend(_Backend):
         super().__init__(scene)
         import pinocchio as pin
 
-        self.pin = pin
-        self.ref = scene.reference
+        from rt70 import reference
+
+        self.pin, self.reference = pin, reference
+        self.ref, self.rd = scene.reference, scene.reference_data
         self.direct = self.ref.identity_map  # book coordinates are Pinocchio's (q, v)
 
     def mass_matrix(self, q):
-        return self.ref.mass_matrix(q)
+        return self.reference.mass_matrix(self.ref, self.rd, q)
 
     def accelerations(self, q, qd, Q_u):
         check_euler_pairs(self.scene.textbook, self.scene.textbook.expand(q))
+        reference, ref, rd = self.reference, self.ref, self.rd
         if not self.direct:  # general coordinates: through the book-coordinate map
-            ref = self.ref
-            a = ref.forward_dynamics(q, qd)
-            _, Qd = ref.spring_damper_force(q, qd)
+            a = reference.forward_dynamics(ref, rd, q, qd)
+            _, Qd = reference.spring_damper_force(ref, rd, q, qd)
             if Q_u is not None:
-                a = a + np.linalg.solve(ref.mass_matrix(q), Q_u)
+                a = a + np.linalg.solve(reference.mass_matrix(ref, rd, q), Q_u)
             return a, Qd
-        ref, pin = self.ref, self.pin
-        Qc, Qd = ref.element_torques(q, qd)
+        Qc, Qd = reference.element_torques(ref, rd, q, qd)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
-        return pin.aba(ref.model, ref.data, q, qd, tau), Qd
+        return self.pin.aba(ref.pin_model, rd.pin_data, q, qd, tau), Qd
 
     def jacobian(self, q, qd, Q_u):
         if not self.direct:
             return None
-        ref, pin = self.ref, self.pin
-        Qc, Qd = ref.element_torques(q, qd)
+        reference, ref, rd, pin = self.reference, self.ref, self.rd, self.pin
+        Qc, Qd = reference.element_torques(ref, rd, q, qd)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
-        dq, dv, Minv = pin.computeABADerivatives(ref.model, ref.data, q, qd, tau)
-        Kc, Dc = ref.element_gains(q)
+        dq, dv, Minv = pin.computeABADerivatives(ref.pin_model, rd.pin_data, q, qd, tau)
+        Kc, Dc = reference.element_gains(ref, rd, q)
         n = self.nv
         J = np.zeros((2 * n, 2 * n))
         J[:n, n:] = np.eye(n)
@@ -115,8 +116,12 @@ class _PinocchioBackend(_Backend):
         return J
 
     def energies(self, q, qd):
-        ref = self.ref
-        return ref.kinetic_energy(q, qd), ref.gravity_potential(q), ref.spring_potential(q)
+        reference, ref, rd = self.reference, self.ref, self.rd
+        return (
+            reference.kinetic_energy(ref, rd, q, qd),
+            reference.gravity_potential(ref, rd, q),
+            reference.spring_potential(ref, rd, q),
+        )
 
 
 class _TextbookBackend(_Backend):

@@ -91,7 +91,10 @@ def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
 
 def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
     """Per quantity: (textbook evaluation, reference evaluation), in the user's coordinate order."""
-    tm, td, ref = scene.textbook, scene.textbook_data, scene.reference
+    from rt70 import reference
+
+    tm, td = scene.textbook, scene.textbook_data
+    ref, rd = scene.reference, scene.reference_data
 
     def tb_forward():
         Qc, Qd = forces.spring_damper_force(tm, td, q, qd)
@@ -100,26 +103,34 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     return {
         "mass_matrix": (
             lambda: dynamics.mass_matrix(tm, td, q),
-            lambda: ref.mass_matrix(q),
+            lambda: reference.mass_matrix(ref, rd, q),
         ),
-        "bias": (lambda: dynamics.bias_force(tm, td, q, qd), lambda: ref.bias_force(q, qd)),
-        "gravity": (lambda: dynamics.gravity_force(tm, td, q), lambda: ref.gravity_force(q)),
+        "bias": (
+            lambda: dynamics.bias_force(tm, td, q, qd),
+            lambda: reference.bias_force(ref, rd, q, qd),
+        ),
+        "gravity": (
+            lambda: dynamics.gravity_force(tm, td, q),
+            lambda: reference.gravity_force(ref, rd, q),
+        ),
         "spring_force": (
             lambda: forces.spring_damper_force(tm, td, q, qd)[0],
-            lambda: ref.spring_damper_force(q, qd)[0],
+            lambda: reference.spring_damper_force(ref, rd, q, qd)[0],
         ),
         "damper_force": (
             lambda: forces.spring_damper_force(tm, td, q, qd)[1],
-            lambda: ref.spring_damper_force(q, qd)[1],
+            lambda: reference.spring_damper_force(ref, rd, q, qd)[1],
         ),
-        "forward_dynamics": (tb_forward, lambda: ref.forward_dynamics(q, qd)),
+        "forward_dynamics": (tb_forward, lambda: reference.forward_dynamics(ref, rd, q, qd)),
         "kinetic_energy": (
             lambda: forces.kinetic_energy(tm, td, q, qd),
-            lambda: ref.kinetic_energy(q, qd),
+            lambda: reference.kinetic_energy(ref, rd, q, qd),
         ),
         "potential_energy": (
             lambda: forces.gravity_potential(tm, td, q) + forces.spring_potential(tm, td, q),
-            lambda: ref.gravity_potential(q) + ref.spring_potential(q),
+            lambda: (
+                reference.gravity_potential(ref, rd, q) + reference.spring_potential(ref, rd, q)
+            ),
         ),
     }
 
@@ -153,7 +164,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
       weights about the ground origin (``c_b`` the bodies' centres of mass): gravity
       torques are differences of such moments;
     - springs, dampers: ``‖Σ_e |J_e|ᵀ |C_e δ_e|‖`` and ``‖Σ_e |J_e|ᵀ |D_e δ̇_e|‖``, the
-      elements' forces before they cancel (``ReferenceModel.spring_damper_magnitudes``);
+      elements' forces before they cancel (:func:`rt70.reference.spring_damper_magnitudes`);
     - q̈, per coordinate: ``|A⁻¹| (f + |A| |q̈|)`` with ``f_i`` the sum of the force
       scales above for coordinate i (``‖A_i‖₁ ‖q̇‖² + |B q̇|_i + G₀ + |Q_g|_i`` and the
       springs' and dampers' terms): the first-order bound of how far a rounding of the
@@ -185,10 +196,12 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
             f"eigenvalues {eig[0]:.3g} … {eig[-1]:.3g}): the forward dynamics is not "
             "determined"
         )
-    ref = scene.reference
+    from rt70 import reference
+
+    ref, rd = scene.reference, scene.reference_data
     speed2 = float(np.max(np.abs(qd), initial=0.0)) ** 2
-    g0 = ref.weight_moment(q)
-    Sc, Sd = ref.spring_damper_magnitudes(q, qd)
+    g0 = reference.weight_moment(ref, rd, q)
+    Sc, Sd = reference.spring_damper_magnitudes(ref, rd, q, qd)
     Q_b, Q_g = np.abs(values["bias"][1]), np.abs(values["gravity"][1])
     f = np.abs(A).sum(axis=1) * speed2 + Q_b + g0 + Q_g + Sc + Sd
     qdd = np.abs(values["forward_dynamics"][1])
@@ -200,7 +213,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "damper_force": float(np.max(Sd, initial=0.0)),
         "forward_dynamics": np.abs(np.linalg.inv(A)) @ (f + np.abs(A) @ qdd),
         "kinetic_energy": norm("mass_matrix") * speed2,
-        "potential_energy": g0 + ref.spring_potential(q),
+        "potential_energy": g0 + reference.spring_potential(ref, rd, q),
     }
 
 

@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 
 import rt70.resources as resources
+from rt70 import reference
 from rt70.atomic import atomic_write_all
 from rt70.cli import EXIT_BROKEN_PIPE, EXIT_TERMINATED, main
 from rt70.errors import (
@@ -220,7 +221,7 @@ def test_bushings_are_attached_without_adding_pinocchio_frames():
     scene = load_scene("rt70")
     assert scene.description.bushings
     plain = pin.buildModelFromXML(scene.text)
-    assert scene.reference.model.nframes == plain.nframes
+    assert scene.reference.pin_model.nframes == plain.nframes
 
 
 def test_child_joints_keep_file_order_and_springs_resolve():
@@ -556,15 +557,15 @@ def _textbook_calls(scene):
 
 
 def _reference_calls(scene):
-    ref = scene.reference
+    m, d = scene.reference, scene.reference_data
     return {
-        "reference.mass_matrix": lambda q, qd: ref.mass_matrix(q),
-        "reference.bias_force": lambda q, qd: ref.bias_force(q, qd),
-        "reference.gravity_force": lambda q, qd: ref.gravity_force(q),
-        "reference.forward_dynamics": lambda q, qd: ref.forward_dynamics(q, qd),
-        "reference.spring_damper_force": lambda q, qd: ref.spring_damper_force(q, qd),
-        "reference.kinetic_energy": lambda q, qd: ref.kinetic_energy(q, qd),
-        "reference.spring_potential": lambda q, qd: ref.spring_potential(q),
+        "reference.mass_matrix": lambda q, qd: reference.mass_matrix(m, d, q),
+        "reference.bias_force": lambda q, qd: reference.bias_force(m, d, q, qd),
+        "reference.gravity_force": lambda q, qd: reference.gravity_force(m, d, q),
+        "reference.forward_dynamics": lambda q, qd: reference.forward_dynamics(m, d, q, qd),
+        "reference.spring_damper_force": lambda q, qd: reference.spring_damper_force(m, d, q, qd),
+        "reference.kinetic_energy": lambda q, qd: reference.kinetic_energy(m, d, q, qd),
+        "reference.spring_potential": lambda q, qd: reference.spring_potential(m, d, q),
     }
 
 
@@ -596,4 +597,6 @@ def test_non_finite_state_is_the_same_error_on_both_sides(scene, side, value):
         with pytest.raises(NonFiniteError, match="^q contains NaN or infinite"):
             call(bad, np.zeros(n))
     with pytest.raises(NonFiniteError, match="^qp contains"):
-        scene.reference.deformations(np.full(scene.reference.model.nq, value))
+        reference.deformations(
+            scene.reference, scene.reference_data, np.full(scene.reference.pin_model.nq, value)
+        )

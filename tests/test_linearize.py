@@ -4,6 +4,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from rt70 import reference
 from rt70.linear import linearize as lin
 from rt70.scene import load_scene
 from rt70.scenes import rt70_state
@@ -30,9 +31,9 @@ def test_gravity_stiffness_matches_pinocchio_analytic(rt70):
     rng = np.random.default_rng(3)
     q = rng.uniform(-0.3, 0.3, rt70.textbook.nv)
     K_g = lin._gravity_stiffness(rt70, q)
-    ref = rt70.reference
-    qp, _, J, _ = ref.to_pinocchio(q)
-    dg = pin.computeGeneralizedGravityDerivatives(ref.model, ref.data, qp)  # ∂g/∂q, g = −Q_g
+    ref, pd = rt70.reference, rt70.reference_data.pin_data
+    qp, _, J, _ = reference.to_pinocchio(ref, q)
+    dg = pin.computeGeneralizedGravityDerivatives(ref.pin_model, pd, qp)  # ∂g/∂q, g = −Q_g
     K_ref = dg if J is None else J.T @ dg @ J
     K_ref = 0.5 * (K_ref + K_ref.T)
     assert np.abs(K_g - K_ref).max() <= 1e-7 * np.abs(K_ref).max()
@@ -71,8 +72,8 @@ def test_locked_coordinates_equal_pinocchio_reduced_model(rt70):
     model = lin.linearize(rt70, q0, locked=tuple(locked))
     assert len(model.coordinates) == 7
     ref = rt70.reference
-    lock_ids = [ref.model.getJointId(n) for n in locked]
-    reduced = pin.buildReducedModel(ref.model, lock_ids, pin.neutral(ref.model))
+    lock_ids = [ref.pin_model.getJointId(n) for n in locked]
+    reduced = pin.buildReducedModel(ref.pin_model, lock_ids, pin.neutral(ref.pin_model))
     M_pin = pin.crba(reduced, reduced.createData(), pin.neutral(reduced))
     M_pin = np.triu(M_pin) + np.triu(M_pin, 1).T
     order = [reduced.names[i] for i in range(1, reduced.njoints)]

@@ -119,18 +119,20 @@ def test_reference_rpy_formulas_are_pinocchios():
     """The batched rpy and inverse rpy Jacobian of rt70.reference equal pin.rpy's."""
     import pinocchio as pin
 
+    from rt70 import reference
+
     scene = load_scene("rt70")
-    ref = scene.reference
+    ref, rd = scene.reference, scene.reference_data
     rng = np.random.default_rng(5)
-    q = rng.uniform(-0.4, 0.4, ref.nv)
-    delta, jac = ref.deformations(q)
-    d = ref.data
+    q = rng.uniform(-0.4, 0.4, ref.nv)  # the RT-70's book coordinates are Pinocchio's q
+    delta, jac = reference.deformations(ref, rd, q)
+    d = rd.pin_data
     for k, ((i1, P1), (i2, P2)) in enumerate(zip(ref.frames1, ref.frames2, strict=True)):
         M12 = (d.oMi[i1] * P1).actInv(d.oMi[i2] * P2)
         rho = pin.rpy.matrixToRpy(M12.rotation.T)
         assert np.allclose(delta[k], np.r_[M12.translation, -rho], atol=1e-12)
-        J1 = pin.getFrameJacobian(ref.model, d, i1, P1, pin.LOCAL)
-        J2 = pin.getFrameJacobian(ref.model, d, i2, P2, pin.LOCAL)
+        J1 = pin.getFrameJacobian(ref.pin_model, d, i1, P1, pin.LOCAL)
+        J2 = pin.getFrameJacobian(ref.pin_model, d, i2, P2, pin.LOCAL)
         J_rel = J2 - M12.inverse().toActionMatrix() @ J1
         expected = np.r_[
             M12.rotation @ J_rel[:3],

@@ -67,7 +67,7 @@ def build_textbook(scene):
 
 
 def build_reference(scene):
-    return scene.reference
+    return scene.reference_data  # the ReferenceModel and its Data
 
 
 def evaluate(scene):

@@ -4,7 +4,7 @@ Every measurement runs in a fresh subprocess (a model that is too large, or a pa
 that segfaults, cannot take this script down):
 
 - memory: growth of the anonymous resident set at its peak (``VmHWM`` less the
-  file-backed pages) while building a ReferenceModel, and
+  file-backed pages) while building a ReferenceModel and its ReferenceData, and
   of one call of every dense textbook function on a fresh Data, for serial chains of
   revolute, planar and floating joints; printed beside the estimates of
   ``rt70.resources`` with a least-squares fit ``a nv³ + b nv² + c`` of the reference side;
@@ -42,10 +42,11 @@ side, n, joint = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 scene = scene_from_text(serial_chain(n, joint_types=(joint,)), "chain")
 desc = scene.description
 if side == "reference":
-    from rt70.reference import ReferenceModel
+    from rt70.reference import ReferenceData, ReferenceModel
     base = status()
     ref = ReferenceModel(desc, scene.text)
-    nv, nb = ref.model.nv, ref.model.njoints
+    ReferenceData(ref)
+    nv, nb = ref.pin_model.nv, ref.pin_model.njoints
 else:
     from rt70.textbook import dynamics, forces
     from rt70.textbook.data import Data
@@ -131,7 +132,7 @@ def main() -> int:
         ref_cases += [("planar", 60), ("floating", 40), ("floating", 50)]
         tb_cases += [("revolute", 600), ("revolute", 800), ("floating", 100)]
 
-    print("reference side (ReferenceModel: Pinocchio model, two Data)")
+    print("reference side (ReferenceModel and ReferenceData: Pinocchio model, two Data)")
     print(f"{'joint':>9} {'nv':>5} {'peak MB':>10} {'estimate MB':>12} {'est/peak':>9}")
     rows = []
     for joint, n in ref_cases:

@@ -17,7 +17,6 @@ import numpy as np
 import pinocchio as pin
 
 from rt70.errors import Rt70Error
-from rt70.reference.legacy import LegacyMethods
 from rt70.reference.parse import parse_urdf
 from rt70.resources import check_reference
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
@@ -50,7 +49,7 @@ class Coordinate:
     offset: float = 0.0
 
 
-class ReferenceModel(LegacyMethods):
+class ReferenceModel:
     """Pinocchio's model of one scene and its spring elements; constant once built.
 
     Parameters

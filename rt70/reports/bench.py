@@ -75,9 +75,12 @@ def compare(
 def _pin_crba(scene: Scene, q: np.ndarray) -> Callable[[], object]:
     import pinocchio as pin
 
+    from rt70 import reference
+
     ref = scene.reference
-    qp = ref.to_pinocchio(q)[0]
-    model, data = ref.model, ref.model.createData()
+    qp = reference.to_pinocchio(ref, q)[0]
+    model = ref.pin_model
+    data = model.createData()  # its own buffers, apart from the scene's
     return lambda: pin.crba(model, data, qp)
 
 
@@ -96,12 +99,15 @@ def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
     """Textbook batched A for K configurations against K calls of ``pin.crba``."""
     import pinocchio as pin
 
+    from rt70 import reference
+
     model = scene.textbook
     Q = np.random.default_rng(1).uniform(-0.5, 0.5, (K, model.nv))
     bdata = structured.BatchData(model, K)
     ref = scene.reference
-    QP = [ref.to_pinocchio(q)[0] for q in Q]
-    pm, pd = ref.model, ref.model.createData()
+    QP = [reference.to_pinocchio(ref, q)[0] for q in Q]
+    pm = ref.pin_model
+    pd = pm.createData()
 
     def pin_loop() -> None:
         for qp in QP:

@@ -57,7 +57,7 @@ def _serve(conn: multiprocessing.connection.Connection, unpinned: str) -> None:
         try:
             if problem not in _CACHE:
                 scene, x0, notes = build_problem(problem)
-                _ = scene.reference, scene.textbook_data  # built outside the timing
+                _ = scene.reference_data, scene.textbook_data  # built outside the timing
                 _CACHE[problem] = scene, x0, notes
             scene, x0, notes = _CACHE[problem]
             conn.send(("ready", scene.textbook.nv, notes, max_threads(), unpinned))

@@ -109,14 +109,17 @@ def rel_error(a: np.ndarray, b: np.ndarray) -> float:
 
 def per_body_qdd_error(scene: Scene, samples: int = CROSS_CHECK_SAMPLES, seed: int = 0) -> float:
     """Largest error of q̈ (textbook against Pinocchio) relative to each body's own |q̈|."""
-    model, data, ref = scene.textbook, scene.textbook_data, scene.reference
+    from rt70 import reference
+
+    model, data = scene.textbook, scene.textbook_data
+    ref, rd = scene.reference, scene.reference_data
     rng = np.random.default_rng(seed)
     worst = 0.0
     for _ in range(samples):
         q, qd = random_state(model.nv, rng)
         Qc, Qd = forces.spring_damper_force(model, data, q, qd)
         a = dynamics.forward_dynamics(model, data, q, qd, Qc + Qd)
-        b = ref.forward_dynamics(q, qd)
+        b = reference.forward_dynamics(ref, rd, q, qd)
         for j in range(model.nb):
             rows = model.coords(j)
             if rows.stop > rows.start:
@@ -147,9 +150,11 @@ def momentum_pinocchio(scene: Scene, q: np.ndarray, qd: np.ndarray):
     """
     import pinocchio as pin
 
-    ref = scene.reference
-    qp, vp, _, _ = ref.to_pinocchio(q, qd)
-    pin.computeCentroidalMomentum(ref.model, ref.data, qp, vp)
-    P = np.array(ref.data.hg.linear)
-    L = np.array(ref.data.hg.angular) + np.cross(ref.data.com[0], P)
+    from rt70 import reference
+
+    ref, pd = scene.reference, scene.reference_data.pin_data
+    qp, vp, _, _ = reference.to_pinocchio(ref, q, qd)
+    pin.computeCentroidalMomentum(ref.pin_model, pd, qp, vp)
+    P = np.array(pd.hg.linear)
+    L = np.array(pd.hg.angular) + np.cross(pd.com[0], P)
     return P, L

@@ -91,7 +91,7 @@ def _findings(tables: dict[str, Table]) -> str:
     )
     out.append(
         "5. **Pinocchio 4.1 cannot cross-check long chains**: its `Data` allocates O(nv³) "
-        "memory and `ReferenceModel` holds two, so chains beyond ~60 six-DOF bodies are "
+        "memory and `ReferenceData` holds two, so chains beyond ~60 six-DOF bodies are "
         "checked textbook-dense against textbook-structured only (long-chain table)."
     )
     units = tables["unit_cases"].rows[1:]

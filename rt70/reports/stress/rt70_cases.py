@@ -222,8 +222,11 @@ def gimbal_spring_cases(quick: bool = False) -> Table:
             ("message", "error message (textbook / Pinocchio)"),
         ],
     )
+    from rt70 import reference
+
     scene = load_scene("rt70")
-    model, data, ref = scene.textbook, scene.textbook_data, scene.reference
+    model, data = scene.textbook, scene.textbook_data
+    ref, rd = scene.reference, scene.reference_data
     for label, q, v, i in _gimbal_states(settings, scene):
         c = abs(math.cos(q[i]))
         row = {
@@ -239,7 +242,7 @@ def gimbal_spring_cases(quick: bool = False) -> Table:
             Qc = Qd = None
             messages.append(str(exc))
         try:
-            Qc_p, Qd_p = ref.spring_damper_force(q, v)
+            Qc_p, Qd_p = reference.spring_damper_force(ref, rd, q, v)
         except SingularConfigurationError as exc:
             Qc_p = Qd_p = None
             messages.append(str(exc))
@@ -247,7 +250,7 @@ def gimbal_spring_cases(quick: bool = False) -> Table:
             row.update(springs="computed", qc=rel_error(Qc, Qc_p), qd=rel_error(Qd, Qd_p))
             try:
                 a_tb = dynamics.forward_dynamics(model, data, q, v, Qc + Qd)
-                row["fd"] = rel_error(a_tb, ref.forward_dynamics(q, v))
+                row["fd"] = rel_error(a_tb, reference.forward_dynamics(ref, rd, q, v))
             except Rt70Error as exc:
                 row["fd"] = short_error(exc)
         elif Qc is None and Qc_p is None:
@@ -321,13 +324,16 @@ def gimbal_mass_matrix_cases(quick: bool = False) -> Table:
             ("qmax", "max |q̈|"),
         ],
     )
+    from rt70 import reference
+
     scene = scene_from_text(remove_spring(rt70_text(), GIMBAL_BUSHING), "rt70_free_cr")
-    model, data, ref = scene.textbook, scene.textbook_data, scene.reference
+    model, data = scene.textbook, scene.textbook_data
+    ref, rd = scene.reference, scene.reference_data
     backends = {name: cls(scene) for name, cls in BACKENDS.items()}
     for label, q, v, i in _gimbal_states(settings, scene):
         row = {"k": label, "cos": abs(math.cos(q[i]))}
         row["cond"] = float(np.linalg.cond(dynamics.mass_matrix(model, data, q)))
-        row["condp"] = float(np.linalg.cond(ref.mass_matrix(q)))
+        row["condp"] = float(np.linalg.cond(reference.mass_matrix(ref, rd, q)))
         results = {}
         Qc, Qd = forces.spring_damper_force(model, data, q, v)
         try:

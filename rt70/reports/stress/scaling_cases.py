@@ -33,7 +33,7 @@ from rt70.validate import random_state
 
 #: Largest nv for which the Pinocchio side is built. Pinocchio 4.1's ``Data`` allocates
 #: O(nv³) memory (four nv × nv × nv second-order-derivative tensors, upstream issue
-#: stack-of-tasks/pinocchio#2949), and :class:`rt70.reference.ReferenceModel` holds two
+#: stack-of-tasks/pinocchio#2949), and :class:`rt70.reference.ReferenceData` holds two
 #: of them: a 100-body elastic chain (nv = 600) peaks at ~15 GB and takes ~1 min to
 #: build, a 300-body one (nv = 1800) raises MemoryError.
 MAX_PINOCCHIO_NV = 360
