@@ -155,7 +155,7 @@ def test_the_unchanged_check_sees_changes():
     ref.pin_model.gravity.linear[2] += 1.0
     ref.spring_k[0] += 1.0
     ref.frames1[0][1].translation[0] += 1.0  # a bushing's own placement
-    ref._cache = ReferenceData(ref)
+    object.__setattr__(ref, "_cache", ReferenceData(ref))  # past the guard below
     assert _differences(before, ref) == [
         "attributes",
         "pin_model",
@@ -163,6 +163,16 @@ def test_the_unchanged_check_sees_changes():
         "frames",
         "bushings",
     ]
+
+
+def test_reference_model_refuses_rebinding():
+    """Like the textbook's frozen Model: an attribute cannot be set after building."""
+    scene = load_scene(ALL_JOINTS)
+    ref = ReferenceModel(scene.description, scene.text)
+    with pytest.raises(AttributeError, match="constant once built"):
+        ref.spring_k = np.zeros(3)
+    with pytest.raises(AttributeError, match="constant once built"):
+        ref.new_cache = 1
 
 
 def test_two_data_of_one_model_give_identical_results(scene):

@@ -105,6 +105,13 @@ class ReferenceModel:
         )
         self.spring_k = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
         self.spring_d = np.array([s.damping for s in desc.joint_springs], dtype=float)
+        self._built = True
+
+    def __setattr__(self, name: str, value: object) -> None:
+        """Refuse to rebind an attribute once built: the Model is constant (as the textbook's)."""
+        if getattr(self, "_built", False):
+            raise AttributeError(f"ReferenceModel is constant once built: cannot set '{name}'")
+        object.__setattr__(self, name, value)
 
     @classmethod
     def from_file(cls, desc: RobotDescription, path: str | Path) -> ReferenceModel:
