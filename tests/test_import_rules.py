@@ -30,8 +30,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "rt70"
 
-#: Modules below both sides that any layer may import.
-SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations")
+#: Modules below both sides that any layer may import (``rt70.loads``: the plain
+#: Wrench value both sides turn into a generalised force).
+SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations", "rt70.loads")
 
 #: layer (module prefix) → module prefixes it may import from rt70.
 RULES = {
@@ -42,6 +43,7 @@ RULES = {
     "rt70.rotations": (),
     "rt70.errors": (),
     "rt70.arrays": ("rt70.errors",),
+    "rt70.loads": ("rt70.arrays", "rt70.errors"),
 }
 
 
