@@ -112,6 +112,13 @@ class Scene:
         return ReferenceModel(self.description, self.text)
 
     @cached_property
+    def reference_data(self):  # -> rt70.reference.ReferenceData
+        """Work buffers of :attr:`reference` (:class:`rt70.reference.ReferenceData`)."""
+        from rt70.reference import ReferenceData
+
+        return ReferenceData(self.reference)
+
+    @cached_property
     def coordinate_names(self) -> list[str]:
         """Names of the generalised coordinates, in the order of every result."""
         return coordinate_names(self.description)
