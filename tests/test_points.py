@@ -13,6 +13,8 @@ along a simulation.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -29,7 +31,7 @@ from rt70.textbook import points as tb_points
 from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure
 from rt70.urdf import read_urdf_string
 
-ALL_TYPES = "tests/data/all_joint_types.urdf"
+ALL_TYPES = Path(__file__).parent / "data" / "all_joint_types.urdf"
 TOL = 1e-12
 
 
