@@ -60,6 +60,10 @@ class SceneError(Rt70Error):
     """A scene name is unknown."""
 
 
+class UnknownLinkError(Rt70Error):
+    """A point, load or output names a link the model has no frame for."""
+
+
 class Rt70Warning(UserWarning):
     """Something odd in the input that rt70 reads anyway, as Pinocchio does.
 

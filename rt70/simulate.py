@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +27,7 @@ from rt70.errors import (
     SimulationError,
     SingularConfigurationError,
 )
+from rt70.outputs import Output, column_labels, evaluate, evaluate_trajectory
 from rt70.scene import Scene
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import check_euler_pairs
@@ -208,6 +209,7 @@ class SimulationResult:
     message: str
     coordinates: list[str] = field(default_factory=list)
     drift_flagged: bool = False
+    outputs: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def relative_drift(self) -> float:
@@ -243,6 +245,7 @@ class SimulationResult:
             }
             arrays.update(input_work=self.input_work, balance=self.balance)
             arrays["coordinates"] = np.array(self.coordinates)
+            arrays.update({f"output:{k}": v for k, v in self.outputs.items()})
             return lambda tmp: np.savez_compressed(tmp, **arrays)
         names = ["t"] + [f"q:{c}" for c in self.coordinates] + [f"qd:{c}" for c in self.coordinates]
         names += ["kinetic", "gravity", "elastic", "dissipated", "input_work", "balance"]
@@ -250,6 +253,9 @@ class SimulationResult:
             [self.t, self.q, self.qd, self.kinetic, self.gravity, self.elastic]
             + [self.dissipated, self.input_work, self.balance]
         )
+        for name, values in self.outputs.items():  # rt70.outputs, one column per component
+            names += column_labels(name, values.shape[1])
+            table = np.column_stack([table, values])
         lines = [",".join(names)] + [",".join(f"{x:.17g}" for x in row) for row in table]
         text = "\n".join(lines) + "\n"
         return lambda tmp: tmp.write_text(text, encoding="utf-8", newline="\n")
@@ -274,6 +280,7 @@ def simulate(
     inputs: Inputs | None = None,
     t_eval: np.ndarray | None = None,
     progress: bool = False,
+    outputs: Sequence[Output] = (),
 ) -> SimulationResult:
     """Integrate the scene's equations of motion over ``t_span``.
 
@@ -301,6 +308,10 @@ def simulate(
         Output times (default: the solver's steps).
     progress : bool
         Show a progress bar on stderr.
+    outputs : sequence of rt70.outputs.Output
+        Quantities evaluated on the trajectory by the backend's side (e.g.
+        :func:`rt70.outputs.optical_point_outputs`), in ``result.outputs`` by name,
+        arrays (n_t, size); checked at the initial state before the run.
     """
     from scipy.integrate import solve_ivp
 
@@ -328,6 +339,8 @@ def simulate(
     q0, qd0 = (np.zeros(n), np.zeros(n)) if x0 is None else x0
     q0 = check_vector("initial state q0", q0, n)
     qd0 = check_vector("initial state qd0", qd0, n)
+    output_side = "reference" if backend == "pinocchio" else "textbook"
+    evaluate(scene, q0, outputs, output_side)  # refuses an unknown link before the run
     try:
         check_euler_pairs(scene.textbook, scene.textbook.expand(q0))
         _check_mass_matrix(scene, side, q0)
@@ -438,6 +451,7 @@ def simulate(
         coordinates=list(scene.textbook.coordinate_names),
     )
     result.drift_flagged = inputs is None and result.relative_drift > DRIFT_FACTOR * rtol
+    result.outputs = evaluate_trajectory(scene, q, outputs, output_side)
     return result
 
 

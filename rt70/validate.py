@@ -1,7 +1,9 @@
 """Cross-check of the textbook algorithm against Pinocchio: error against run time.
 
 For each scene and each of N random states (q, q̇) both sides compute the same
-quantities; every row of the report gives the largest absolute error, the largest
+quantities — the dynamics, the positions of the links' origins and of the scene's
+optical points (:mod:`rt70.outputs`) and the generalised force of a random load (:mod:`rt70.loads`);
+every row of the report gives the largest absolute error, the largest
 error relative to the reference's max-norm, and the mean wall time per evaluation of
 each side.
 """
@@ -16,8 +18,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.loads import Wrench
+from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
 from rt70.scene import Scene, require_coordinates
-from rt70.textbook import dynamics, forces
+from rt70.textbook import dynamics, forces, points
 
 #: Default agreement tolerance, relative to the reference's max-norm.
 DEFAULT_TOLERANCE = 1e-10
@@ -32,6 +36,8 @@ QUANTITIES = (
     "forward_dynamics",
     "kinetic_energy",
     "potential_energy",
+    "points",
+    "load_force",
 )
 
 
@@ -75,6 +81,44 @@ def random_state(nv: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndar
     return rng.uniform(-0.5, 0.5, nv), rng.uniform(-1.0, 1.0, nv)
 
 
+def random_wrench(scene: Scene, rng: np.random.Generator) -> Wrench:
+    """A random load for the cross-check (:class:`rt70.loads.Wrench`).
+
+    On a moving link drawn uniformly, at a point within ±1 m of its origin, with force
+    and torque uniform in ±1 N and ±1 N·m per ground axis.
+    """
+    links = [name for name, (body, _, _) in scene.textbook.link_frames.items() if body >= 0]
+    link = links[int(rng.integers(len(links)))]
+    xyz, force, torque = rng.uniform(-1.0, 1.0, (3, 3))
+    return Wrench(link, xyz, force, torque)
+
+
+def state_wrench(scene: Scene, q: np.ndarray) -> Wrench:
+    """The random load compared at the state q (row ``load_force``).
+
+    :func:`random_wrench` drawn from a generator seeded with the bits of q: reproducible,
+    new at every sampled state, and apart from the stream the states are drawn from.
+    """
+    bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
+    return random_wrench(scene, np.random.default_rng(bits))
+
+
+def compared_points(scene: Scene) -> list[Output]:
+    """The positions compared in row ``points``.
+
+    The scene's optical points (its outputs, :func:`rt70.outputs.optical_point_outputs`)
+    and the origin of every link with a frame on both sides (``link:<name>``), so that
+    every scene has points to compare.
+    """
+    links = scene.textbook.link_frames
+    origins = [position_output(f"link:{link}", link, np.zeros(3)) for link in links]
+    return optical_point_outputs(scene) + origins
+
+
+def _stacked(values: dict[str, np.ndarray]) -> np.ndarray:
+    return np.concatenate(list(values.values())) if values else np.zeros(0)
+
+
 def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
     """Value of ``fn()`` and its mean wall time over ``repeat`` calls after one warm-up.
 
@@ -90,11 +134,17 @@ def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
 
 
 def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
-    """Per quantity: (textbook evaluation, reference evaluation), in the user's coordinate order."""
+    """Per quantity: (textbook evaluation, reference evaluation), in the user's coordinate order.
+
+    The load of ``load_force`` is :func:`state_wrench`.
+    """
     from rt70 import reference
+    from rt70.reference import points as ref_points
 
     tm, td = scene.textbook, scene.textbook_data
     ref, rd = scene.reference, scene.reference_data
+    wrench = state_wrench(scene, q)
+    located = compared_points(scene)
 
     def tb_forward():
         Qc, Qd = forces.spring_damper_force(tm, td, q, qd)
@@ -131,6 +181,14 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: (
                 reference.gravity_potential(ref, rd, q) + reference.spring_potential(ref, rd, q)
             ),
+        ),
+        "points": (
+            lambda: _stacked(evaluate(scene, q, located, "textbook")),
+            lambda: _stacked(evaluate(scene, q, located, "reference")),
+        ),
+        "load_force": (
+            lambda: points.generalized_force(tm, td, q, wrench),
+            lambda: ref_points.generalized_force(ref, rd, q, wrench),
         ),
     }
 
@@ -171,7 +229,11 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
       forces and of A moves q̈ = A⁻¹ Q (Higham §7.1), coordinate by coordinate, so a
       badly scaled A (a mimic factor of 10³⁰, mixed units) excuses no other coordinate;
     - kinetic energy: ``‖A‖ ‖q̇‖²``; potential energy: ``G₀ + U_c`` (the terms
-      ``m_b g·c_b`` and the spring energy).
+      ``m_b g·c_b`` and the spring energy);
+    - points (:func:`compared_points`): the largest distance of a compared point from
+      the ground origin (a position is a sum of the bodies' offsets);
+    - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
+      ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel.
 
     Raises
     ------
@@ -214,7 +276,19 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "forward_dynamics": np.abs(np.linalg.inv(A)) @ (f + np.abs(A) @ qdd),
         "kinetic_energy": norm("mass_matrix") * speed2,
         "potential_energy": g0 + reference.spring_potential(ref, rd, q),
+        "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
+        "load_force": _load_scale(scene, q),
     }
+
+
+def _load_scale(scene: Scene, q: np.ndarray) -> float:
+    """``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖`` of the state's load, Pinocchio's Jacobian."""
+    from rt70.reference import points as ref_points
+
+    w = state_wrench(scene, q)
+    Jv, Jw = ref_points.point_jacobian(scene.reference, scene.reference_data, q, w.link, w.xyz)
+    terms = np.abs(Jv).T @ np.abs(w.force) + np.abs(Jw).T @ np.abs(w.torque)
+    return float(np.max(terms, initial=0.0))
 
 
 def _relative_error(x_tb: np.ndarray, x_ref: np.ndarray, floor) -> float:

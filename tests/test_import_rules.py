@@ -31,8 +31,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "rt70"
 
-#: Modules below both sides that any layer may import.
-SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations", "rt70.constraints")
+#: Modules below both sides that any layer may import (``rt70.loads``: the plain
+#: Wrench value both sides turn into a generalised force).
+SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations", "rt70.loads", "rt70.constraints")
 
 #: layer (module prefix) → module prefixes it may import from rt70.
 RULES = {
@@ -40,12 +41,13 @@ RULES = {
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
     # not rt70.constraints: the reference side maps mimic joints on its own, so the
     # cross-check also checks the textbook's constraint matrix G
-    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED[:3]),
+    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED[:4]),
     "rt70.resources": ("rt70.urdf.description", *SHARED),
     "rt70.rotations": (),
     "rt70.errors": (),
     "rt70.arrays": ("rt70.errors",),
     "rt70.constraints": ("rt70.errors",),
+    "rt70.loads": ("rt70.arrays", "rt70.errors"),
 }
 
 

@@ -26,8 +26,9 @@ import scipy.linalg
 
 from rt70.constraints import HolonomicMap, locking
 from rt70.errors import Rt70Error
+from rt70.loads import Wrench
 from rt70.scene import Scene
-from rt70.textbook import dynamics, forces
+from rt70.textbook import dynamics, forces, points
 
 #: Finite-difference step of the stiffness matrix, per coordinate (m or rad).
 FD_STEP = 1e-6
@@ -213,35 +214,20 @@ def sag(scene: Scene, q_eq: np.ndarray, held: dict[str, float]) -> list[Sag]:
     return out
 
 
-def _point_jacobian(
-    scene: Scene, q0: np.ndarray, link: str, xyz: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Point velocity and angular velocity of ``link`` in ground axes (3 × nv each)."""
-    from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure
-
-    model, data = scene.textbook, scene.textbook_data
-    if link not in model.link_frames:
-        raise Rt70Error(f"{scene.name}: no link '{link}'")
-    body, r_link, c_link = model.link_frames[link]
-    update_structure(model, data, q0)
-    r = r_link + c_link @ np.asarray(xyz, dtype=float)
-    J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
-    R, _ = frame_pose(data, body, np.zeros(3), np.eye(3))
-    return R @ J[:3], R @ J[3:]
-
-
 def force_input(
     lm: Linearization, scene: Scene, link: str, direction, torque: bool = False, xyz=(0, 0, 0)
 ) -> np.ndarray:
     """Input column of a unit force (or torque) on ``link`` along a ground-axis ``direction``.
 
-    The generalised force of a body wrench is ``Q_u = S U`` (4.129)–(4.131), i.e. the
-    transposed Jacobian of the point of application (``xyz`` in the link frame) times
-    the force; for a torque, the angular Jacobian. Rows follow ``lm.coordinates``.
+    The generalised force of the wrench (:class:`rt70.loads.Wrench`, applied at ``xyz``
+    in the link frame) is ``Q_u = S U`` (4.129)–(4.131),
+    :func:`rt70.textbook.points.generalized_force`. Rows follow ``lm.coordinates``.
     """
-    Jv, Jw = _point_jacobian(scene, lm.q0, link, np.asarray(xyz, dtype=float))
     a = np.asarray(direction, dtype=float)
-    column = (Jw if torque else Jv).T @ (a / np.linalg.norm(a))
+    unit = a / np.linalg.norm(a)
+    zero = np.zeros(3)
+    wrench = Wrench(link, xyz, force=zero if torque else unit, torque=unit if torque else zero)
+    column = points.generalized_force(scene.textbook, scene.textbook_data, lm.q0, wrench)
     keep = coordinate_indices(scene, lm.coordinates)
     return column[keep]
 
@@ -252,11 +238,11 @@ def point_output(lm: Linearization, scene: Scene, link: str, xyz) -> np.ndarray:
     ``δr = J_p δq`` about q0 — e.g. the foci and vertices of the mirrors (§4.1.8,
     ``<rt70:optical_point>``).
     """
-    Jv, _ = _point_jacobian(scene, lm.q0, link, np.asarray(xyz, dtype=float))
+    Jv, _ = points.point_jacobian(scene.textbook, scene.textbook_data, lm.q0, link, xyz)
     return Jv[:, coordinate_indices(scene, lm.coordinates)]
 
 
 def rotation_output(lm: Linearization, scene: Scene, link: str) -> np.ndarray:
     """Output rows (3 × n) of the small rotation of ``link`` about the ground axes."""
-    _, Jw = _point_jacobian(scene, lm.q0, link, np.zeros(3))
+    _, Jw = points.point_jacobian(scene.textbook, scene.textbook_data, lm.q0, link, np.zeros(3))
     return Jw[:, coordinate_indices(scene, lm.coordinates)]

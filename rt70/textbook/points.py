@@ -1,0 +1,98 @@
+"""Points of bodies on the textbook side: position, Jacobian, generalised force of a load.
+
+All from the book's matrices (formalism §4.2, §4.4). A point ``xyz`` of a URDF link
+sits at ``r = r_link + c_link · xyz`` in the frame of the link's body
+(``Model.link_frames``: a link welded by fixed joints lies on its parent's body). Its
+position comes from the absolute body poses of the forward pass; its velocity from the
+stacked body Jacobian ``V⁰ = Sᵀ q̇`` (4.63) moved to the point, ``V_p = (T(r))ᵀ V_body``;
+a wrench on it acts as ``Q = S U`` (4.129)–(4.131). All results are in ground axes. The
+reference side computes the same from Pinocchio (:mod:`rt70.reference.points`);
+``rt70 validate`` compares them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from rt70.arrays import check_vector
+from rt70.errors import UnknownLinkError
+from rt70.loads import Wrench
+from rt70.textbook.data import Data
+from rt70.textbook.kinematics import (
+    forward_kinematics,
+    frame_jacobian,
+    frame_pose,
+    update_structure,
+)
+from rt70.textbook.model import Model
+
+
+def link_point(model: Model, link: str, xyz) -> tuple[int, np.ndarray]:
+    """Body of ``link`` and the point ``xyz`` (link frame) in that body's frame.
+
+    Raises
+    ------
+    UnknownLinkError
+        If the model has no frame for ``link``: an unknown name, or a massless link
+        inside a 6-DOF pair (merged into the pair's body by the textbook model; take
+        the point on the pair's end link instead).
+    """
+    if link not in model.link_frames:
+        known = ", ".join(list(model.link_frames)[:8])
+        raise UnknownLinkError(
+            f"{model.name}: no link '{link}' with a frame in the textbook model (links: "
+            f"{known}{', …' if len(model.link_frames) > 8 else ''}; the massless links "
+            "inside a 6-DOF pair are merged into its end link)"
+        )
+    body, r_link, c_link = model.link_frames[link]
+    return body, r_link + c_link @ check_vector(f"point of link '{link}'", xyz, 3)
+
+
+def point_positions(
+    model: Model, data: Data, q: np.ndarray, points: Sequence[tuple[str, np.ndarray]]
+) -> np.ndarray:
+    """Ground-axis positions (n, 3) of the points ``(link, xyz)`` at q, in m.
+
+    One forward pass (4.5)–(4.7) for all of them: ``p = p_body + c_0,body r``.
+    """
+    located = [link_point(model, link, xyz) for link, xyz in points]
+    q = check_vector("q", q, model.nv)
+    data.q_full = model.expand(q)
+    forward_kinematics(model, data, data.q_full)
+    out = np.empty((len(located), 3))
+    for k, (body, r) in enumerate(located):
+        out[k] = frame_pose(data, body, r, np.eye(3))[1]
+    return out
+
+
+def point_position(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> np.ndarray:
+    """Ground-axis position (3,) of the point ``xyz`` of ``link`` at q, in m."""
+    return point_positions(model, data, q, [(link, xyz)])[0]
+
+
+def point_jacobian(
+    model: Model, data: Data, q: np.ndarray, link: str, xyz
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
+
+    ``[v_p; ω]`` in the body's axes is the frame Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63);
+    both rows are turned to ground axes by the body's rotation ``c_0,body``.
+    """
+    body, r = link_point(model, link, xyz)
+    update_structure(model, data, q)
+    J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
+    R, _ = frame_pose(data, body, np.zeros(3), np.eye(3))
+    return R @ J[:3], R @ J[3:]
+
+
+def generalized_force(model: Model, data: Data, q: np.ndarray, wrench: Wrench) -> np.ndarray:
+    """Generalised force (nv,) of a wrench: ``Q = S U = J_vᵀ F + J_ωᵀ M`` (4.129)–(4.131).
+
+    ``U`` is the wrench moved to the body frame; ``S U`` is the transposed point
+    Jacobian times the force and the torque, both in ground axes. Its power is
+    ``q̇ᵀ Q = F·v_p + M·ω``.
+    """
+    Jv, Jw = point_jacobian(model, data, q, wrench.link, wrench.xyz)
+    return Jv.T @ np.asarray(wrench.force) + Jw.T @ np.asarray(wrench.torque)
