@@ -3,7 +3,7 @@
 - ``cond(A)``: the 2-norm condition number of the mass matrix ``A = S Θ Sᵀ`` at the
   case's initial state (``numpy.linalg.cond`` of the dense textbook A; for nv > 2000 the
   LAPACK ``dpocon`` 1-norm estimate from a Cholesky factor, marked ``≈``);
-- the cross-check error: the largest relative error over the eight quantities of
+- the cross-check error: the largest relative error over the ten quantities of
   :func:`rt70.validate.cross_check` (textbook against Pinocchio) on a few random states;
 - the eigenfrequencies of the springs-only stiffness, and the linear and angular momentum
   of the structure on both sides.

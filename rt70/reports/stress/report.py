@@ -137,7 +137,7 @@ def write_report(
         "Conventions (details in the `rt70.reports.stress` docstrings): cond(A) is the 2-norm "
         "condition number of the textbook mass matrix at the case's initial state; the "
         "cross-check error is the largest relative error of `rt70.validate.cross_check` "
-        "(textbook against Pinocchio, eight quantities) over random states (q ±0.5, "
+        "(textbook against Pinocchio, ten quantities) over random states (q ±0.5, "
         "q̇ ±1); 'energy drift' is the largest |T + U_g + U_c + E_ψ − const| over the "
         "run relative to the energy exchanged; 'rejected' counts rejected step attempts "
         "(solve_ivp does not report them: counted from the right-hand-side evaluation "
