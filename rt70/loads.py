@@ -8,8 +8,8 @@ kinematics (formalism §4.4, (4.129)–(4.131)):
   book's structure matrix, i.e. ``Q = J_vᵀ F + J_ωᵀ M`` with the point's Jacobian
   ``[J_v; J_ω] = (T(r)[c])ᵀ Sᵀ`` of :func:`rt70.textbook.points.point_jacobian`;
 - reference side, :func:`rt70.reference.points.generalized_force`: ``Q = Jᵀ f`` with
-  Pinocchio's frame Jacobian of the point in ``LOCAL_WORLD_ALIGNED`` axes, mapped to the
-  book's coordinates.
+  Pinocchio's Jacobian of the link's parent joint (``pin.computeJointJacobian``) moved
+  to the point and turned to ground axes, mapped to the book's coordinates.
 
 ``Q`` is what the load adds to the right-hand side of ``A q̈ + B q̇ = Q_g + Q_c + Q_d +
 Q_u`` (drives, wind, a probe force); its power is ``q̇ᵀ Q = F·v_p + M·ω``. A new load
