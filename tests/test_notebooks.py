@@ -1,4 +1,6 @@
-"""Every notebook in notebooks/ executes without error (so they never rot)."""
+"""Every notebook in notebooks/ executes without error (so they never rot), and keeps its
+outputs (so it reads as a tutorial): a cell that prints or draws has its output committed
+(``python notebooks/execute.py`` writes them)."""
 
 from pathlib import Path
 
@@ -15,8 +17,9 @@ def test_there_are_notebooks():
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
 def test_notebook_executes(path, monkeypatch):
-    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.delenv("MPLBACKEND", raising=False)  # the kernel draws inline, headless
     nb = nbformat.read(path, as_version=4)
+    committed = [bool(c.get("outputs")) for c in nb.cells if c.cell_type == "code"]
     NotebookClient(
         nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(path.parent)}}
     ).execute()
@@ -28,3 +31,6 @@ def test_notebook_executes(path, monkeypatch):
         if o.output_type == "error"
     ]
     assert not errors
+    produced = [bool(c.get("outputs")) for c in nb.cells if c.cell_type == "code"]
+    missing = [i for i, (a, b) in enumerate(zip(committed, produced, strict=True)) if b and not a]
+    assert not missing, f"code cells {missing} print or draw but have no committed output"
