@@ -66,8 +66,11 @@ class CoordinateElements:
         np.add.at(S, self.index, np.abs(f))
 
     def add_jt_w_j(self, K: np.ndarray, w: np.ndarray) -> None:
-        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: the diagonal weights)."""
-        K[self.index, self.index] += w
+        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: the diagonal weights).
+
+        Unbuffered (``np.add.at``): two springs on one joint add up.
+        """
+        np.add.at(K, (self.index, self.index), w)
 
     def squares(self, w: np.ndarray) -> float:
         """``Σ_e δ_eᵀ W_e δ_e``."""
