@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
@@ -42,16 +43,26 @@ class CoordinateElements:
 
     Attributes
     ----------
+    model : ReferenceModel
+        The model the elements belong to.
+    qp : numpy.ndarray
+        Pinocchio's configuration they are evaluated at.
     index : numpy.ndarray
         Pinocchio velocity index of each element, shape (n_e,).
-    delta, stiffness, damping : numpy.ndarray
-        δ, C and D of each element, shape (n_e,).
+    stiffness, damping : numpy.ndarray
+        C and D of each element, shape (n_e,).
     """
 
+    model: ReferenceModel
+    qp: np.ndarray
     index: np.ndarray
-    delta: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
+
+    @cached_property
+    def delta(self) -> np.ndarray:
+        """δ of each element, shape (n_e,); read on first use (the gains need none)."""
+        return _joint_angles(self.model, self.qp)[self.index]
 
     def rate(self, vp: np.ndarray) -> np.ndarray:
         """``δ̇ = (∂δ/∂v) v`` of each element, shape (n_e,)."""
@@ -126,10 +137,7 @@ def joint_spring_elements(
     """Joint springs: δ is the joint's coordinate, read from Pinocchio's ``q``."""
     if not model.spring_v.size:
         return None
-    angles = _joint_angles(model, qp)
-    return CoordinateElements(
-        model.spring_v, angles[model.spring_v], model.spring_k, model.spring_d
-    )
+    return CoordinateElements(model, qp, model.spring_v, model.spring_k, model.spring_d)
 
 
 def bushing_elements(
