@@ -371,7 +371,7 @@ def simulate(
             Q_u = np.asarray(inputs(t, q, qd), dtype=float)
             if Q_u.shape != (n,):
                 raise ShapeError(f"inputs(t, q, qd): expected shape ({n},), got shape {Q_u.shape}")
-        Q_s = layout.force(t, x)
+        Q_s = layout.force(t, q, qd, x) if layout.pushing else None
         if Q_s is not None:
             pushed[0] = True
             Q_u = Q_s if Q_u is None else Q_u + Q_s
@@ -384,7 +384,7 @@ def simulate(
         qdd, Qd = side.accelerations(q, qd, Q_u)
         if progress and t - t0 > bar.n:
             bar.update(t - t0 - bar.n)
-        extra = layout.derivatives(t, x, MechanicsForces(Qd, Q_u))
+        extra = layout.derivatives(t, q, qd, x, MechanicsForces(Qd, Q_u))
         out = np.concatenate([qd, qdd, *extra])
         if not np.isfinite(out).all():
             raise SimulationError("the accelerations are not finite")

@@ -26,15 +26,14 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from rt70.errors import Rt70Error, ShapeError
 
 
-@dataclass(frozen=True)
-class MechanicsForces:
+class MechanicsForces(NamedTuple):
     """Generalised forces the mechanics computed at one evaluation (book coordinates).
 
     Attributes
@@ -144,6 +143,12 @@ class StateLayout:
             self.slices.append(slice(start, start + k))
             start += k
         self.size = start - 2 * nv
+        #: The components that push a force on the mechanics (override ``force``).
+        self.pushing = [
+            (c, where)
+            for c, where in zip(self.components, self.slices, strict=True)
+            if type(c).force is not StateComponent.force
+        ]
 
     def initial(self) -> list[np.ndarray]:
         """Initial values of the extra states, one array per component."""
@@ -153,11 +158,10 @@ class StateLayout:
         """Absolute tolerances of the extra states, one array per component."""
         return [np.asarray(c.atol, dtype=float) for c in self.components]
 
-    def force(self, t: float, x: np.ndarray) -> np.ndarray | None:
+    def force(self, t: float, q: np.ndarray, qd: np.ndarray, x: np.ndarray) -> np.ndarray | None:
         """Sum of the components' generalised forces at state ``x``, or None if none."""
         n, total = self.nv, None
-        q, qd = x[:n], x[n : 2 * n]
-        for c, where in zip(self.components, self.slices, strict=True):
+        for c, where in self.pushing:
             Q = c.force(t, q, qd, x[where])
             if Q is None:
                 continue
@@ -170,17 +174,20 @@ class StateLayout:
             total = Q if total is None else total + Q
         return total
 
-    def derivatives(self, t: float, x: np.ndarray, forces: MechanicsForces) -> list[np.ndarray]:
-        """Time derivatives of the extra states, one array per component."""
-        n, out = self.nv, []
-        q, qd = x[:n], x[n : 2 * n]
+    def derivatives(
+        self, t: float, q: np.ndarray, qd: np.ndarray, x: np.ndarray, forces: MechanicsForces
+    ) -> list[np.ndarray]:
+        """Time derivatives of the extra states at state ``x``, one array per component."""
+        out = []
         for c, where in zip(self.components, self.slices, strict=True):
-            ds = np.asarray(c.derivative(t, q, qd, x[where], forces), dtype=float)
-            if ds.shape != (len(c.names),):
-                raise ShapeError(
-                    f"state component {type(c).__name__}: derivative must have shape "
-                    f"({len(c.names)},), got {ds.shape}"
-                )
+            ds = c.derivative(t, q, qd, x[where], forces)
+            if type(ds) is not np.ndarray or ds.shape != (where.stop - where.start,):
+                ds = np.asarray(ds, dtype=float)
+                if ds.shape != (len(c.names),):
+                    raise ShapeError(
+                        f"state component {type(c).__name__}: derivative must have shape "
+                        f"({len(c.names)},), got {ds.shape}"
+                    )
             out.append(ds)
         return out
 

@@ -164,7 +164,7 @@ def elements(
     model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
 ) -> list[Elements]:
     """The deformations of every element at Pinocchio's ``qp``, kind by kind."""
-    found = (kind(model, data, qp, jacobian) for kind in ELEMENTS.values())
+    found = [kind(model, data, qp, jacobian) for kind in ELEMENTS.values()]
     return [e for e in found if e is not None]
 
 
