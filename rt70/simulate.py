@@ -356,11 +356,6 @@ def simulate(
     atol_q = 1e-3 * rtol if atol is None else atol
     layout = StateLayout([EnergyAudit(rtol * energy_scale), *components], n)
     atol_vec = np.concatenate([np.full(2 * n, atol_q), *layout.atol()])
-    bar = tqdm(  # on stderr; simulated time since t0
-        total=t1 - t0,
-        disable=not progress,
-        bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]",
-    )
     reached = [t0]  # the last time the right-hand side was evaluated at
     pushed = [False]  # whether a component ever pushed a force on the mechanics
 
@@ -403,6 +398,11 @@ def simulate(
                 raise SimulationError("the Jacobian of the right-hand side is not finite")
             return J
 
+    bar = tqdm(  # on stderr; simulated time since t0
+        total=t1 - t0,
+        disable=not progress,
+        bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]",
+    )
     start = time.perf_counter()
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked above

@@ -15,7 +15,8 @@ and velocities of the mechanics, then the states ``s_i`` of every
   is added to the input force ``Q_u``: the energy audit counts it as input work.
 
 The rows and columns of the extra states in the analytic Jacobian of the implicit
-methods are zero (the solver's Newton iteration treats them explicitly).
+methods are zero, and it holds no derivative of a component's force: the solver's
+Newton iteration treats them explicitly (it converges, more slowly if they are stiff).
 
 The first component is the energy audit (:class:`EnergyAudit`, (1.73)), which every
 simulation carries; drives with motor states come next. The simulation's result holds
