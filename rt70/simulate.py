@@ -2,16 +2,17 @@
 
 Both backends integrate the same equations ``A q̈ + B q̇ = Q_g + Q_c + Q_d + Q_u``: the
 Pinocchio backend by ABA with the spring and damper forces as ``tau``, the textbook
-backend by the structured ``S Θ Sᵀ`` algorithm and a Cholesky solve. The state carries
-two extra components integrated with it (not by quadrature of samples):
-the dissipated energy ``E_ψ = ∫ q̇ᵀ D q̇ dt = −∫ q̇ᵀ Q_d dt`` and the work of the inputs
-``W_u = ∫ q̇ᵀ Q_u dt``. Along any trajectory ``T + U_g + U_c + E_ψ − W_u`` is constant;
-its drift is reported with every result.
+backend by the structured ``S Θ Sᵀ`` algorithm and a Cholesky solve. The state is
+``[q, q̇]`` followed by the states of every :class:`rt70.states.StateComponent`,
+integrated with it (not by quadrature of samples). The first component is always the
+energy audit (:class:`rt70.states.EnergyAudit`): the dissipated energy
+``E_ψ = ∫ q̇ᵀ D q̇ dt = −∫ q̇ᵀ Q_d dt`` and the work of the inputs ``W_u = ∫ q̇ᵀ Q_u dt``.
+Along any trajectory ``T + U_g + U_c + E_ψ − W_u`` is constant; its drift is reported
+with every result.
 """
 
 from __future__ import annotations
 
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -29,6 +30,7 @@ from rt70.errors import (
 )
 from rt70.outputs import Output, column_labels, evaluate, evaluate_trajectory
 from rt70.scene import Scene
+from rt70.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import check_euler_pairs
 
@@ -182,7 +184,9 @@ class SimulationResult:
     ``input_work`` W_u; ``balance = T + U_g + U_c + E_ψ − W_u − (its value at t0)`` and
     ``balance_scale`` the energy exchanged in the run (what ``relative_drift`` is
     relative to). ``drift_flagged`` is set when a passive run drifts by more than
-    ``DRIFT_FACTOR · rtol`` of it.
+    ``DRIFT_FACTOR · rtol`` of it. ``states`` holds the trajectory of every extra state
+    by name (:mod:`rt70.states`; the energy audit's ``dissipated`` and ``input_work``
+    first).
     """
 
     scene: str
@@ -210,6 +214,7 @@ class SimulationResult:
     coordinates: list[str] = field(default_factory=list)
     drift_flagged: bool = False
     outputs: dict[str, np.ndarray] = field(default_factory=dict)
+    states: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def relative_drift(self) -> float:
@@ -244,14 +249,17 @@ class SimulationResult:
                 for k in ("t", "q", "qd", "kinetic", "gravity", "elastic", "dissipated")
             }
             arrays.update(input_work=self.input_work, balance=self.balance)
+            arrays.update({f"state:{k}": v for k, v in self._component_states().items()})
             arrays["coordinates"] = np.array(self.coordinates)
             arrays.update({f"output:{k}": v for k, v in self.outputs.items()})
             return lambda tmp: np.savez_compressed(tmp, **arrays)
+        extra = self._component_states()
         names = ["t"] + [f"q:{c}" for c in self.coordinates] + [f"qd:{c}" for c in self.coordinates]
         names += ["kinetic", "gravity", "elastic", "dissipated", "input_work", "balance"]
+        names += [f"state:{k}" for k in extra]
         table = np.column_stack(
             [self.t, self.q, self.qd, self.kinetic, self.gravity, self.elastic]
-            + [self.dissipated, self.input_work, self.balance]
+            + [self.dissipated, self.input_work, self.balance, *extra.values()]
         )
         for name, values in self.outputs.items():  # rt70.outputs, one column per component
             names += column_labels(name, values.shape[1])
@@ -259,6 +267,10 @@ class SimulationResult:
         lines = [",".join(names)] + [",".join(f"{x:.17g}" for x in row) for row in table]
         text = "\n".join(lines) + "\n"
         return lambda tmp: tmp.write_text(text, encoding="utf-8", newline="\n")
+
+    def _component_states(self) -> dict[str, np.ndarray]:
+        """The extra states other than the energy audit's (written as ``state:<name>``)."""
+        return {k: v for k, v in self.states.items() if k not in EnergyAudit.names}
 
 
 def check_output_suffix(path: str | Path) -> str:
@@ -281,6 +293,7 @@ def simulate(
     t_eval: np.ndarray | None = None,
     progress: bool = False,
     outputs: Sequence[Output] = (),
+    components: Sequence[StateComponent] = (),
 ) -> SimulationResult:
     """Integrate the scene's equations of motion over ``t_span``.
 
@@ -307,13 +320,17 @@ def simulate(
     t_eval : array, optional
         Output times (default: the solver's steps).
     progress : bool
-        Show a progress bar on stderr.
+        Show a progress bar (tqdm) on stderr.
+    components : sequence of StateComponent
+        Extra states integrated with the mechanics, after the energy audit's
+        (:mod:`rt70.states`); their trajectories are in ``result.states`` by name.
     outputs : sequence of rt70.outputs.Output
         Quantities evaluated on the trajectory by the backend's side (e.g.
         :func:`rt70.outputs.optical_point_outputs`), in ``result.outputs`` by name,
         arrays (n_t, size); checked at the initial state before the run.
     """
     from scipy.integrate import solve_ivp
+    from tqdm import tqdm
 
     if backend not in BACKENDS:
         raise Rt70Error(f"unknown backend '{backend}' (choose from {', '.join(BACKENDS)})")
@@ -355,27 +372,33 @@ def simulate(
         )
     energy_scale = max(T0 + Uc0, 1e-12 * max(abs(Ug0), 1.0), 1e-300)
     atol_q = 1e-3 * rtol if atol is None else atol
-    atol_vec = np.r_[np.full(2 * n, atol_q), np.full(2, rtol * energy_scale)]
-    bar = _Progress(t0, t1) if progress else None
+    layout = StateLayout([EnergyAudit(rtol * energy_scale), *components], n)
+    atol_vec = np.concatenate([np.full(2 * n, atol_q), *layout.atol()])
     reached = [t0]  # the last time the right-hand side was evaluated at
+    pushed = [False]  # whether a component ever pushed a force on the mechanics
 
-    def input_force(t, q, qd):
-        if inputs is None:
-            return None
-        Q_u = np.asarray(inputs(t, q, qd), dtype=float)
-        if Q_u.shape != (n,):
-            raise ShapeError(f"inputs(t, q, qd): expected shape ({n},), got shape {Q_u.shape}")
+    def input_force(t, x):
+        q, qd = x[:n], x[n : 2 * n]
+        Q_u = None
+        if inputs is not None:
+            Q_u = np.asarray(inputs(t, q, qd), dtype=float)
+            if Q_u.shape != (n,):
+                raise ShapeError(f"inputs(t, q, qd): expected shape ({n},), got shape {Q_u.shape}")
+        Q_s = layout.force(t, q, qd, x) if layout.pushing else None
+        if Q_s is not None:
+            pushed[0] = True
+            Q_u = Q_s if Q_u is None else Q_u + Q_s
         return Q_u
 
     def rhs(t, x):
         reached[0] = t
         q, qd = x[:n], x[n : 2 * n]
-        Q_u = input_force(t, q, qd)
+        Q_u = input_force(t, x)
         qdd, Qd = side.accelerations(q, qd, Q_u)
-        if bar is not None:
-            bar.update(t)
-        power_u = 0.0 if Q_u is None else float(qd @ Q_u)
-        out = np.concatenate([qd, qdd, [-float(qd @ Qd), power_u]])
+        if progress and t - t0 > bar.n:
+            bar.update(t - t0 - bar.n)
+        extra = layout.derivatives(t, q, qd, x, MechanicsForces(Qd, Q_u))
+        out = np.concatenate([qd, qdd, *extra])
         if not np.isfinite(out).all():
             raise SimulationError("the accelerations are not finite")
         return out
@@ -387,19 +410,24 @@ def simulate(
 
         def jac(t, x):
             q, qd = x[:n], x[n : 2 * n]
-            J = np.zeros((2 * n + 2, 2 * n + 2))
-            J[: 2 * n, : 2 * n] = side.jacobian(q, qd, input_force(t, q, qd))
+            J = np.zeros((2 * n + layout.size, 2 * n + layout.size))  # zero for extra states
+            J[: 2 * n, : 2 * n] = side.jacobian(q, qd, input_force(t, x))
             if not np.isfinite(J).all():
                 raise SimulationError("the Jacobian of the right-hand side is not finite")
             return J
 
+    bar = tqdm(  # on stderr; simulated time since t0
+        total=t1 - t0,
+        disable=not progress,
+        bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]",
+    )
     start = time.perf_counter()
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked above
             sol = solve_ivp(
                 rhs,
                 (t0, t1),
-                np.r_[q0, qd0, 0.0, 0.0],
+                np.concatenate([q0, qd0, *layout.initial()]),
                 method=method,
                 rtol=rtol,
                 atol=atol_vec,
@@ -414,12 +442,12 @@ def simulate(
         kind = type(exc) if isinstance(exc, Rt70Error) else SimulationError
         raise kind(f"{scene.name}: integration stopped at t = {reached[0]:.6g} s: {exc}") from None
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
     wall = time.perf_counter() - start
     q, qd = sol.y[:n].T, sol.y[n : 2 * n].T
     energies = np.array([side.energies(a, b) for a, b in zip(q, qd, strict=True)])
-    E_psi, W_u = sol.y[2 * n], sol.y[2 * n + 1]
+    states = layout.read(sol.y)
+    E_psi, W_u = states["dissipated"], states["input_work"]
     total = energies.sum(axis=1) + E_psi - W_u
     balance = total - total[0]
     mech = energies[:, 0] + energies[:, 2]
@@ -449,8 +477,10 @@ def simulate(
         success=bool(sol.success),
         message=str(sol.message),
         coordinates=list(scene.textbook.coordinate_names),
+        states=states,
     )
-    result.drift_flagged = inputs is None and result.relative_drift > DRIFT_FACTOR * rtol
+    passive = inputs is None and not pushed[0]
+    result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
     result.outputs = evaluate_trajectory(scene, q, outputs, output_side)
     return result
 
@@ -471,20 +501,3 @@ def _check_mass_matrix(scene: Scene, side: _Backend, q0: np.ndarray) -> None:
         raise SimulationError(
             f"{scene.name}: the mass matrix is not positive definite at the initial state"
         ) from None
-
-
-class _Progress:
-    """A minimal text progress bar on stderr (only when stderr is a terminal or forced)."""
-
-    def __init__(self, t0: float, t1: float, width: int = 40) -> None:
-        self.t0, self.t1, self.width, self.shown = t0, t1, width, -1
-
-    def update(self, t: float) -> None:
-        done = int(self.width * min(max((t - self.t0) / (self.t1 - self.t0), 0.0), 1.0))
-        if done != self.shown:
-            self.shown = done
-            sys.stderr.write(f"\r[{'#' * done}{'.' * (self.width - done)}] t = {t:.3f} s")
-            sys.stderr.flush()
-
-    def close(self) -> None:
-        sys.stderr.write("\n")

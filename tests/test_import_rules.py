@@ -211,6 +211,7 @@ RT70_MODULES = ("rt70.scenes.rt70_data", "rt70.scenes.rt70_chapter2", "rt70.scen
 GENERIC = (
     "rt70.linear",
     "rt70.simulate",
+    "rt70.states",
     "rt70.validate",
     "rt70.scene",
     "rt70.reference",

@@ -6,9 +6,20 @@ roll-pitch-yaw Jacobian for the Euler-angle rates — independently of the textb
 side's :class:`rt70.textbook.forces.Deformation`. Potential ``½ δᵀ C δ``, spring force
 ``−(∂δ/∂v)ᵀ C δ``, damper force ``−(∂δ/∂v)ᵀ D δ̇``; the results go to Pinocchio as
 ``tau`` (:func:`element_torques`) or back to book coordinates through ``Jᵀ``.
+
+The element kinds are listed once, in :data:`ELEMENTS` (the same kinds as the textbook
+side's, tested): the ``RobotDescription`` list each is read into, and the function
+giving the deformations of all its elements at once (:class:`CoordinateElements` when
+each δ is a joint's coordinate, :class:`GeneralElements` with batched dense Jacobians
+otherwise). The sums over them — forces, gains, potential, magnitudes — are written
+once, for every kind.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
@@ -20,6 +31,141 @@ from rt70.reference.model import ReferenceData, ReferenceModel
 
 #: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
 GIMBAL_LOCK_COS = 1e-8
+
+
+@dataclass(frozen=True)
+class CoordinateElements:
+    """Elements of one kind whose deformation is one joint coordinate each (joint springs).
+
+    ``δ_e`` is the coordinate of the 1-DOF joint with velocity index ``v_e`` (its angle
+    for a continuous joint), so ``∂δ_e/∂v`` is the unit row ``v_e``: ``Jᵀ f`` scatters
+    ``f`` on those indices, without forming J.
+
+    Attributes
+    ----------
+    model : ReferenceModel
+        The model the elements belong to.
+    qp : numpy.ndarray
+        Pinocchio's configuration they are evaluated at.
+    index : numpy.ndarray
+        Pinocchio velocity index of each element, shape (n_e,).
+    stiffness, damping : numpy.ndarray
+        C and D of each element, shape (n_e,).
+    """
+
+    model: ReferenceModel
+    qp: np.ndarray
+    index: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+    @cached_property
+    def delta(self) -> np.ndarray:
+        """δ of each element, shape (n_e,); read on first use (the gains need none)."""
+        return _joint_angles(self.model, self.qp)[self.index]
+
+    def rate(self, vp: np.ndarray) -> np.ndarray:
+        """``δ̇ = (∂δ/∂v) v`` of each element, shape (n_e,)."""
+        return vp[self.index]
+
+    def subtract_jt(self, Q: np.ndarray, f: np.ndarray) -> None:
+        """``Q −= Σ_e (∂δ_e/∂v)ᵀ f_e`` in place."""
+        np.subtract.at(Q, self.index, f)
+
+    def add_abs_jt(self, S: np.ndarray, f: np.ndarray) -> None:
+        """``S += Σ_e |∂δ_e/∂v|ᵀ |f_e|`` in place."""
+        np.add.at(S, self.index, np.abs(f))
+
+    def add_jt_w_j(self, K: np.ndarray, w: np.ndarray) -> None:
+        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: the diagonal weights).
+
+        Unbuffered (``np.add.at``): two springs on one joint add up.
+        """
+        np.add.at(K, (self.index, self.index), w)
+
+    def squares(self, w: np.ndarray) -> float:
+        """``Σ_e δ_eᵀ W_e δ_e``."""
+        return float(np.sum(w * self.delta**2))
+
+
+@dataclass(frozen=True)
+class GeneralElements:
+    """Elements of one kind with a deformation and a dense Jacobian each, batched (bushings).
+
+    Attributes
+    ----------
+    delta : numpy.ndarray
+        δ of each element, shape (n_e, k).
+    jacobian : numpy.ndarray or None
+        ``∂δ/∂v`` of each element, shape (n_e, k, nv); None when not computed.
+    stiffness, damping : numpy.ndarray
+        Diagonals of C and D of each element, shape (n_e, k).
+    """
+
+    delta: np.ndarray
+    jacobian: np.ndarray | None
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+    def rate(self, vp: np.ndarray) -> np.ndarray:
+        """``δ̇ = (∂δ/∂v) v`` of each element, shape (n_e, k)."""
+        return self.jacobian @ vp
+
+    def subtract_jt(self, Q: np.ndarray, f: np.ndarray) -> None:
+        """``Q −= Σ_e (∂δ_e/∂v)ᵀ f_e`` in place."""
+        Q -= np.einsum("bin,bi->n", self.jacobian, f)
+
+    def add_abs_jt(self, S: np.ndarray, f: np.ndarray) -> None:
+        """``S += Σ_e |∂δ_e/∂v|ᵀ |f_e|`` in place."""
+        S += np.einsum("bin,bi->n", np.abs(self.jacobian), np.abs(f))
+
+    def add_jt_w_j(self, K: np.ndarray, w: np.ndarray) -> None:
+        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: the diagonal weights)."""
+        K += np.einsum("bin,bi,bim->nm", self.jacobian, w, self.jacobian)
+
+    def squares(self, w: np.ndarray) -> float:
+        """``Σ_e δ_eᵀ W_e δ_e``."""
+        return float(np.sum(w * self.delta**2))
+
+
+Elements = CoordinateElements | GeneralElements
+
+
+def joint_spring_elements(
+    model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
+) -> CoordinateElements | None:
+    """Joint springs: δ is the joint's coordinate, read from Pinocchio's ``q``."""
+    if not model.spring_v.size:
+        return None
+    return CoordinateElements(model, qp, model.spring_v, model.spring_k, model.spring_d)
+
+
+def bushing_elements(
+    model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
+) -> GeneralElements | None:
+    """Bushings and struts: :func:`deformations` from Pinocchio's frame kinematics."""
+    if not model.bushings:
+        return None
+    delta, jac = deformations(model, data, qp, jacobian=jacobian)
+    return GeneralElements(delta, jac, model.stiffness, model.damping)
+
+
+#: Every element kind of the reference side: the ``RobotDescription`` list its elements
+#: are read into → the function giving their deformations at Pinocchio's ``qp`` (the
+#: Jacobians only with ``jacobian=True``), None when the model has none. In summation
+#: order; the textbook side lists the same kinds (tested).
+ELEMENTS: dict[str, Callable[..., Elements | None]] = {
+    "joint_springs": joint_spring_elements,
+    "bushings": bushing_elements,
+}
+
+
+def elements(
+    model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
+) -> list[Elements]:
+    """The deformations of every element at Pinocchio's ``qp``, kind by kind."""
+    found = [kind(model, data, qp, jacobian) for kind in ELEMENTS.values()]
+    return [e for e in found if e is not None]
 
 
 def spring_damper_force(
@@ -43,15 +189,9 @@ def element_torques(
     """
     nv = model.pin_model.nv
     Qc, Qd = np.zeros(nv), np.zeros(nv)
-    if model.spring_v.size:
-        angles = _joint_angles(model, qp)
-        np.subtract.at(Qc, model.spring_v, model.spring_k * angles[model.spring_v])
-        np.subtract.at(Qd, model.spring_v, model.spring_d * vp[model.spring_v])
-    if model.bushings:
-        delta, jac = deformations(model, data, qp)
-        rate = jac @ vp  # δ̇ of every bushing, (n_b, 6)
-        Qc -= np.einsum("bin,bi->n", jac, model.stiffness * delta)
-        Qd -= np.einsum("bin,bi->n", jac, model.damping * rate)
+    for e in elements(model, data, qp):  # τ_c = −Σ Jᵀ C δ, τ_d = −Σ Jᵀ D δ̇
+        e.subtract_jt(Qc, e.stiffness * e.delta)
+        e.subtract_jt(Qd, e.damping * e.rate(vp))
     return Qc, Qd
 
 
@@ -66,12 +206,9 @@ def element_gains(
     """
     n = model.pin_model.nv
     K, D = np.zeros((n, n)), np.zeros((n, n))
-    K[model.spring_v, model.spring_v] += model.spring_k
-    D[model.spring_v, model.spring_v] += model.spring_d
-    if model.bushings:
-        _, jac = deformations(model, data, qp)
-        K += np.einsum("bin,bi,bim->nm", jac, model.stiffness, jac)
-        D += np.einsum("bin,bi,bim->nm", jac, model.damping, jac)
+    for e in elements(model, data, qp):
+        e.add_jt_w_j(K, e.stiffness)
+        e.add_jt_w_j(D, e.damping)
     return K, D
 
 
@@ -79,12 +216,8 @@ def spring_potential(model: ReferenceModel, data: ReferenceData, q: np.ndarray) 
     """``Σ ½ δᵀ C δ`` with δ from Pinocchio's frame placements."""
     qp, _, _, _ = to_pinocchio(model, q)
     U = 0.0
-    if model.spring_v.size:
-        angles = _joint_angles(model, qp)
-        U += 0.5 * float(np.sum(model.spring_k * angles[model.spring_v] ** 2))
-    if model.bushings:
-        delta, _ = deformations(model, data, qp, jacobian=False)
-        U += 0.5 * float(np.sum(model.stiffness * delta**2))
+    for e in elements(model, data, qp, jacobian=False):
+        U += 0.5 * e.squares(e.stiffness)
     return U
 
 
@@ -101,15 +234,9 @@ def spring_damper_magnitudes(
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     nv = model.pin_model.nv
     Sc, Sd = np.zeros(nv), np.zeros(nv)
-    if model.spring_v.size:
-        angles = _joint_angles(model, qp)
-        np.add.at(Sc, model.spring_v, np.abs(model.spring_k * angles[model.spring_v]))
-        np.add.at(Sd, model.spring_v, np.abs(model.spring_d * vp[model.spring_v]))
-    if model.bushings:
-        delta, jac = deformations(model, data, qp)
-        rate = jac @ vp
-        Sc += np.einsum("bin,bi->n", np.abs(jac), np.abs(model.stiffness * delta))
-        Sd += np.einsum("bin,bi->n", np.abs(jac), np.abs(model.damping * rate))
+    for e in elements(model, data, qp):
+        e.add_abs_jt(Sc, e.stiffness * e.delta)
+        e.add_abs_jt(Sd, e.damping * e.rate(vp))
     return (Sc, Sd) if J is None else (np.abs(J).T @ Sc, np.abs(J).T @ Sd)
 
 

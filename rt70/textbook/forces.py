@@ -5,10 +5,19 @@ Every elastic element is defined by its deformation δ(q): its potential is
 ``Q_d = −(∂δ/∂q)ᵀ D δ̇`` with ``δ̇ = (∂δ/∂q) q̇`` — conservative by construction, so the
 energy audit (1.73) closes. The book's direct pair (4.83) and strut package
 (4.85)–(4.110) are both bushings between two frames.
+
+The element kinds are listed once, in :data:`ELEMENTS`: the ``RobotDescription`` list
+each is read into, and the function giving the deformations of all its elements
+(:class:`CoordinateElements` when each δ is a pair coordinate, :class:`GeneralElements`
+with one :class:`Deformation` per element otherwise). The sums over them —
+:func:`spring_damper_force`, :func:`spring_potential` — are written once, for every kind.
+The reference side (:mod:`rt70.reference.forces`) lists the same kinds, computed
+independently from Pinocchio's kinematics.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,36 +66,137 @@ def bushing_deformation(data: Data, b: BushingModel) -> Deformation:
     return Deformation(np.concatenate([r12, phi]), jac)
 
 
+@dataclass(frozen=True)
+class CoordinateElements:
+    """Elements of one kind whose deformation is one pair coordinate each (joint springs).
+
+    ``δ_e = q_full[coords_e]``, so ``∂δ_e/∂q`` is row ``coords_e`` of G
+    (``q_full = G q + q_offset``, the mimic constraints): ``Jᵀ f`` is ``f`` scattered on
+    the pair coordinates and reduced, ``Gᵀ``, without forming J.
+
+    Attributes
+    ----------
+    coords : numpy.ndarray
+        Pair coordinate of each element, shape (n_e,).
+    delta, stiffness, damping : numpy.ndarray
+        δ, C and D of each element, shape (n_e,).
+    """
+
+    coords: np.ndarray
+    delta: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+    def rate(self, model: Model, qd: np.ndarray) -> np.ndarray:
+        """``δ̇ = (∂δ/∂q) q̇`` of each element, shape (n_e,)."""
+        return model.expand(qd, offset=False)[self.coords]
+
+    def subtract_jt(self, model: Model, Q: np.ndarray, f: np.ndarray) -> None:
+        """``Q −= Σ_e (∂δ_e/∂q)ᵀ f_e`` in place (``f``: one value per element)."""
+        Q_full = np.zeros(model.n_full)
+        np.subtract.at(Q_full, self.coords, f)
+        Q += model.reduce(Q_full)
+
+    def squares(self, w: np.ndarray) -> list[float]:
+        """``Σ_e δ_eᵀ W_e δ_e`` (``w``: the diagonal weights), as a list of partial sums."""
+        return [float(np.sum(w * self.delta**2))]
+
+
+@dataclass(frozen=True)
+class GeneralElements:
+    """Elements of one kind with a deformation and a dense Jacobian each (bushings).
+
+    Attributes
+    ----------
+    deformations : list of Deformation
+        δ and ``∂δ/∂q`` of each element.
+    stiffness, damping : numpy.ndarray
+        Diagonals of C and D of each element, shape (n_e, k).
+    """
+
+    deformations: list[Deformation]
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+    @property
+    def delta(self) -> np.ndarray:
+        """δ of each element, shape (n_e, k)."""
+        return np.array([d.delta for d in self.deformations])
+
+    def rate(self, model: Model, qd: np.ndarray) -> np.ndarray:
+        """``δ̇ = (∂δ/∂q) q̇`` of each element, shape (n_e, k)."""
+        return np.array([d.jacobian @ qd for d in self.deformations])
+
+    def subtract_jt(self, model: Model, Q: np.ndarray, f: np.ndarray) -> None:
+        """``Q −= (∂δ_e/∂q)ᵀ f_e`` in place, element by element (``f``: shape (n_e, k))."""
+        for d, fe in zip(self.deformations, f, strict=True):
+            Q -= d.jacobian.T @ fe
+
+    def squares(self, w: np.ndarray) -> list[float]:
+        """``δ_eᵀ W_e δ_e`` of each element (``w``: the diagonal weights, (n_e, k))."""
+        return [float(d.delta @ (we * d.delta)) for d, we in zip(self.deformations, w, strict=True)]
+
+
+Elements = CoordinateElements | GeneralElements
+
+
+def joint_spring_elements(model: Model, data: Data) -> CoordinateElements | None:
+    """Joint springs (``<rt70:joint_spring>``): δ is the joint's coordinate (4.83)."""
+    if not model.spring_coords.size:
+        return None
+    idx = model.spring_coords
+    return CoordinateElements(idx, data.q_full[idx], model.spring_stiffness, model.spring_damping)
+
+
+def bushing_elements(model: Model, data: Data) -> GeneralElements | None:
+    """Bushings and struts (``<rt70:bushing>``, ``<rt70:strut_package>``), (4.85)–(4.110)."""
+    if not model.bushings:
+        return None
+    return GeneralElements(
+        [bushing_deformation(data, b) for b in model.bushings],
+        np.array([b.stiffness for b in model.bushings]),
+        np.array([b.damping for b in model.bushings]),
+    )
+
+
+#: Every element kind of the textbook side: the ``RobotDescription`` list its elements are
+#: read into → the function giving their deformations at the configuration of ``data``
+#: (after :func:`~rt70.textbook.kinematics.update_structure`), None when the model has
+#: none. In summation order; the reference side lists the same kinds (tested).
+ELEMENTS: dict[str, Callable[[Model, Data], Elements | None]] = {
+    "joint_springs": joint_spring_elements,
+    "bushings": bushing_elements,
+}
+
+
+def elements(model: Model, data: Data, q: np.ndarray) -> list[Elements]:
+    """The deformations of every element at ``q``, kind by kind (:data:`ELEMENTS`)."""
+    update_structure(model, data, q)
+    found = (kind(model, data) for kind in ELEMENTS.values())
+    return [e for e in found if e is not None]
+
+
 def spring_damper_force(
     model: Model, data: Data, q: np.ndarray, qd: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Generalised spring force ``Q_c`` and damper force ``Q_d`` of all elements."""
+    """Spring force ``Q_c = −Σ Jᵀ C δ`` and damper force ``Q_d = −Σ Jᵀ D J q̇`` (J = ∂δ/∂q)."""
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
-    update_structure(model, data, q)
-    q_full, qd_full = data.q_full, model.expand(qd, offset=False)
-    idx = model.spring_coords
-    Qc = np.zeros(model.n_full)
-    Qd = np.zeros(model.n_full)
-    np.subtract.at(Qc, idx, model.spring_stiffness * q_full[idx])
-    np.subtract.at(Qd, idx, model.spring_damping * qd_full[idx])
-    Qc, Qd = model.reduce(Qc), model.reduce(Qd)
-    for b in model.bushings:
-        d = bushing_deformation(data, b)
-        Qc -= d.jacobian.T @ (b.stiffness * d.delta)
-        Qd -= d.jacobian.T @ (b.damping * (d.jacobian @ qd))
+    Qc = np.zeros(model.nv)
+    Qd = np.zeros(model.nv)
+    for e in elements(model, data, q):
+        e.subtract_jt(model, Qc, e.stiffness * e.delta)
+        e.subtract_jt(model, Qd, e.damping * e.rate(model, qd))
     return Qc, Qd
 
 
 def spring_potential(model: Model, data: Data, q: np.ndarray) -> float:
-    """Elastic potential ``Σ ½ δᵀ C δ`` of all springs."""
+    """Elastic potential ``Σ ½ δᵀ C δ`` of all elements."""
     q = check_vector("q", q, model.nv)
-    update_structure(model, data, q)
-    idx = model.spring_coords
-    U = 0.5 * float(np.sum(model.spring_stiffness * data.q_full[idx] ** 2))
-    for b in model.bushings:
-        delta = bushing_deformation(data, b).delta
-        U += 0.5 * float(delta @ (b.stiffness * delta))
+    U = 0.0
+    for e in elements(model, data, q):
+        for square in e.squares(e.stiffness):
+            U += 0.5 * square
     return U
 
 
