@@ -103,8 +103,8 @@ class EnergyAudit(StateComponent):
 
     def derivative(self, t, q, qd, s, forces):
         """``[−q̇ᵀ Q_d, q̇ᵀ Q_u]``: the dampers' and the inputs' power."""
-        power_u = 0.0 if forces.Q_u is None else float(qd @ forces.Q_u)
-        return np.array([-float(qd @ forces.Q_d), power_u])
+        Q_d, Q_u = forces
+        return np.array((-(qd @ Q_d), 0.0 if Q_u is None else qd @ Q_u))
 
 
 class StateLayout:
@@ -144,6 +144,10 @@ class StateLayout:
             self.slices.append(slice(start, start + k))
             start += k
         self.size = start - 2 * nv
+        #: (component, its slice of x, its number of states), in state order.
+        self.placed = [
+            (c, where, len(c.names)) for c, where in zip(self.components, self.slices, strict=True)
+        ]
         #: The components that push a force on the mechanics (override ``force``).
         self.pushing = [
             (c, where)
@@ -180,14 +184,14 @@ class StateLayout:
     ) -> list[np.ndarray]:
         """Time derivatives of the extra states at state ``x``, one array per component."""
         out = []
-        for c, where in zip(self.components, self.slices, strict=True):
+        for c, where, k in self.placed:
             ds = c.derivative(t, q, qd, x[where], forces)
-            if type(ds) is not np.ndarray or ds.shape != (where.stop - where.start,):
+            if type(ds) is not np.ndarray or ds.shape != (k,):
                 ds = np.asarray(ds, dtype=float)
-                if ds.shape != (len(c.names),):
+                if ds.shape != (k,):
                     raise ShapeError(
                         f"state component {type(c).__name__}: derivative must have shape "
-                        f"({len(c.names)},), got {ds.shape}"
+                        f"({k},), got {ds.shape}"
                     )
             out.append(ds)
         return out
