@@ -133,23 +133,38 @@ def _modes(args: argparse.Namespace) -> int:
         raise SingularConfigurationError(f"{scene.name}: {exc}") from None
     require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
     result = modal.modes(model.M, model.K, model.D)
+    damped = modal.damped_modes(model.M, model.K, model.D)
     rows = []
     energy = result.shapes * (model.M @ result.shapes)  # kinetic-energy share per coordinate
     for i in range(len(result.freq_hz)):
         unstable = bool(result.negative[i])
+        zeta = None if np.isnan(result.zeta[i]) else float(result.zeta[i])
+        kind = "unstable" if unstable else "rigid" if result.rigid[i] else "elastic"
+        if kind == "elastic" and zeta is not None and zeta >= 1.0:
+            kind = "overdamped"  # ζ ≥ 1: it creeps back, it does not ring
         rows.append(
             {
                 "mode": i + 1,
                 "freq_hz": None if unstable else float(result.freq_hz[i]),
-                "kind": "unstable" if unstable else "rigid" if result.rigid[i] else "elastic",
+                "kind": kind,
                 # an unstable mode diverges as exp(λt), λ = √(−ω²)
                 "divergence_rate": float(np.sqrt(-result.omega2[i])) if unstable else None,
-                "zeta": None if np.isnan(result.zeta[i]) else float(result.zeta[i]),
+                "zeta": zeta,
                 "dominant": model.coordinates[int(np.argmax(np.abs(energy[:, i])))],
+                "shape": dict(zip(model.coordinates, result.shapes[:, i].tolist(), strict=True)),
             }
         )
+    damped_summary = {
+        "oscillatory": [
+            {"freq_hz": float(f), "zeta": float(z)}
+            for f, z in zip(damped.frequencies_hz, damped.zeta, strict=True)
+        ],
+        "real_eigenvalues": damped.real.tolist(),
+        "proportional": bool(result.proportional),
+    }
     if args.json:
-        print(json.dumps({"scene": scene.name, "held": held, "modes": rows}, indent=2))
+        out = {"scene": scene.name, "held": held, "modes": rows, "damped": damped_summary}
+        print(json.dumps(out, indent=2))
         return 0
     where = f", elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
     axes = " (axes locked)" if args.lock_axes and held else ""
@@ -159,13 +174,26 @@ def _modes(args: argparse.Namespace) -> int:
         zeta = "" if r["zeta"] is None else f"{r['zeta']:.4f}"
         freq = f"{r['freq_hz']:.4f}" if r["freq_hz"] is not None else "—"
         print(f"{r['mode']:>4} {freq:>10} {zeta:>8}  {r['kind']:<8} {r['dominant']}")
-    unstable = [r for r in rows if r["kind"] == "unstable"]
-    for r in unstable:
-        print(
-            f"mode {r['mode']} is unstable (negative stiffness, divergence rate "
-            f"{r['divergence_rate']:.4g} 1/s): gravity is not balanced on a free axis; "
-            "use --lock-axes to let the drives hold it"
-        )
+    print(
+        "ξ = (VᵀDV)ᵢᵢ/2ωᵢ of the undamped modes"
+        + ("" if result.proportional else " (approximate: the damping is not proportional)")
+        + f"; the damped system has {len(damped.oscillatory)} oscillatory pairs and "
+        f"{len(damped.real)} real eigenvalues (creeping motions: overdamped, rigid, unstable)"
+    )
+    hint = "; --lock-axes lets the drives hold it" if held and not args.lock_axes else ""
+    for r in rows:
+        if r["kind"] == "unstable":
+            print(
+                f"mode {r['mode']} is unstable (negative stiffness, divergence rate "
+                f"{r['divergence_rate']:.4g} 1/s): gravity's moment about {r['dominant']} "
+                "grows faster than any spring resists it — the part it swings is not balanced "
+                f"about that free axis{hint}"
+            )
+        elif r["kind"] == "rigid":
+            print(
+                f"mode {r['mode']} is a rigid-body motion along {r['dominant']}: nothing holds "
+                f"it (no spring, no drive, no gravity moment){hint}"
+            )
     return 0
 
 

@@ -415,3 +415,19 @@ def test_bad_inputs_elsewhere_raise():
         modal.stiffness_proportional_damping(
             np.zeros((2, 2)), modal.modes(np.eye(2), np.zeros((2, 2)))
         )
+
+
+def test_damped_modes_proportional_pairs_and_overdamped_reals():
+    """λ = −ζω ± iω√(1−ζ²) for proportional damping; real λ for an overdamped mode."""
+    M = np.diag([1.0, 2.0])
+    K = np.array([[3.0, -1.0], [-1.0, 2.0]])
+    und = modal.modes(M, K, 0.1 * K)
+    d = modal.damped_modes(M, K, 0.1 * K)
+    assert np.allclose(d.frequencies_hz, und.freq_hz, rtol=1e-12)
+    assert np.allclose(d.zeta, und.zeta, rtol=1e-12)
+    assert d.real.size == 0 and d.eigenvalues.size == 4
+    # one mass, ζ = 2: λ = ω(−ζ ± √(ζ² − 1)), both real
+    omega, zeta = 3.0, 2.0
+    d1 = modal.damped_modes(np.eye(1), np.eye(1) * omega**2, np.eye(1) * 2 * zeta * omega)
+    expected = np.sort(omega * (-zeta + np.array([-1.0, 1.0]) * np.sqrt(zeta**2 - 1)))
+    assert d1.oscillatory.size == 0 and np.allclose(d1.real, expected, rtol=1e-12)

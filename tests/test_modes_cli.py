@@ -21,16 +21,40 @@ def test_modes_json_and_rt70_pointing(capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["scene"] == "rt70" and len(data["modes"]) == 42
     kinds = {m["kind"] for m in data["modes"]}
-    assert kinds <= {"rigid", "elastic", "unstable"}
+    assert kinds <= {"rigid", "elastic", "overdamped", "unstable"}
+    # ζ ≥ 1 is called overdamped, never elastic
+    for m in data["modes"]:
+        if m["zeta"] is not None:
+            assert (m["kind"] == "overdamped") == (m["zeta"] >= 1.0), m
+    assert "overdamped" in kinds  # the listing's damping is heavy on its stiff modes
+    # mode shapes by coordinate name; the damped system's eigenvalues all accounted for
+    assert set(data["modes"][0]["shape"]) == set(data["modes"][1]["shape"])
+    assert len(data["modes"][0]["shape"]) == 42
+    damped = data["damped"]
+    assert 2 * len(damped["oscillatory"]) + len(damped["real_eigenvalues"]) == 84
+    assert max(damped["real_eigenvalues"]) > 0  # the unstable mode creeps away
+    assert all(0 < o["zeta"] < 1 for o in damped["oscillatory"])
     # the listing's swinging part is not balanced about the free elevation axis
     assert "unstable" in kinds
     assert main(["modes", "rt70", "--elevation", "30", "--lock-axes", "--json"]) == 0
     locked = json.loads(capsys.readouterr().out)
     assert len(locked["modes"]) == 40
-    assert all(m["kind"] == "elastic" and m["freq_hz"] > 0 for m in locked["modes"])
+    assert all(m["kind"] in ("elastic", "overdamped") and m["freq_hz"] > 0 for m in locked["modes"])
 
 
 def test_pointing_on_a_scene_without_axes_is_bad_input(capsys):
     assert main(["modes", "rt70_elevation", "--elevation", "10"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("rt70: error:") and "pointing axes" in err
+
+
+def test_text_explains_unstable_and_rigid_modes(capsys):
+    assert main(["modes", "rt70"]) == 0
+    out = capsys.readouterr().out
+    assert "overdamped" in out
+    assert re.search(r"mode 1 is unstable .* about base_rx .* --lock-axes", out)
+    assert re.search(r"mode 2 is a rigid-body motion along platform_rz", out)
+    assert "the damping is not proportional" in out
+    assert main(["modes", "rt70_elevation"]) == 0
+    out = capsys.readouterr().out
+    assert "rigid-body motion" in out and "--lock-axes" not in out  # no axes to lock
