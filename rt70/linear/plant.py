@@ -1,0 +1,186 @@
+"""The linear plant a servo engineer closes loops around: named inputs, states, outputs.
+
+One call, :func:`plant`, linearises a scene about a static equilibrium
+(:func:`rt70.linear.linearize.linearize`) and assembles ``ẋ = A x + B u``,
+``y = C x`` with ``x = [q; q̇]`` (:func:`rt70.linear.responses.state_space`):
+
+- inputs are generalised forces: a torque or force on a named coordinate
+  (:class:`CoordinateInput`, what a drive applies to its axis), or a load
+  (:class:`LoadInput`, a :class:`rt70.loads.Wrench` per unit input — a force on the
+  counterweight, wind on the dish), whose column is the load's generalised force
+  ``S·U`` (4.129)–(4.131) on the textbook side;
+- outputs are coordinates (:class:`CoordinateOutput`, an axis angle) or any
+  :class:`rt70.outputs.Output` (the optical points, the mirror system's quantities),
+  linearised by central differences of the output on the textbook side.
+
+:func:`to_control` hands the result to python-control as a ``StateSpace`` with its
+state, input and output names, for Bode plots, margins and loop design there. Do not
+convert a high-order, lightly damped plant to a transfer function (``ss2tf``): the
+polynomial coefficients lose the resonances (``scipy.signal.bode`` via ``ss2tf`` is off
+by 24 dB at 1 Hz on the RT-70); evaluate the state space
+(:func:`rt70.linear.responses.frequency_response`, or python-control's own
+``frequency_response`` on the ``StateSpace``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.linear import linearize as lin
+from rt70.linear.responses import StateSpace, state_space
+from rt70.loads import Wrench
+from rt70.outputs import Output, column_labels, evaluate
+from rt70.scene import Scene
+from rt70.textbook import points
+
+#: Central-difference step of an output's linearisation, per coordinate (m or rad): the
+#: truncation error is O(h²) ≈ 1e-12 relative, the rounding O(ε/h) ≈ 1e-10 relative.
+OUTPUT_FD_STEP = 1e-6
+
+
+@dataclass(frozen=True)
+class CoordinateInput:
+    """A unit generalised force (N or N·m) on one coordinate, e.g. a drive's axis torque."""
+
+    name: str
+    coordinate: str
+
+
+@dataclass(frozen=True)
+class LoadInput:
+    """A load per unit input: the wrench applied when the input is 1."""
+
+    name: str
+    wrench: Wrench
+
+
+@dataclass(frozen=True)
+class CoordinateOutput:
+    """One coordinate as an output (m or rad), e.g. an axis angle."""
+
+    name: str
+    coordinate: str
+
+
+PlantInput = CoordinateInput | LoadInput
+PlantOutput = CoordinateOutput | Output
+
+
+def _input_column(lm: lin.Linearization, scene: Scene, u: PlantInput) -> np.ndarray:
+    """Generalised force of one unit input, rows in ``lm.coordinates``."""
+    if isinstance(u, CoordinateInput):
+        if u.coordinate not in lm.coordinates:
+            raise Rt70Error(
+                f"{scene.name}: input '{u.name}': no free coordinate '{u.coordinate}'"
+                + (" (it is locked)" if u.coordinate in lm.locked else "")
+            )
+        column = np.zeros(len(lm.coordinates))
+        column[lm.coordinates.index(u.coordinate)] = 1.0
+        return column
+    Q = points.generalized_force(scene.textbook, scene.textbook_data, lm.q0, u.wrench)
+    return Q[lin.coordinate_indices(scene, lm.coordinates)]
+
+
+def _output_rows(
+    lm: lin.Linearization, scene: Scene, y: PlantOutput
+) -> tuple[np.ndarray, list[str]]:
+    """Rows ``∂y/∂q`` (one per output component) over ``lm.coordinates``, and their names."""
+    if isinstance(y, CoordinateOutput):
+        if y.coordinate not in lm.coordinates:
+            raise Rt70Error(f"{scene.name}: output '{y.name}': no free coordinate '{y.coordinate}'")
+        row = np.zeros((1, len(lm.coordinates)))
+        row[0, lm.coordinates.index(y.coordinate)] = 1.0
+        return row, [y.name]
+    keep = lin.coordinate_indices(scene, lm.coordinates)
+    rows = np.empty((y.size, keep.size))
+    h = OUTPUT_FD_STEP
+    for j, i in enumerate(keep):
+        step = np.zeros(lm.q0.size)
+        step[i] = h
+        up = evaluate(scene, lm.q0 + step, [y], "textbook")[y.name]
+        down = evaluate(scene, lm.q0 - step, [y], "textbook")[y.name]
+        rows[:, j] = (np.ravel(up) - np.ravel(down)) / (2.0 * h)
+    return rows, column_labels(y.name, y.size) if y.size > 1 else [y.name]
+
+
+def plant(
+    scene: Scene,
+    q0: np.ndarray,
+    inputs: Sequence[PlantInput],
+    outputs: Sequence[PlantOutput],
+    locked: Sequence[str] = (),
+) -> StateSpace:
+    """The linear plant about the equilibrium ``q0`` with named inputs and outputs.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    q0 : ndarray
+        A static equilibrium (:func:`rt70.linear.linearize.equilibrium`).
+    inputs : sequence of CoordinateInput or LoadInput
+        The inputs, in order (their names label B's columns).
+    outputs : sequence of CoordinateOutput or rt70.outputs.Output
+        The outputs, in order; an Output with several components gives one row each
+        (``name:x``, ``name:y``, … as in :func:`rt70.outputs.column_labels`).
+    locked : sequence of str
+        Coordinates removed from the model (held rigidly).
+
+    Returns
+    -------
+    StateSpace
+        States ``q…`` and ``q…_dot`` named by coordinate; frequency responses by
+        :func:`rt70.linear.responses.frequency_response`; python-control by
+        :func:`to_control`.
+
+    Raises
+    ------
+    Rt70Error
+        If there is no input or no output, two have the same name, or one refers to a
+        coordinate that is not free.
+    """
+    if not inputs or not outputs:
+        raise Rt70Error(f"{scene.name}: a plant needs at least one input and one output")
+    lm = lin.linearize(scene, q0, locked=tuple(locked))
+    B = np.column_stack([_input_column(lm, scene, u) for u in inputs])
+    blocks = [_output_rows(lm, scene, y) for y in outputs]
+    C = np.vstack([rows for rows, _ in blocks])
+    output_names = [name for _, names in blocks for name in names]
+    input_names = [u.name for u in inputs]
+    for kind, names in (("input", input_names), ("output", output_names)):
+        repeated = sorted({n for n in names if names.count(n) > 1})
+        if repeated:
+            raise Rt70Error(f"{scene.name}: {kind} names used twice: {', '.join(repeated)}")
+    return state_space(
+        lm.M,
+        lm.K,
+        lm.D,
+        B,
+        C,
+        coord_names=lm.coordinates,
+        input_names=input_names,
+        output_names=output_names,
+    )
+
+
+def to_control(ss: StateSpace):
+    """The plant as a python-control ``StateSpace``, with its state, input and output names.
+
+    python-control (``control``) is the project's library for state-space objects, Bode
+    plots, margins and LQG; it is imported here, only when asked for.
+    """
+    import control
+
+    return control.ss(
+        ss.A,
+        ss.B,
+        ss.C,
+        ss.D,
+        states=list(ss.state_names),
+        inputs=list(ss.input_names),
+        outputs=list(ss.output_names),
+    )
