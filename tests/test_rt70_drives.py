@@ -295,3 +295,15 @@ def test_bad_values_name_the_field():
         dataclasses.replace(drv.AZIMUTH_DRIVE, motors_per_axis=3)
     with pytest.raises(Rt70Error, match="sector_radius"):
         dataclasses.replace(drv.ELEVATION_DRIVE, sector_radius=0.0)
+
+
+def test_ratio_choice_numbers_of_the_page():
+    """docs/drives.md §2: why 10⁵, and how much the rotors dominate the axis inertia."""
+    m = drv.MOTOR
+    slow = m.rated_speed / 1e6  # the book's upper ratio
+    assert math.degrees(slow) == pytest.approx(0.018, rel=PRINTED)
+    assert math.pi / slow / 3600 == pytest.approx(2.78, abs=0.01)  # hours for 180°
+    refl = drv.AZIMUTH_DRIVE.reflected_motor_inertia
+    assert refl / drv.AZIMUTH_DRIVE.reference_inertia == pytest.approx(178.0, abs=0.1)
+    assert refl / drv.ELEVATION_DRIVE.reference_inertia == pytest.approx(24.9, abs=0.1)
+    assert m.rated_torque * m.rated_speed == pytest.approx(77.0e3, abs=50.0)
