@@ -109,22 +109,10 @@ def _modes(args: argparse.Namespace) -> int:
     from rt70.linear import linearize as lin
     from rt70.linear import modal
     from rt70.scene import load_scene
-    from rt70.scenes import rt70_state
     from rt70.textbook.massless import require_diagonal
 
     scene = load_scene(args.scene)
-    names = scene.textbook.coordinate_names
-    if not names:
-        raise Rt70Error(f"{scene.name}: the model has no degree of freedom: no modes")
-    axes = (rt70_state.AZIMUTH_COORDINATE, rt70_state.ELEVATION_COORDINATE)
-    has_axes = all(axis in names for axis in axes)
-    if (args.elevation is not None or args.azimuth is not None) and not has_axes:
-        raise Rt70Error(
-            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes ({', '.join(axes)})"
-        )
-    elevation = 90.0 if args.elevation is None else args.elevation
-    azimuth = 0.0 if args.azimuth is None else args.azimuth
-    held = rt70_state.rt70_pointing(elevation, azimuth) if has_axes else {}
+    has_axes, elevation, azimuth, held = _pointing(args, scene, "modes")
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
             q0 = lin.equilibrium(scene, held)
@@ -194,6 +182,87 @@ def _modes(args: argparse.Namespace) -> int:
                 f"mode {r['mode']} is a rigid-body motion along {r['dominant']}: nothing holds "
                 f"it (no spring, no drive, no gravity moment){hint}"
             )
+    return 0
+
+
+def _pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, float, float, dict]:
+    """The RT-70 pointing asked for: (has axes, elevation, azimuth, held coordinates)."""
+    from rt70.scenes import rt70_state
+
+    names = scene.textbook.coordinate_names
+    if not names:
+        raise Rt70Error(f"{scene.name}: the model has no degree of freedom: no {what}")
+    axes = (rt70_state.AZIMUTH_COORDINATE, rt70_state.ELEVATION_COORDINATE)
+    has_axes = all(axis in names for axis in axes)
+    if (args.elevation is not None or args.azimuth is not None) and not has_axes:
+        raise Rt70Error(
+            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes ({', '.join(axes)})"
+        )
+    elevation = 90.0 if args.elevation is None else args.elevation
+    azimuth = 0.0 if args.azimuth is None else args.azimuth
+    held = rt70_state.rt70_pointing(elevation, azimuth) if has_axes else {}
+    return has_axes, elevation, azimuth, held
+
+
+def _plant(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from rt70.linear import linearize as lin
+    from rt70.linear import modal
+    from rt70.linear import plant as pl
+    from rt70.outputs import optical_point_outputs
+    from rt70.scene import load_scene
+
+    scene = load_scene(args.scene)
+    has_axes, elevation, azimuth, held = _pointing(args, scene, "plant")
+    names = scene.textbook.coordinate_names
+    if has_axes:  # the drives' torques in; the axis angles and the optical points out
+        inputs = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
+        outputs = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
+        outputs += optical_point_outputs(scene)
+    else:  # a generalised force on, and the value of, every coordinate
+        inputs = [pl.CoordinateInput(f"force:{n}", n) for n in names]
+        outputs = [pl.CoordinateOutput(n, n) for n in names]
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            q0 = lin.equilibrium(scene, held)
+            ss = pl.plant(scene, q0, inputs, outputs)
+    except SingularConfigurationError as exc:
+        raise SingularConfigurationError(f"{scene.name}: {exc}") from None
+    # from K v = ω² M v, not from eig(A): a rigid mode's double pole at 0 splits by
+    # rounding into ±√ε-sized poles that would look unstable
+    so = ss.second_order
+    spectrum = modal.modes(so.M, so.K)
+    unstable, rigid = int(spectrum.negative.sum()), int(spectrum.rigid.sum())
+    info = {
+        "scene": scene.name,
+        "pointing": {"elevation_deg": elevation, "azimuth_deg": azimuth} if has_axes else None,
+        "states": list(ss.state_names),
+        "inputs": list(ss.input_names),
+        "outputs": list(ss.output_names),
+        "unstable_modes": unstable,
+        "rigid_modes": rigid,
+        "units": "SI: inputs N or N·m; outputs m or rad; states m, rad and their rates",
+    }
+    if args.out:
+        from rt70.atomic import atomic_write
+
+        arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
+        labels = {k: np.array(info[k]) for k in ("states", "inputs", "outputs")}
+        atomic_write(args.out, lambda tmp: np.savez_compressed(tmp, **arrays, **labels))
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    where = f" at elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
+    print(
+        f"{scene.name}: linear plant{where}: {ss.n_states} states, {ss.n_inputs} inputs, "
+        f"{ss.n_outputs} outputs; {unstable} unstable and {rigid} rigid mode(s) "
+        "(the loops the drives must close)"
+    )
+    print("  inputs:  " + ", ".join(ss.input_names))
+    print("  outputs: " + ", ".join(ss.output_names))
+    if args.out:
+        print(f"wrote {args.out}")
     return 0
 
 
@@ -331,6 +400,28 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mod.add_argument("--json", action="store_true", help="print JSON")
     mod.set_defaults(func=_modes)
+    pla = sub.add_parser(
+        "plant",
+        help="the linear plant (state space) with named inputs and outputs",
+        description="Linearise a scene at its static equilibrium (the RT-70 at a pointing, "
+        "its axes held) and print the state space's named inputs and outputs: for the "
+        "RT-70 the axis torques in, the axis angles and the optical points out; for other "
+        "scenes a force on and the value of every coordinate. --out writes A, B, C, D and "
+        "the names (.npz); in Python, rt70.linear.plant.to_control gives python-control's "
+        "StateSpace.",
+    )
+    pla.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
+    pla.add_argument(
+        "--elevation",
+        type=options.elevation,
+        help="RT-70 elevation, degrees, 0 (horizon) to 90 (zenith; the default)",
+    )
+    pla.add_argument(
+        "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
+    )
+    pla.add_argument("--json", action="store_true", help="print JSON")
+    pla.add_argument("--out", help="write A, B, C, D and the names to FILE.npz")
+    pla.set_defaults(func=_plant)
     sim = sub.add_parser(
         "simulate",
         help="integrate the equations of motion with an energy audit",

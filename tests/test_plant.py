@@ -131,3 +131,33 @@ def test_bad_plant_requests_are_clear(rt70_plant):
             [pl.CoordinateInput("u", "base_rx"), pl.CoordinateInput("u", "platform_rz")],
             [pl.CoordinateOutput("y", "base_rx")],
         )
+
+
+def test_cli_plant_json_lists_named_inputs_and_outputs(capsys, tmp_path):
+    import json
+
+    from rt70.cli import main
+
+    out = tmp_path / "plant.npz"
+    assert main(["plant", "rt70", "--elevation", "60", "--json", "--out", str(out)]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["inputs"] == ["torque:platform_rz", "torque:base_rx"]
+    assert info["outputs"][:2] == ["angle:platform_rz", "angle:base_rx"]
+    assert "main_mirror_focus:z" in info["outputs"] and len(info["states"]) == 84
+    assert info["unstable_modes"] >= 1  # the unbalanced swinging part on its free axis
+    data = np.load(out)
+    assert data["A"].shape == (84, 84) and data["B"].shape == (84, 2)
+    assert data["C"].shape == (len(info["outputs"]), 84)
+    assert list(data["inputs"]) == info["inputs"]
+
+
+def test_cli_plant_bad_input(capsys, tmp_path):
+    from rt70.cli import main
+
+    assert main(["plant", "rt70", "--out", str(tmp_path / "plant.txt")]) == 2
+    assert ".npz" in capsys.readouterr().err
+    assert main(["plant", "rt70_elevation", "--elevation", "30"]) == 2
+    assert "pointing axes" in capsys.readouterr().err
+    assert main(["plant", "rt70_elevation"]) == 0  # no axes: every coordinate in and out
+    out = capsys.readouterr().out
+    assert "6 inputs, 6 outputs" in out and "1 rigid" in out
