@@ -205,7 +205,12 @@ def test_report_rule_sees_every_spelling(tmp_path):
 # --- generic analyses know no telescope (issue 9) ---------------------------------------
 
 #: The RT-70's own modules: the book's tables and what is built from them.
-RT70_MODULES = ("rt70.scenes.rt70_data", "rt70.scenes.rt70_chapter2", "rt70.scenes.rt70_state")
+RT70_MODULES = (
+    "rt70.scenes.rt70_data",
+    "rt70.scenes.rt70_chapter2",
+    "rt70.scenes.rt70_state",
+    "rt70.scenes.rt70_optics",
+)
 
 #: Generic analyses and simulation: they take what they need of a scene as arguments.
 GENERIC = (
@@ -213,6 +218,7 @@ GENERIC = (
     "rt70.simulate",
     "rt70.states",
     "rt70.outputs",
+    "rt70.optics",
     "rt70.loads",
     "rt70.constraints",
     "rt70.validate",
