@@ -133,6 +133,13 @@ def _norm(v: np.ndarray) -> np.ndarray:
     return np.sqrt(np.sum(v * v))
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product a × b of two 3-vectors (faster than numpy.cross for one pair)."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / _norm(v)
 
@@ -174,7 +181,7 @@ class _Geometry:
         """
         a1 = self.R_support[:, 0]
         a3 = self.R7[:, 2]
-        return a1, _unit(np.cross(a3, a1)), a3
+        return a1, _unit(_cross(a3, a1)), a3
 
 
 def _pointing_correction(g: _Geometry, source: np.ndarray) -> np.ndarray:
@@ -188,7 +195,7 @@ def _pointing_correction(g: _Geometry, source: np.ndarray) -> np.ndarray:
     ``Y1 Δα + Y2 Δβ = s^OK − n5^OK`` (4.162), solved from its x, y rows (4.163): the OK z
     axis is the focal axis at construction, so those are the transverse components.
     """
-    Y = np.stack([g.in_ok(np.cross(g.z_az, source)), g.in_ok(np.cross(g.x_el, source))], axis=1)
+    Y = np.stack([g.in_ok(_cross(g.z_az, source)), g.in_ok(_cross(g.x_el, source))], axis=1)
     A, b = Y[:2], (g.in_ok(source) - g.in_ok(g.n5))[:2]
     scale = float(np.max(np.abs(Y.real))) ** 2
     if abs(np.linalg.det(A.real)) <= SINGULAR * scale:
@@ -212,7 +219,7 @@ def _cr_rotation(g: _Geometry) -> np.ndarray:
     optical points on the counterreflector's z) a3 = n7, so Δα7 = 0.
     """
     n7 = g.in_ok(g.n7)
-    X = np.stack([-g.in_ok(np.cross(a, g.n7)) for a in g.cr_axes()], axis=1)
+    X = np.stack([-g.in_ok(_cross(a, g.n7)) for a in g.cr_axes()], axis=1)
     s = np.linalg.svd(X.real, compute_uv=False)
     if s[1] <= SINGULAR * s[0]:
         raise SingularConfigurationError(
@@ -233,7 +240,7 @@ def _cr_translation(g: _Geometry, rotation: np.ndarray) -> np.ndarray:
     of construction offsets written as positions; d = 0 is the book).
     """
     lever = g.p7f - g.o7
-    Z = [g.R_support.T @ np.cross(a, lever) for a in g.cr_axes()]
+    Z = [g.R_support.T @ _cross(a, lever) for a in g.cr_axes()]
     Z4 = g.R_support.T @ (g.p5f + g.R_ok @ g.design - g.p7f)
     return Z4 - Z[0] * rotation[0] - Z[1] * rotation[1] - Z[2] * rotation[2]
 
@@ -333,16 +340,19 @@ def output_matrix(
     ``J_v`` of each point on ``side`` (:func:`rt70.textbook.points.point_jacobian` or
     :func:`rt70.reference.points.point_jacobian`) and ``∂f/∂p_k`` of the formula by a
     complex step (exact to rounding), checked against central differences
-    (:data:`CHECK_STEP`). Rows in the order of ``outputs``, components in order.
+    (:data:`CHECK_STEP`). Rows in the order of ``outputs``, components in order;
+    columns are the scene's coordinates (for a
+    :class:`rt70.linear.linearize.Linearization` take the columns
+    ``coordinate_indices(scene, lm.coordinates)``).
 
     Raises
     ------
     Rt70Error
         If a formula has no derivative at q0 (e.g. an angle magnitude at zero).
     """
-    from rt70.outputs import _check
+    from rt70.outputs import evaluate
 
-    _check(outputs, side)
+    evaluate(scene, q0, outputs, side)  # checks the side, the names, the links, the shapes
     if side == "textbook":
         from rt70.textbook.points import point_jacobian, point_positions
 
@@ -352,13 +362,18 @@ def output_matrix(
 
         model, data = scene.reference, scene.reference_data
     q0 = np.asarray(q0, dtype=float)
+    jacobians: dict[tuple, np.ndarray] = {}  # J_v of each distinct point, computed once
     rows = []
     for o in outputs:
         p = point_positions(model, data, q0, list(o.points))
         G = _formula_gradient(o, p)
         C = np.zeros((o.size, q0.size))
         for k, (link, xyz) in enumerate(o.points):
-            if np.any(G[:, k]):
-                C += G[:, k] @ point_jacobian(model, data, q0, link, xyz)[0]
+            if not np.any(G[:, k]):
+                continue
+            key = (link, tuple(float(x) for x in xyz))
+            if key not in jacobians:
+                jacobians[key] = point_jacobian(model, data, q0, link, xyz)[0]
+            C += G[:, k] @ jacobians[key]
         rows.append(C)
     return np.vstack(rows) if rows else np.zeros((0, q0.size))
