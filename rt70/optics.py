@@ -22,6 +22,7 @@ name                              unit    size  formula
 ``main_mirror_error``             arcsec  3     s − n5 in OK, small-angle vector (4.156)
 ``counterreflector_misalignment`` arcsec  1     2 arcsin(|n7 − n5|/2) (4.166)
 ``counterreflector_error``        arcsec  3     n7 − n5 in OK, small-angle vector (4.165)
+``counterreflector_source_...``   arcsec  1     2 arcsin(|s − n7|/2) (φ7 КИР of 4.1.8)
 ``focal_offset``                  mm      3     Rᵀ(r7f − r5f) − d (4.152)
 ``pointing_correction``           arcsec  2     [Δα, Δβ] from the x, y rows (4.159)–(4.163)
 ``counterreflector_rotation``     arcsec  3     [Δβ7, Δθ7, Δα7] (4.168)–(4.172)
@@ -286,6 +287,12 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
             lambda g: ARCSEC * np.atleast_1d(_angle(g.n7, g.n5)),
         ),
         out("counterreflector_error", "arcsec", 3, lambda g: ARCSEC * g.in_ok(g.n7 - g.n5)),
+        out(
+            "counterreflector_source_misalignment",
+            "arcsec",
+            1,
+            lambda g: ARCSEC * np.atleast_1d(_angle(s, g.n7)),
+        ),
         out("focal_offset", "mm", 3, lambda g: MM * (g.in_ok(g.p7f - g.p5f) - g.design)),
         out("pointing_correction", "arcsec", 2, lambda g: ARCSEC * _pointing_correction(g, s)),
         out("counterreflector_rotation", "arcsec", 3, lambda g: ARCSEC * _cr_rotation(g)),

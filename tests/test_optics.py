@@ -96,6 +96,9 @@ def test_listing_state_outputs_are_what_the_geometry_says(rt70, states):
     values = outputs.evaluate(rt70, q, rt70_optics.rt70_mirror_outputs(rt70, e, a))
     assert values["counterreflector_misalignment"][0] < 1e-6  # arcsec
     assert values["main_mirror_misalignment"][0] > 100.0  # the listing's elastic turns
+    assert values["counterreflector_source_misalignment"][0] == pytest.approx(
+        values["main_mirror_misalignment"][0], rel=1e-9
+    )
     assert np.linalg.norm(values["main_mirror_axis"]) == pytest.approx(1.0, abs=1e-13)
 
 
@@ -140,6 +143,8 @@ def test_turning_the_dish_asks_for_the_opposite_correction(rt70, coordinate):
         errors.append(float(np.max(np.abs(v["pointing_correction"] - expected))))
         if coordinate == "base_rx":  # a turn in the source's vertical plane: the angle itself
             assert v["main_mirror_misalignment"][0] == pytest.approx(delta_arcsec, rel=1e-9)
+            source = v["counterreflector_source_misalignment"][0]
+            assert source == pytest.approx(delta_arcsec, rel=1e-9)
         assert v["counterreflector_misalignment"][0] < 1e-6  # the dish turned as a whole
     # within the second-order bound δ² (in rad, shown in arcsec), at both sizes
     assert errors[0] <= (10.0 / ARCSEC) ** 2 * ARCSEC, errors
