@@ -265,3 +265,20 @@ def test_bad_requests(rt70):
         rt70_optics.rt70_mirror_system(load_scene("double_pendulum"))
     assert np.allclose(optics.source_direction(0.0, np.pi / 2), [0.0, 0.0, 1.0])
     assert np.allclose(rt70_optics.pointing_source(0.0, 90.0), [1.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("coordinate", ["main_mirror_rx", "mirror_base_rx"])
+def test_tilting_the_mirror_or_its_ring(rt70, coordinate):
+    """The main mirror tilted by δ on its ring (OK) turns its axis in OK; the ring tilted
+    by δ carries the mirror with it, the axis stays put in OK and the source moves. Both
+    ask for Δβ = −δ (the bearing's x is the ring's x here) within δ²."""
+    outs = rt70_optics.rt70_mirror_outputs(rt70, 60.0, -30.0)
+    delta = 20.0  # arcsec
+    q = _pointing(rt70, 60.0, -30.0, **{coordinate: delta / ARCSEC})
+    v = outputs.evaluate(rt70, q, outs, "textbook")
+    on_ring = coordinate == "main_mirror_rx"
+    axis_turned = abs(v["main_mirror_axis"][1]) * ARCSEC
+    assert axis_turned == pytest.approx(delta if on_ring else 0.0, abs=1e-6)
+    assert v["main_mirror_misalignment"][0] == pytest.approx(delta, rel=1e-9)
+    bound = (delta / ARCSEC) ** 2 * ARCSEC
+    assert np.allclose(v["pointing_correction"], [0.0, -delta], rtol=0, atol=bound)
