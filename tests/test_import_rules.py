@@ -210,6 +210,7 @@ RT70_MODULES = (
     "rt70.scenes.rt70_chapter2",
     "rt70.scenes.rt70_state",
     "rt70.scenes.rt70_drives",
+    "rt70.scenes.rt70_optics",
 )
 
 #: Generic analyses and simulation: they take what they need of a scene as arguments.
@@ -218,6 +219,7 @@ GENERIC = (
     "rt70.simulate",
     "rt70.states",
     "rt70.outputs",
+    "rt70.optics",
     "rt70.loads",
     "rt70.constraints",
     "rt70.validate",

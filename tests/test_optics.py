@@ -1,0 +1,284 @@
+"""Outputs of the mirror system (book 4.1.8, :mod:`rt70.optics`): both sides, hand cases, C.
+
+Each output is a formula of point positions that each side computes by its own
+kinematics; the sides must agree to 1e-10. Hand-made cases check the readings: the
+undeformed telescope has no error; turning the whole dish by a known small angle asks
+for the opposite pointing correction; moving the counterreflector by a known distance
+shows as that focal offset and asks for the opposite translation; tilting it asks for
+the opposite turn. The linear rows C (exact point Jacobians, complex step through the
+formula) match finite differences of the nonlinear outputs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rt70 import optics, outputs
+from rt70.errors import Rt70Error, SingularConfigurationError
+from rt70.linear.linearize import equilibrium
+from rt70.scene import load_scene
+from rt70.scenes import rt70_optics, rt70_state
+from rt70.simulate import simulate
+
+ARCSEC = optics.ARCSEC
+#: The scale of the quantities each output is formed from (unit vectors, positions of
+#: order metres): 1 in its unit, 1 rad in arcsec, 1 m in mm.
+NATURAL = {"1": 1.0, "arcsec": ARCSEC, "mm": 1e3}
+
+
+@pytest.fixture(scope="module")
+def rt70():
+    return load_scene("rt70")
+
+
+def _q(scene, values: dict[str, float], base: np.ndarray | None = None) -> np.ndarray:
+    names = scene.textbook.coordinate_names
+    q = np.zeros(len(names)) if base is None else base.copy()
+    for name, value in values.items():
+        q[names.index(name)] += value
+    return q
+
+
+def _pointing(scene, elevation, azimuth, **extra):
+    """The rigid pointing's coordinates, plus ``extra`` added to them."""
+    return _q(scene, extra, _q(scene, rt70_state.rt70_pointing(elevation, azimuth)))
+
+
+def _both(scene, q, outs):
+    return outputs.evaluate(scene, q, outs, "textbook"), outputs.evaluate(
+        scene, q, outs, "reference"
+    )
+
+
+@pytest.fixture(scope="module")
+def states(rt70):
+    """Listing state, two pointing equilibria, and a generic deformed pointing."""
+    q_list, _ = rt70_state.listing_initial_state(rt70)
+    names = rt70.textbook.coordinate_names
+    listing = (
+        90.0 - np.degrees(q_list[names.index("base_rx")]),
+        np.degrees(q_list[names.index("platform_rz")]),
+        q_list,
+    )
+    out = {"listing": listing}
+    for e, a in ((30.0, 20.0), (75.0, -40.0)):
+        out[f"equilibrium E{e:g} A{a:g}"] = (
+            e,
+            a,
+            equilibrium(rt70, rt70_state.rt70_pointing(e, a)),
+        )
+    generic = _pointing(rt70, 50.0, 120.0) + np.random.default_rng(8).uniform(-2e-3, 2e-3, 42)
+    out["generic"] = (50.0, 120.0, generic)
+    return out
+
+
+def test_sides_agree(rt70, states):
+    """≤ 1e-10 relative to max(|value|, the scale it is formed from); ≤ 1e-10 relative to
+    |value| itself where no output is zero by symmetry (the generic state)."""
+    worst = 0.0
+    for label, (e, a, q) in states.items():
+        outs = rt70_optics.rt70_mirror_outputs(rt70, e, a)
+        tb, ref = _both(rt70, q, outs)
+        for o in outs:
+            diff = float(np.max(np.abs(tb[o.name] - ref[o.name])))
+            size = float(np.max(np.abs(ref[o.name])))
+            assert diff <= 1e-10 * max(size, NATURAL[o.unit]), (label, o.name, diff, size)
+            if label == "generic":
+                assert size > 1e-3 * NATURAL[o.unit] * 1e-3, o.name  # not zero here
+                worst = max(worst, diff / size)
+    assert worst <= 1e-10, worst
+
+
+def test_listing_state_outputs_are_what_the_geometry_says(rt70, states):
+    """The listing turns every mirror pair alike, so the two axes stay parallel."""
+    e, a, q = states["listing"]
+    values = outputs.evaluate(rt70, q, rt70_optics.rt70_mirror_outputs(rt70, e, a))
+    assert values["counterreflector_misalignment"][0] < 1e-6  # arcsec
+    assert values["main_mirror_misalignment"][0] > 100.0  # the listing's elastic turns
+    assert values["counterreflector_source_misalignment"][0] == pytest.approx(
+        values["main_mirror_misalignment"][0], rel=1e-9
+    )
+    assert np.linalg.norm(values["main_mirror_axis"]) == pytest.approx(1.0, abs=1e-13)
+
+
+def test_construction_is_the_design(rt70):
+    """q = 0: axes along OK z, no misalignment, foci at their design offset, no correction;
+    the pointing correction is undefined there (zenith: the azimuth axis is the source)."""
+    system = rt70_optics.rt70_mirror_system(rt70)
+    outs = optics.mirror_outputs(system, [0.0, 0.0, 1.0])
+    without = [o for o in outs if o.name != "pointing_correction"]
+    for side in outputs.SIDES:
+        v = outputs.evaluate(rt70, np.zeros(42), without, side)
+        assert np.array_equal(v["main_mirror_axis"], [0.0, 0.0, 1.0])
+        assert np.array_equal(v["counterreflector_axis"], [0.0, 0.0, 1.0])
+        for name in without[2:]:
+            assert np.max(np.abs(v[name.name])) < 1e-9, name.name
+    with pytest.raises(SingularConfigurationError, match="zenith keyhole"):
+        outputs.evaluate(rt70, np.zeros(42), outs)
+    assert rt70_optics.DESIGN_FOCAL_OFFSET == pytest.approx((0.0, 0.0, 1.2), abs=1e-12)
+
+
+@pytest.mark.parametrize(("elevation", "azimuth"), [(40.0, 30.0), (10.0, -100.0), (89.0, 0.0)])
+def test_rigid_pointing_has_no_error(rt70, elevation, azimuth):
+    outs = rt70_optics.rt70_mirror_outputs(rt70, elevation, azimuth)
+    v = outputs.evaluate(rt70, _pointing(rt70, elevation, azimuth), outs, "reference")
+    for o in outs[2:]:
+        assert np.max(np.abs(v[o.name])) < 1e-6, o.name  # µ-arcsec, µm: rounding only
+
+
+@pytest.mark.parametrize("coordinate", ["platform_rz", "base_rx"])
+def test_turning_the_dish_asks_for_the_opposite_correction(rt70, coordinate):
+    """A rigid turn δ about the azimuth (elevation) axis → Δα = −δ (Δβ = −δ), to first
+    order: the error is within δ² (δ = 10″ and 1″)."""
+    elevation, azimuth = 35.0, 60.0
+    outs = rt70_optics.rt70_mirror_outputs(rt70, elevation, azimuth)
+    k = 0 if coordinate == "platform_rz" else 1
+    errors = []
+    for delta_arcsec in (10.0, 1.0):
+        q = _pointing(rt70, elevation, azimuth, **{coordinate: delta_arcsec / ARCSEC})
+        v = outputs.evaluate(rt70, q, outs, "textbook")
+        expected = np.zeros(2)
+        expected[k] = -delta_arcsec
+        errors.append(float(np.max(np.abs(v["pointing_correction"] - expected))))
+        if coordinate == "base_rx":  # a turn in the source's vertical plane: the angle itself
+            assert v["main_mirror_misalignment"][0] == pytest.approx(delta_arcsec, rel=1e-9)
+            source = v["counterreflector_source_misalignment"][0]
+            assert source == pytest.approx(delta_arcsec, rel=1e-9)
+        assert v["counterreflector_misalignment"][0] < 1e-6  # the dish turned as a whole
+    # within the second-order bound δ² (in rad, shown in arcsec), at both sizes
+    assert errors[0] <= (10.0 / ARCSEC) ** 2 * ARCSEC, errors
+    assert errors[1] <= (1.0 / ARCSEC) ** 2 * ARCSEC, errors
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_moving_the_counterreflector_shows_as_focal_offset(rt70, axis):
+    """A pure translation of 1 mm along a rigel axis: offset +1 mm, translation −1 mm."""
+    coordinate = ("counterreflector_x", "counterreflector_y", "counterreflector_z")[axis]
+    outs = rt70_optics.rt70_mirror_outputs(rt70, 50.0, 10.0)
+    q = _pointing(rt70, 50.0, 10.0, **{coordinate: 1e-3})
+    tb, ref = _both(rt70, q, outs)
+    expected = np.zeros(3)
+    expected[axis] = 1.0
+    for v in (tb, ref):
+        assert np.allclose(v["focal_offset"], expected, rtol=0, atol=1e-9)
+        assert np.allclose(v["counterreflector_translation"], -expected, rtol=0, atol=1e-9)
+        assert np.max(np.abs(v["counterreflector_rotation"])) < 1e-6
+        assert v["counterreflector_misalignment"][0] < 1e-6
+
+
+@pytest.mark.parametrize(
+    ("coordinate", "k"), [("counterreflector_rx", 0), ("counterreflector_ry", 1)]
+)
+def test_tilting_the_counterreflector_asks_for_the_opposite_turn(rt70, coordinate, k):
+    """A tilt δ about its drive's x (y) axis: misalignment δ exactly, Δβ7 (Δθ7) = −δ, and
+    no translation to first order (the turn back also brings the focus back)."""
+    outs = rt70_optics.rt70_mirror_outputs(rt70, 50.0, 10.0)
+    delta = 5.0  # arcsec
+    q = _pointing(rt70, 50.0, 10.0, **{coordinate: delta / ARCSEC})
+    v = outputs.evaluate(rt70, q, outs, "reference")
+    assert v["counterreflector_misalignment"][0] == pytest.approx(delta, rel=1e-9)
+    assert np.linalg.norm(v["counterreflector_error"]) == pytest.approx(delta, rel=1e-6)
+    expected = np.zeros(3)
+    expected[k] = -delta
+    assert np.allclose(v["counterreflector_rotation"], expected, rtol=0, atol=1e-6)
+    lever = 1.2e3 * delta / ARCSEC  # mm the focus moved, 1.2 m from the pivot
+    assert abs(v["focal_offset"][1 - k]) == pytest.approx(lever, rel=1e-6)
+    # second order only: the chord of the turn back, lever · δ/2
+    assert np.max(np.abs(v["counterreflector_translation"])) <= lever * delta / ARCSEC
+
+
+def test_counterreflector_system_is_rank_two(rt70, states):
+    """[erratum] (4.172): a turn about the focal axis does not move it; the minimum-norm
+    reading gives Δα7 = 0 on the RT-70, where the optical points lie on the CR's z."""
+    e, a, q = states["equilibrium E30 A20"]
+    v = outputs.evaluate(rt70, q, rt70_optics.rt70_mirror_outputs(rt70, e, a))
+    rotation = v["counterreflector_rotation"]
+    assert abs(rotation[2]) < 1e-9 * np.max(np.abs(rotation)) and rotation[0] > 100.0
+
+
+def _stack(values: dict[str, np.ndarray]) -> np.ndarray:
+    return np.concatenate(list(values.values()))
+
+
+def test_output_matrix_is_the_derivative(rt70, states):
+    """C of both sides agree, and match central differences of the nonlinear outputs."""
+    e, a, q = states["equilibrium E30 A20"]
+    outs = [o for o in rt70_optics.rt70_mirror_outputs(rt70, e, a) if "misalignment" not in o.name]
+    C_tb = optics.output_matrix(rt70, q, outs, "textbook")
+    C_ref = optics.output_matrix(rt70, q, outs, "reference")
+    assert C_tb.shape == (sum(o.size for o in outs), 42)
+    scale = float(np.max(np.abs(C_ref)))
+    assert float(np.max(np.abs(C_tb - C_ref))) <= 1e-10 * scale
+    h = 1e-6
+    columns = []
+    for i in range(42):
+        e_i = np.zeros(42)
+        e_i[i] = h
+        plus = _stack(outputs.evaluate(rt70, q + e_i, outs, "reference"))
+        minus = _stack(outputs.evaluate(rt70, q - e_i, outs, "reference"))
+        columns.append((plus - minus) / (2 * h))
+    fd = np.array(columns).T
+    assert float(np.max(np.abs(C_ref - fd))) <= 1e-6 * scale
+    # the pointing correction needs the azimuth and elevation coordinates
+    names = rt70.textbook.coordinate_names
+    row = sum(o.size for o in outs[: [o.name for o in outs].index("pointing_correction")])
+    assert C_tb[row, names.index("platform_rz")] == pytest.approx(-ARCSEC, rel=1e-3)
+    assert C_tb[row + 1, names.index("base_rx")] == pytest.approx(-ARCSEC, rel=1e-3)
+
+
+def test_output_matrix_refuses_what_has_no_derivative(rt70):
+    q = _pointing(rt70, 40.0, 0.0)
+    outs = rt70_optics.rt70_mirror_outputs(rt70, 40.0, 0.0)
+    angle = next(o for o in outs if o.name == "main_mirror_misalignment")
+    with pytest.raises(Rt70Error, match="'main_mirror_misalignment' has no derivative"):
+        optics.output_matrix(rt70, q, [angle])  # |s − n5| at 0: a cone, not a plane
+    focus = outputs.optical_point_outputs(rt70)[0]
+    hidden = outputs.Output("size", "m", 1, focus.points, lambda p: np.linalg.norm(p)[None])
+    with pytest.raises(Rt70Error, match="'size' has no derivative"):
+        optics.output_matrix(rt70, q, [hidden])  # norm() drops the complex step: caught
+    same = optics.output_matrix(rt70, q, [focus])  # a position: C is J_v
+    assert (
+        same.shape == (3, 42) and same[2, rt70.textbook.coordinate_names.index("platform_z")] == 1.0
+    )
+
+
+def test_outputs_ride_along_a_simulation(rt70, states):
+    e, a, _ = states["listing"]
+    outs = rt70_optics.rt70_mirror_outputs(rt70, e, a)
+    x0 = rt70_state.listing_initial_state(rt70)
+    t = np.linspace(0.0, 0.02, 3)
+    result = simulate(rt70, (0.0, 0.02), x0, backend="textbook", t_eval=t, outputs=outs)
+    assert result.outputs["pointing_correction"].shape == (3, 2)
+    expected = outputs.evaluate_trajectory(rt70, result.q, outs, "textbook")
+    for o in outs:
+        assert np.array_equal(result.outputs[o.name], expected[o.name])
+    moved = result.outputs["main_mirror_misalignment"][:, 0]
+    assert abs(moved[-1] - moved[0]) > 1e-3  # arcsec: the structure vibrates
+
+
+def test_bad_requests(rt70):
+    system = rt70_optics.rt70_mirror_system(rt70)
+    with pytest.raises(Rt70Error, match="source direction"):
+        optics.mirror_outputs(system, [0.0, 0.0, 0.0])
+    with pytest.raises(Rt70Error, match="no <rt70:optical_point> named main_mirror_focus"):
+        rt70_optics.rt70_mirror_system(load_scene("double_pendulum"))
+    assert np.allclose(optics.source_direction(0.0, np.pi / 2), [0.0, 0.0, 1.0])
+    assert np.allclose(rt70_optics.pointing_source(0.0, 90.0), [1.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("coordinate", ["main_mirror_rx", "mirror_base_rx"])
+def test_tilting_the_mirror_or_its_ring(rt70, coordinate):
+    """The main mirror tilted by δ on its ring (OK) turns its axis in OK; the ring tilted
+    by δ carries the mirror with it, the axis stays put in OK and the source moves. Both
+    ask for Δβ = −δ (the bearing's x is the ring's x here) within δ²."""
+    outs = rt70_optics.rt70_mirror_outputs(rt70, 60.0, -30.0)
+    delta = 20.0  # arcsec
+    q = _pointing(rt70, 60.0, -30.0, **{coordinate: delta / ARCSEC})
+    v = outputs.evaluate(rt70, q, outs, "textbook")
+    on_ring = coordinate == "main_mirror_rx"
+    axis_turned = abs(v["main_mirror_axis"][1]) * ARCSEC
+    assert axis_turned == pytest.approx(delta if on_ring else 0.0, abs=1e-6)
+    assert v["main_mirror_misalignment"][0] == pytest.approx(delta, rel=1e-9)
+    bound = (delta / ARCSEC) ** 2 * ARCSEC
+    assert np.allclose(v["pointing_correction"], [0.0, -delta], rtol=0, atol=bound)
