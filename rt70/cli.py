@@ -185,6 +185,10 @@ def _modes(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Above this elevation (degrees) the pointing corrections are not given (zenith keyhole).
+ZENITH_KEYHOLE_DEG = 89.0
+
+
 def _pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, float, float, dict]:
     """The RT-70 pointing asked for: (has axes, elevation, azimuth, held coordinates)."""
     from rt70.scenes import rt70_state
@@ -220,6 +224,11 @@ def _plant(args: argparse.Namespace) -> int:
         inputs = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
         outputs = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
         outputs += optical_point_outputs(scene)
+        if elevation < ZENITH_KEYHOLE_DEG:  # at the zenith Δα, Δβ are undefined (4.160)
+            from rt70.scenes.rt70_optics import rt70_mirror_outputs
+
+            mirror = rt70_mirror_outputs(scene, elevation, azimuth)
+            outputs += [o for o in mirror if o.name in ("focal_offset", "pointing_correction")]
     else:  # a generalised force on, and the value of, every coordinate
         inputs = [pl.CoordinateInput(f"force:{n}", n) for n in names]
         outputs = [pl.CoordinateOutput(n, n) for n in names]
@@ -242,7 +251,8 @@ def _plant(args: argparse.Namespace) -> int:
         "outputs": list(ss.output_names),
         "unstable_modes": unstable,
         "rigid_modes": rigid,
-        "units": "SI: inputs N or N·m; outputs m or rad; states m, rad and their rates",
+        "units": "inputs N or N·m; angles rad, points m, focal_offset mm, "
+        "pointing_correction arcsec (Δα, Δβ); states m, rad and their rates",
     }
     if args.out:
         from rt70.atomic import atomic_write

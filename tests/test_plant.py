@@ -144,6 +144,10 @@ def test_cli_plant_json_lists_named_inputs_and_outputs(capsys, tmp_path):
     assert info["inputs"] == ["torque:platform_rz", "torque:base_rx"]
     assert info["outputs"][:2] == ["angle:platform_rz", "angle:base_rx"]
     assert "main_mirror_focus:z" in info["outputs"] and len(info["states"]) == 84
+    # the mirror system's pointing corrections (4.159)-(4.163), away from the zenith
+    assert {"pointing_correction:0", "pointing_correction:1", "focal_offset:z"} <= set(
+        info["outputs"]
+    )
     assert info["unstable_modes"] >= 1  # the unbalanced swinging part on its free axis
     data = np.load(out)
     assert data["A"].shape == (84, 84) and data["B"].shape == (84, 2)
