@@ -43,6 +43,7 @@ from rt70.bondgraph import (
     reducer_outputs,
     state_equations,
 )
+from rt70.bondgraph.equations import _AlgebraicLoop, _Former
 from rt70.bondgraph.lagrange import book_motor_matrices, reducer_deformations
 from rt70.errors import Rt70Error
 
@@ -262,6 +263,57 @@ def test_two_flow_sources_on_a_1_junction_conflict():
     with pytest.raises(CausalityError, match="causal conflict on bond 'v2->1'.*source Sf 'v1'"):
         assign_causality(g)
     assert issubclass(CausalityError, Rt70Error)
+
+
+def test_algebraic_loop_is_solved():
+    """A resistor divider: R1 and R2 fix each other's variables (an algebraic loop).
+
+    Hand solution: node voltage V = (U − i) R1R2/(R1 + R2) with R1 = 1, R2 = 2; then
+    L di/dt = V − R3 i, so with p = L i: ṗ = −(2/3 + 3) p / L + (2/3) U.
+    """
+    g = BondGraph("divider")
+    g.source_effort("U", input="U")
+    g.one("1_a")
+    g.resistor("R1", 1.0)
+    g.zero("0_b")
+    g.resistor("R2", 2.0)
+    g.one("1_c")
+    g.resistor("R3", 3.0)
+    g.inertia("L", 1e-3)
+    for tail, head in [
+        ("U", "1_a"),
+        ("1_a", "R1"),
+        ("1_a", "0_b"),
+        ("0_b", "R2"),
+        ("0_b", "1_c"),
+        ("1_c", "R3"),
+        ("1_c", "L"),
+    ]:
+        g.bond(tail, head)
+    former = _Former(assign_causality(g), ["p_L"], ["U"])
+    with pytest.raises(_AlgebraicLoop):  # the causal evaluation does meet the loop
+        former.get(("1_c->L", "e"))
+    ss = state_equations(g, [("V", "0_b->R2", "e")])
+    assert ss.A[0, 0] == pytest.approx(-(2 / 3 + 3) / 1e-3, rel=TOL)
+    assert ss.B[0, 0] == pytest.approx(2 / 3, rel=TOL)
+    assert ss.C[0, 0] == pytest.approx(-(2 / 3) / 1e-3, rel=TOL)  # V per p (i = p/L)
+    assert ss.D[0, 0] == pytest.approx(2 / 3, rel=TOL)
+    b = ss.power(np.array([0.3]), np.array([2.0]))
+    assert abs(b.stored - (b.supplied - b.dissipated)) <= TOL * b.dissipated
+
+
+def test_bond_graph_doctest_and_unknown_output():
+    import doctest
+
+    import rt70.bondgraph.graph as graph_module
+
+    result = doctest.testmod(graph_module)
+    assert result.attempted >= 5 and result.failed == 0
+    g = dc_motor_reducer_load(drive_params())
+    with pytest.raises(BondGraphError, match="no bond named 'nope'"):
+        state_equations(g, [("y", "nope", "f")])
+    with pytest.raises(BondGraphError, match="output 'y': variable must be e or f"):
+        state_equations(g, [("y", "J_l", "v")])
 
 
 def test_malformed_graphs_and_parameters_are_refused():

@@ -12,7 +12,9 @@ states and the sources' inputs through the junction laws (2.1)/(2.2), the transf
 (2.6) and gyrator (2.7) laws and the resistors (2.5); then ``ṗ = e`` on each ``I``
 bond and ``q̇ = f`` on each ``C`` bond. Each coefficient is a short product/sum of the
 parameters, so it carries a few rounding errors only (no linear solve). A cycle in
-this evaluation is an algebraic loop (through ``R`` elements); it is refused.
+this evaluation is an algebraic loop (resistors fixing each other's variables); then
+all bond variables are solved at once from their causal laws, ``(1 − N) v = S [x; u]``
+(a singular loop is refused).
 
 Sign convention: a bond carries ``e`` and ``f`` with ``e·f`` the power in its
 direction. A one-port whose bond points *into* it sees ``(e, f)``; one whose bond
@@ -120,6 +122,14 @@ class StateSpace:
         return Cb @ np.linalg.solve(s * np.eye(n) - Ab, Bb.astype(complex)) + self.D
 
 
+class _AlgebraicLoop(Exception):
+    """Internal: the causal evaluation met a cycle (the keys on it)."""
+
+    def __init__(self, keys: list[Key]) -> None:
+        super().__init__(keys)
+        self.keys = list(keys)
+
+
 class _Former:
     """Evaluates each bond variable as a linear form in ``z = [x; u]``, in causal order."""
 
@@ -129,33 +139,58 @@ class _Former:
         self.n = len(states) + len(inputs)
         self.index = {name: i for i, name in enumerate(states)}
         self.index.update({f"u:{name}": len(states) + i for i, name in enumerate(inputs)})
+        self.width = self.n  # length of a form; longer while solving a loop
+        self.symbolic: dict[Key, int] | None = None
         self.forms: dict[Key, np.ndarray] = {}
         self.busy: list[Key] = []
 
     def unit(self, key: str) -> np.ndarray:
-        v = np.zeros(self.n)
+        v = np.zeros(self.width)
         v[self.index[key]] = 1.0
         return v
 
     def get(self, key: Key) -> np.ndarray:
         if key in self.forms:
             return self.forms[key]
+        if self.symbolic is not None:  # a bond variable stands for itself
+            v = np.zeros(self.width)
+            v[self.n + self.symbolic[key]] = 1.0
+            return v
         if key in self.busy:
-            loop = ", ".join(f"{b}.{v}" for b, v in self.busy[self.busy.index(key) :])
-            raise CausalityError(
-                f"bond graph '{self.g.name}': algebraic loop through {loop} (resistors "
-                "joined without a storage between them); not supported: add the storage "
-                "or merge the resistors"
-            )
+            raise _AlgebraicLoop(self.busy[self.busy.index(key) :])
         self.busy.append(key)
-        bond = self.g.bond_named(key[0])
-        receiver = self.c.effort_to[bond.name]
-        sender = bond.head if bond.tail == receiver else bond.tail
-        element = sender if key[1] == "e" else receiver
-        form = self._law(bond, key[1], element)
+        form = self._law_of(key)
         self.busy.pop()
         self.forms[key] = form
         return form
+
+    def _law_of(self, key: Key) -> np.ndarray:
+        bond = self.g.bond_named(key[0])
+        receiver = self.c.effort_to[bond.name]
+        sender = bond.head if bond.tail == receiver else bond.tail
+        return self._law(bond, key[1], sender if key[1] == "e" else receiver)
+
+    def solve_all(self, loop: list[Key]) -> None:
+        """Every bond variable at once: ``v = N v + S z`` solved as ``(1 − N) v = S z``.
+
+        Used only when the causal evaluation meets an algebraic loop (resistors that
+        fix each other's variables); the loop-free evaluation needs no solve.
+        """
+        keys = [(b.name, var) for b in self.g.bonds for var in ("e", "f")]
+        self.symbolic = {k: i for i, k in enumerate(keys)}
+        self.width = self.n + len(keys)
+        self.forms, self.busy = {}, []
+        rows = np.array([self._law_of(k) for k in keys])
+        self.symbolic, self.width = None, self.n
+        matrix = np.eye(len(keys)) - rows[:, self.n :]
+        if np.linalg.matrix_rank(matrix) < len(keys):
+            names = ", ".join(f"{b}.{v}" for b, v in loop)
+            raise CausalityError(
+                f"bond graph '{self.g.name}': the algebraic loop through {names} has no "
+                "unique solution (singular junction structure)"
+            )
+        solved = np.linalg.solve(matrix, rows[:, : self.n])
+        self.forms = {k: solved[i] for i, k in enumerate(keys)}
 
     def _law(self, bond: Bond, var: str, name: str) -> np.ndarray:
         el = self.g.elements[name]
@@ -196,7 +231,7 @@ class _Former:
         if var == common:  # the common variable, brought in by the strong bond
             return self.get((strong.name, common))
         # the summed variable on the strong bond: Σ σ_b v_b = 0, σ = +1 into the junction
-        total = np.zeros(self.n)
+        total = np.zeros(self.width)
         for b in bonds:
             if b.name != bond.name:
                 total = total + (1.0 if b.head == name else -1.0) * self.get((b.name, var))
@@ -226,7 +261,7 @@ def state_equations(
     Raises
     ------
     CausalityError
-        Derivative causality, a causal conflict, or an algebraic loop.
+        Derivative causality, a causal conflict, or a singular algebraic loop.
     BondGraphError
         An output names an unknown bond or variable.
     """
@@ -239,6 +274,12 @@ def state_equations(
     ]
     inputs = g.inputs()
     former = _Former(causal, states, inputs)
+    try:
+        for b in g.bonds:  # every bond variable, in causal order
+            former.get((b.name, "e"))
+            former.get((b.name, "f"))
+    except _AlgebraicLoop as loop:
+        former.solve_all(loop.keys)
     rows = []
     for state in states:
         el = g.elements[state[2:]]
@@ -247,9 +288,6 @@ def state_equations(
             rows.append(former.get((b.name, "e")))
         else:  # q̇ = f_in = s f
             rows.append((1.0 if b.head == el.name else -1.0) * former.get((b.name, "f")))
-    for b in g.bonds:  # every bond variable, for the power budget
-        former.get((b.name, "e"))
-        former.get((b.name, "f"))
     out_rows, out_names = [], []
     for name, bond, var in outputs or []:
         if var not in ("e", "f"):

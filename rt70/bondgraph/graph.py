@@ -84,10 +84,21 @@ class BondGraph:
 
     Examples
     --------
+    An RC circuit, ``q̇ = (U − 4 q)/2``:
+
+    >>> from rt70.bondgraph import state_equations
     >>> g = BondGraph("rc")
-    >>> g.source_effort("U", input="U"); g.one("1"); g.resistor("R", 2.0)
+    >>> g.source_effort("U", input="U")
+    >>> g.one("1")
+    >>> g.resistor("R", 2.0)
     >>> g.compliance("C", stiffness=4.0)
-    >>> g.bond("U", "1"); g.bond("1", "R"); g.bond("1", "C")
+    >>> for end in ("R", "C"):
+    ...     _ = g.bond("1", end)
+    >>> g.bond("U", "1")
+    'U->1'
+    >>> ss = state_equations(g)
+    >>> ss.states, ss.A.tolist(), ss.B.tolist()
+    (['q_C'], [[-2.0]], [[0.5]])
     """
 
     name: str
