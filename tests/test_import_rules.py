@@ -47,6 +47,8 @@ RULES = {
     "rt70.errors": (),
     "rt70.arrays": ("rt70.errors",),
     "rt70.constraints": ("rt70.errors",),
+    # a second formulation of the drives, independent of both rigid-body sides
+    "rt70.bondgraph": ("rt70.bondgraph", *SHARED),
     "rt70.loads": ("rt70.arrays", "rt70.errors"),
 }
 
@@ -222,6 +224,7 @@ GENERIC = (
     "rt70.optics",
     "rt70.loads",
     "rt70.constraints",
+    "rt70.bondgraph",
     "rt70.validate",
     "rt70.scene",
     "rt70.reference",
