@@ -225,6 +225,7 @@ GENERIC = (
     "rt70.loads",
     "rt70.constraints",
     "rt70.bondgraph",
+    "rt70.drives",
     "rt70.validate",
     "rt70.scene",
     "rt70.reference",

@@ -1,0 +1,117 @@
+"""A DC motor driving one coordinate through a compliant reducer, as simulation states.
+
+The drive of formalism §4.5 ((4.137)–(4.143)) on one axis: an armature circuit
+(inductance L_a, resistance R_a, back-EMF c_e ω_m), a rotor (inertia J_m, viscous D_m,
+torque c_m I) and a reducer of ratio i_r whose compliance C_r and damping D_r sit
+between the rotor, seen through the ratio (α_m / i_r), and the driven coordinate α of
+the structure. Its states are the armature current I, the rotor angle α_m and speed ω_m;
+it pushes the reducer torque
+
+    τ_r = C_r (α_m / i_r − α) + D_r (ω_m / i_r − α̇)
+
+on the driven coordinate (the extra-state seam's ``force``, :mod:`rt70.states`) and
+feels ``τ_r / i_r`` back on the rotor:
+
+    L_a İ = u − R_a I − c_e ω_m,   α̇_m = ω_m,   J_m ω̇_m = c_m I − D_m ω_m − τ_r / i_r.
+
+The structure's own forces (gravity, springs, the load's damping) come from the scene.
+The same drive assembled as a bond graph (:mod:`rt70.bondgraph`) and in Lagrange form
+(:func:`rt70.bondgraph.lagrange.drive_lagrange`) gives the linear equations this
+component must reproduce on a rigid load (tests/test_drives.py). Dry friction, backlash
+and the servo loops come next (issue 10).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from rt70.bondgraph.parameters import DriveParameters
+from rt70.errors import Rt70Error
+from rt70.states import MechanicsForces, StateComponent
+
+#: Armature voltage as a function of (t, q, q̇, the drive's states [I, α_m, ω_m]).
+Voltage = Callable[[float, np.ndarray, np.ndarray, np.ndarray], float]
+
+
+class DcDrive(StateComponent):
+    """A DC motor and compliant reducer driving one coordinate (formalism §4.5).
+
+    Parameters
+    ----------
+    name : str
+        Prefix of the state names (``name:current``, ``name:motor_angle``,
+        ``name:motor_speed``).
+    coordinates : sequence of str
+        The scene's coordinate names (``scene.coordinate_names``).
+    coordinate : str
+        The driven coordinate (an axis angle, rad).
+    parameters : DriveParameters
+        L_a, R_a, c_m, c_e, J_m, D_m, i_r, C_r, D_r (``J_l``, ``D_l`` are the scene's:
+        its inertia and damping; they are not used here).
+    voltage : float or callable
+        Armature voltage u, V: a constant or ``u(t, q, q̇, s)`` (a servo law).
+    initial : array_like, optional
+        ``[I, α_m, ω_m]`` at the start; default zero. :meth:`holding` gives the state
+        that holds a torque at rest.
+    atol : array_like, optional
+        Absolute tolerances of the three states (default 1e-9 A, 1e-9 rad, 1e-9 rad/s).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        coordinates: list[str],
+        coordinate: str,
+        parameters: DriveParameters,
+        voltage: float | Voltage = 0.0,
+        initial=None,
+        atol=None,
+    ) -> None:
+        if coordinate not in coordinates:
+            raise Rt70Error(f"drive '{name}': no coordinate '{coordinate}'")
+        self.names = (f"{name}:current", f"{name}:motor_angle", f"{name}:motor_speed")
+        self.index = coordinates.index(coordinate)
+        self.n = len(coordinates)
+        self.p = parameters
+        self.voltage = voltage if callable(voltage) else (lambda t, q, qd, s, u=float(voltage): u)
+        self.initial = np.zeros(3) if initial is None else np.asarray(initial, dtype=float)
+        self.atol = np.full(3, 1e-9) if atol is None else np.asarray(atol, dtype=float)
+
+    @staticmethod
+    def holding(parameters: DriveParameters, angle: float, torque: float) -> np.ndarray:
+        """``[I, α_m, ω_m]`` holding ``torque`` on the coordinate at ``angle``, at rest.
+
+        The reducer is twisted by ``torque / C_r`` and the motor supplies
+        ``torque / i_r``: ``I = torque / (i_r c_m)``, ``α_m = i_r (angle + torque / C_r)``.
+        """
+        p = parameters
+        return np.array([torque / (p.i_r * p.c_m), p.i_r * (angle + torque / p.C_r), 0.0])
+
+    def reducer_torque(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> float:
+        """``τ_r = C_r (α_m/i_r − α) + D_r (ω_m/i_r − α̇)``, on the driven coordinate."""
+        p, k = self.p, self.index
+        return p.C_r * (s[1] / p.i_r - q[k]) + p.D_r * (s[2] / p.i_r - qd[k])
+
+    def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """The reducer torque as a generalised force on the driven coordinate."""
+        Q = np.zeros(self.n)
+        Q[self.index] = self.reducer_torque(q, qd, s)
+        return Q
+
+    def derivative(
+        self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
+    ) -> np.ndarray:
+        """``[İ, α̇_m, ω̇_m]`` of the armature and the rotor (4.137)–(4.143)."""
+        p = self.p
+        current, _, speed = s
+        u = float(self.voltage(t, q, qd, s))
+        tau = self.reducer_torque(q, qd, s)
+        return np.array(
+            (
+                (u - p.R_a * current - p.c_e * speed) / p.L_a,
+                speed,
+                (p.c_m * current - p.D_m * speed - tau / p.i_r) / p.J_m,
+            )
+        )
