@@ -104,9 +104,12 @@ class DcDrive(StateComponent):
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
         """``[İ, α̇_m, ω̇_m]`` of the armature and the rotor (4.137)–(4.143)."""
+        return self.motor_rates(q, qd, s, float(self.voltage(t, q, qd, s)))
+
+    def motor_rates(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray, u: float) -> np.ndarray:
+        """``[İ, α̇_m, ω̇_m]`` under the armature voltage ``u`` (s = ``[I, α_m, ω_m]``)."""
         p = self.p
-        current, _, speed = s
-        u = float(self.voltage(t, q, qd, s))
+        current, _, speed = s[0], s[1], s[2]
         tau = self.reducer_torque(q, qd, s)
         return np.array(
             (

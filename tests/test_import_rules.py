@@ -226,6 +226,7 @@ GENERIC = (
     "rt70.constraints",
     "rt70.bondgraph",
     "rt70.drives",
+    "rt70.servo",
     "rt70.validate",
     "rt70.scene",
     "rt70.reference",
