@@ -5,8 +5,8 @@ vertex, the counterreflector's focus and vertex, and unit offsets that give the 
 a few link frames — into the book's control errors of the mirror system, each an
 :class:`rt70.outputs.Output`. Each side of the cross-check computes the positions with
 its own kinematics, so ``outputs.evaluate(scene, q, outs, side)`` and
-``simulate(..., outputs=outs)`` work unchanged. :func:`output_matrix` gives the rows of
-the linear plant (C) at q0.
+``simulate(..., outputs=outs)`` work unchanged. :func:`rt70.outputs.output_matrix` gives their
+rows of the linear plant (C) at q0.
 
 Frames (ground axes are the base frame of (4.153)): the reference ring (OK) frame is a
 link's frame (the book's mirror base, body 4); a frame's rotation ``R`` (columns = its
@@ -45,7 +45,6 @@ import numpy as np
 
 from rt70.errors import Rt70Error, SingularConfigurationError
 from rt70.outputs import Output, Point
-from rt70.scene import Scene
 
 #: Arc seconds per radian (the listing's TURNE0: KANGLE = 206264.806).
 ARCSEC = 180.0 * 3600.0 / np.pi
@@ -303,84 +302,3 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
             lambda g: MM * _cr_translation(g, _cr_rotation(g)),
         ),
     ]
-
-
-# --- the linear plant's output rows -----------------------------------------------------
-
-#: Complex step of the formula in position space (m): exact to rounding for a formula
-#: without abs/conjugation (:func:`output_matrix`).
-COMPLEX_STEP = 1e-30
-#: Central-difference step (m) of the check of the complex step; its error is
-#: ≲ h²|f'''| + ε|f|/h ≈ 1e-8 relative for formulas over lengths of order 1 m.
-CHECK_STEP = 1e-5
-
-
-def _formula_gradient(o: Output, p: np.ndarray) -> np.ndarray:
-    """∂formula/∂positions (size × n_points × 3) by complex step, checked by differences."""
-    n = p.shape[0]
-    G = np.empty((o.size, n, 3))
-    D = np.empty((o.size, n, 3))
-    for k in range(n):
-        for i in range(3):
-            e = np.zeros((n, 3))
-            e[k, i] = 1.0
-            G[:, k, i] = np.imag(np.asarray(o.formula(p + 1j * COMPLEX_STEP * e))) / COMPLEX_STEP
-            plus = np.asarray(o.formula(p + CHECK_STEP * e), dtype=float)
-            minus = np.asarray(o.formula(p - CHECK_STEP * e), dtype=float)
-            D[:, k, i] = (plus - minus) / (2 * CHECK_STEP)
-    scale = max(float(np.max(np.abs(D))), 1e-300)
-    if not np.isfinite(G).all() or np.max(np.abs(G - D)) > 1e-5 * scale:
-        raise Rt70Error(
-            f"output '{o.name}' has no derivative at this state by complex step (it is not "
-            "differentiable here — e.g. an angle magnitude at zero; use its vector form — "
-            "or its formula takes abs/conjugates)"
-        )
-    return G
-
-
-def output_matrix(
-    scene: Scene, q0: np.ndarray, outputs: Sequence[Output], side: str = "textbook"
-) -> np.ndarray:
-    """Rows C (Σ sizes × nv) of the outputs' small-signal response ``δy = C δq`` at q0.
-
-    Chain rule through the point Jacobians: ``C = Σ_k (∂f/∂p_k) J_v,k`` with the exact
-    ``J_v`` of each point on ``side`` (:func:`rt70.textbook.points.point_jacobian` or
-    :func:`rt70.reference.points.point_jacobian`) and ``∂f/∂p_k`` of the formula by a
-    complex step (exact to rounding), checked against central differences
-    (:data:`CHECK_STEP`). Rows in the order of ``outputs``, components in order;
-    columns are the scene's coordinates (for a
-    :class:`rt70.linear.linearize.Linearization` take the columns
-    ``coordinate_indices(scene, lm.coordinates)``).
-
-    Raises
-    ------
-    Rt70Error
-        If a formula has no derivative at q0 (e.g. an angle magnitude at zero).
-    """
-    from rt70.outputs import evaluate
-
-    evaluate(scene, q0, outputs, side)  # checks the side, the names, the links, the shapes
-    if side == "textbook":
-        from rt70.textbook.points import point_jacobian, point_positions
-
-        model, data = scene.textbook, scene.textbook_data
-    else:
-        from rt70.reference.points import point_jacobian, point_positions
-
-        model, data = scene.reference, scene.reference_data
-    q0 = np.asarray(q0, dtype=float)
-    jacobians: dict[tuple, np.ndarray] = {}  # J_v of each distinct point, computed once
-    rows = []
-    for o in outputs:
-        p = point_positions(model, data, q0, list(o.points))
-        G = _formula_gradient(o, p)
-        C = np.zeros((o.size, q0.size))
-        for k, (link, xyz) in enumerate(o.points):
-            if not np.any(G[:, k]):
-                continue
-            key = (link, tuple(float(x) for x in xyz))
-            if key not in jacobians:
-                jacobians[key] = point_jacobian(model, data, q0, link, xyz)[0]
-            C += G[:, k] @ jacobians[key]
-        rows.append(C)
-    return np.vstack(rows) if rows else np.zeros((0, q0.size))

@@ -205,8 +205,8 @@ def test_output_matrix_is_the_derivative(rt70, states):
     """C of both sides agree, and match central differences of the nonlinear outputs."""
     e, a, q = states["equilibrium E30 A20"]
     outs = [o for o in rt70_optics.rt70_mirror_outputs(rt70, e, a) if "misalignment" not in o.name]
-    C_tb = optics.output_matrix(rt70, q, outs, "textbook")
-    C_ref = optics.output_matrix(rt70, q, outs, "reference")
+    C_tb = outputs.output_matrix(rt70, q, outs, "textbook")
+    C_ref = outputs.output_matrix(rt70, q, outs, "reference")
     assert C_tb.shape == (sum(o.size for o in outs), 42)
     scale = float(np.max(np.abs(C_ref)))
     assert float(np.max(np.abs(C_tb - C_ref))) <= 1e-10 * scale
@@ -232,12 +232,12 @@ def test_output_matrix_refuses_what_has_no_derivative(rt70):
     outs = rt70_optics.rt70_mirror_outputs(rt70, 40.0, 0.0)
     angle = next(o for o in outs if o.name == "main_mirror_misalignment")
     with pytest.raises(Rt70Error, match="'main_mirror_misalignment' has no derivative"):
-        optics.output_matrix(rt70, q, [angle])  # |s − n5| at 0: a cone, not a plane
+        outputs.output_matrix(rt70, q, [angle])  # |s − n5| at 0: a cone, not a plane
     focus = outputs.optical_point_outputs(rt70)[0]
     hidden = outputs.Output("size", "m", 1, focus.points, lambda p: np.linalg.norm(p)[None])
     with pytest.raises(Rt70Error, match="'size' has no derivative"):
-        optics.output_matrix(rt70, q, [hidden])  # norm() drops the complex step: caught
-    same = optics.output_matrix(rt70, q, [focus])  # a position: C is J_v
+        outputs.output_matrix(rt70, q, [hidden])  # norm() drops the complex step: caught
+    same = outputs.output_matrix(rt70, q, [focus])  # a position: C is J_v
     assert (
         same.shape == (3, 42) and same[2, rt70.textbook.coordinate_names.index("platform_z")] == 1.0
     )

@@ -47,7 +47,7 @@ def test_plant_has_named_inputs_outputs_states(rt70_plant):
 
 
 def test_output_rows_match_point_jacobian(rt70_plant):
-    """The optical point's rows (central differences) equal the exact point Jacobian."""
+    """The optical point's rows (outputs.output_matrix) equal linearize's point Jacobian."""
     scene, q0, ss = rt70_plant
     lm = lin.linearize(scene, q0)
     exact = lin.point_output(lm, scene, "main_mirror", (0, 0, 13))

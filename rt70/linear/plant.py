@@ -11,7 +11,8 @@ One call, :func:`plant`, linearises a scene about a static equilibrium
   ``S·U`` (4.129)–(4.131) on the textbook side;
 - outputs are coordinates (:class:`CoordinateOutput`, an axis angle) or any
   :class:`rt70.outputs.Output` (the optical points, the mirror system's quantities),
-  linearised by central differences of the output on the textbook side.
+  linearised on the textbook side by :func:`rt70.outputs.output_matrix` (the exact point
+  Jacobians through the output's formula).
 
 :func:`to_control` hands the result to python-control as a ``StateSpace`` with its
 state, input and output names, for Bode plots, margins and loop design there. Do not
@@ -33,13 +34,9 @@ from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.linear.responses import StateSpace, state_space
 from rt70.loads import Wrench
-from rt70.outputs import Output, column_labels, evaluate
+from rt70.outputs import Output, column_labels, output_matrix
 from rt70.scene import Scene
 from rt70.textbook import points
-
-#: Central-difference step of an output's linearisation, per coordinate (m or rad): the
-#: truncation error is O(h²) ≈ 1e-12 relative, the rounding O(ε/h) ≈ 1e-10 relative.
-OUTPUT_FD_STEP = 1e-6
 
 
 @dataclass(frozen=True)
@@ -96,14 +93,7 @@ def _output_rows(
         row[0, lm.coordinates.index(y.coordinate)] = 1.0
         return row, [y.name]
     keep = lin.coordinate_indices(scene, lm.coordinates)
-    rows = np.empty((y.size, keep.size))
-    h = OUTPUT_FD_STEP
-    for j, i in enumerate(keep):
-        step = np.zeros(lm.q0.size)
-        step[i] = h
-        up = evaluate(scene, lm.q0 + step, [y], "textbook")[y.name]
-        down = evaluate(scene, lm.q0 - step, [y], "textbook")[y.name]
-        rows[:, j] = (np.ravel(up) - np.ravel(down)) / (2.0 * h)
+    rows = output_matrix(scene, lm.q0, [y], "textbook")[:, keep]
     return rows, column_labels(y.name, y.size) if y.size > 1 else [y.name]
 
 
