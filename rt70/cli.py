@@ -189,6 +189,18 @@ def _modes(args: argparse.Namespace) -> int:
 ZENITH_KEYHOLE_DEG = 89.0
 
 
+def _add_pointing_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--elevation`` and ``--azimuth`` of the RT-70 (read back by :func:`_pointing`)."""
+    parser.add_argument(
+        "--elevation",
+        type=options.elevation,
+        help="RT-70 elevation, degrees, 0 (horizon) to 90 (zenith; the default)",
+    )
+    parser.add_argument(
+        "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
+    )
+
+
 def _pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, float, float, dict]:
     """The RT-70 pointing asked for: (has axes, elevation, azimuth, held coordinates)."""
     from rt70.scenes import rt70_state
@@ -395,14 +407,7 @@ def build_parser() -> argparse.ArgumentParser:
         "the eigenfrequencies of K v = ω² M v.",
     )
     mod.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
-    mod.add_argument(
-        "--elevation",
-        type=options.elevation,
-        help="RT-70 elevation, degrees, 0 (horizon) to 90 (zenith; the default)",
-    )
-    mod.add_argument(
-        "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
-    )
+    _add_pointing_arguments(mod)
     mod.add_argument(
         "--lock-axes",
         action="store_true",
@@ -421,14 +426,7 @@ def build_parser() -> argparse.ArgumentParser:
         "StateSpace.",
     )
     pla.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
-    pla.add_argument(
-        "--elevation",
-        type=options.elevation,
-        help="RT-70 elevation, degrees, 0 (horizon) to 90 (zenith; the default)",
-    )
-    pla.add_argument(
-        "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
-    )
+    _add_pointing_arguments(pla)
     pla.add_argument("--json", action="store_true", help="print JSON")
     pla.add_argument("--out", help="write A, B, C, D and the names to FILE.npz")
     pla.set_defaults(func=_plant)

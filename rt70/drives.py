@@ -56,8 +56,11 @@ class DcDrive(StateComponent):
         ``[I, α_m, ω_m]`` at the start; default zero. :meth:`holding` gives the state
         that holds a torque at rest.
     atol : array_like, optional
-        Absolute tolerances of the three states (default 1e-9 A, 1e-9 rad, 1e-9 rad/s).
+        Absolute tolerances of the states (default 1e-9 A, rad, rad/s).
     """
+
+    #: The drive's states (after ``name:``); a subclass appends its own.
+    STATES: tuple[str, ...] = ("current", "motor_angle", "motor_speed")
 
     def __init__(
         self,
@@ -71,13 +74,14 @@ class DcDrive(StateComponent):
     ) -> None:
         if coordinate not in coordinates:
             raise Rt70Error(f"drive '{name}': no coordinate '{coordinate}'")
-        self.names = (f"{name}:current", f"{name}:motor_angle", f"{name}:motor_speed")
+        self.names = tuple(f"{name}:{state}" for state in self.STATES)
         self.index = coordinates.index(coordinate)
         self.n = len(coordinates)
         self.p = parameters
         self.voltage = voltage if callable(voltage) else (lambda t, q, qd, s, u=float(voltage): u)
-        self.initial = np.zeros(3) if initial is None else np.asarray(initial, dtype=float)
-        self.atol = np.full(3, 1e-9) if atol is None else np.asarray(atol, dtype=float)
+        k = len(self.STATES)
+        self.initial = np.zeros(k) if initial is None else np.asarray(initial, dtype=float)
+        self.atol = np.full(k, 1e-9) if atol is None else np.asarray(atol, dtype=float)
 
     @staticmethod
     def holding(parameters: DriveParameters, angle: float, torque: float) -> np.ndarray:

@@ -114,6 +114,8 @@ class ServoDrive(DcDrive):
     sidereal ramp.
     """
 
+    STATES = DcDrive.STATES + ("int_position", "int_rate", "int_current")
+
     def __init__(
         self,
         name: str,
@@ -125,16 +127,10 @@ class ServoDrive(DcDrive):
         initial=None,
         atol=None,
     ) -> None:
-        super().__init__(name, coordinates, coordinate, parameters, 0.0)
-        self.names = self.names + (
-            f"{name}:int_position",
-            f"{name}:int_rate",
-            f"{name}:int_current",
-        )
+        # the armature voltage comes from the cascade (derivative), not from a voltage law
+        super().__init__(name, coordinates, coordinate, parameters, 0.0, initial, atol)
         self.g = gains
         self.reference = reference
-        self.initial = np.zeros(6) if initial is None else np.asarray(initial, dtype=float)
-        self.atol = np.full(6, 1e-9) if atol is None else np.asarray(atol, dtype=float)
 
     def _loops(self, t: float, q: np.ndarray, s: np.ndarray):
         """References and clamps of the three loops: (errors, saturated flags, voltage)."""
