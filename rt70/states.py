@@ -131,7 +131,8 @@ class StateLayout:
         repeated = sorted({name for name in self.names if self.names.count(name) > 1})
         if repeated:
             raise Rt70Error(f"simulation states named twice: {', '.join(repeated)}")
-        self.slices: list[slice] = []
+        #: (component, its slice of x, its number of states), in state order.
+        self.placed: list[tuple[StateComponent, slice, int]] = []
         start = 2 * nv
         for c in self.components:
             k = len(c.names)
@@ -141,18 +142,12 @@ class StateLayout:
                         f"state component {type(c).__name__}: {what} must have shape ({k},), "
                         f"got {np.shape(getattr(c, what))}"
                     )
-            self.slices.append(slice(start, start + k))
+            self.placed.append((c, slice(start, start + k), k))
             start += k
         self.size = start - 2 * nv
-        #: (component, its slice of x, its number of states), in state order.
-        self.placed = [
-            (c, where, len(c.names)) for c, where in zip(self.components, self.slices, strict=True)
-        ]
         #: The components that push a force on the mechanics (override ``force``).
         self.pushing = [
-            (c, where)
-            for c, where in zip(self.components, self.slices, strict=True)
-            if type(c).force is not StateComponent.force
+            (c, where) for c, where, _ in self.placed if type(c).force is not StateComponent.force
         ]
 
     def initial(self) -> list[np.ndarray]:
