@@ -82,8 +82,10 @@ def locking_map(scene: Scene, locked: dict[str, float] | list[str]) -> Holonomic
     :func:`rt70.constraints.locking`, with the scene's name in the error for an
     unknown coordinate.
     """
-    coordinate_indices(scene, list(locked))  # the error names the scene
-    return locking(scene.textbook.coordinate_names, locked)
+    try:
+        return locking(scene.textbook.coordinate_names, locked)
+    except Rt70Error as exc:  # the same check, its message with the scene's name
+        raise Rt70Error(f"{scene.name}: {exc}") from None
 
 
 def equilibrium(
