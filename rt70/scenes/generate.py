@@ -51,16 +51,39 @@ def rt70_scene() -> str:
         1..7, direct elastic pairs as bushings, the two strut packages, gravity and the
         optical points.
     """
-    d = rt70_data
-    bodies = {b["name"]: b for b in d.LISTING_BODIES}
-    w = uw.Writer()
-    uw.begin(
-        w,
+    return _rt70_text(
         "rt70",
         "RT-70 radio telescope, 42-DOF nonlinear model (Dubarenko 2007, "
         "listing of section 4.2.3, errata in docs/rt70-errata.md)",
+        rt70_data.LISTING_BODIES,
     )
-    for body in d.LISTING_BODIES:
+
+
+def rt70_servo_scene() -> str:
+    """Build the RT-70 the drives can hold: the listing with its counterweight below the axis.
+
+    The listing puts the counterweight 16 m *above* the elevation axis, on the mirror's
+    side, so nothing balances the swinging part: its gravity moment with the axis
+    horizontal is 2.66 times the book's nominal drive torque (errata item 12). This
+    scene is the listing with the counterweight's offset mirrored to ``[0, 0, −16]`` m
+    (the only change; :data:`rt70_data.SERVO_BODIES`), the control object of issue 10.
+    """
+    return _rt70_text(
+        "rt70_servo",
+        "RT-70 radio telescope as a control object: the 42-DOF listing of section 4.2.3 "
+        "with the counterweight below the elevation axis (errata item 12 in "
+        "docs/rt70-errata.md)",
+        rt70_data.SERVO_BODIES,
+    )
+
+
+def _rt70_text(name: str, description: str, listing_bodies: Sequence[dict]) -> str:
+    """The 42-DOF RT-70 URDF text with the given bodies (the listing's or a variant)."""
+    d = rt70_data
+    bodies = {b["name"]: b for b in listing_bodies}
+    w = uw.Writer()
+    uw.begin(w, name, description)
+    for body in listing_bodies:
         uw.six_dof_body(
             w,
             body["name"],
@@ -344,6 +367,7 @@ def two_body_gravity_scene() -> str:
 #: Scene name → function returning the scene's URDF text.
 SCENES: dict[str, Callable[[], str]] = {
     "rt70": rt70_scene,
+    "rt70_servo": rt70_servo_scene,
     "rt70_elevation": rt70_elevation_scene,
     "rt70_azimuth": rt70_azimuth_scene,
     "rt70_azimuth_el90": rt70_azimuth_el90_scene,

@@ -196,6 +196,14 @@ LISTING_BODIES: tuple[dict, ...] = (
     },
 )
 
+#: The listing's bodies with the counterweight below the elevation axis, offset
+#: ``[0, 0, −16]`` m instead of the printed ``[0, 0, 16]`` (errata item 12): the
+#: ``rt70_servo`` scene, the control object the drives can hold. Nothing else changes.
+SERVO_BODIES: tuple[dict, ...] = tuple(
+    {**body, "offset": (0.0, 0.0, -16.0)} if body["name"] == "counterweight" else body
+    for body in LISTING_BODIES
+)
+
 #: Direct elastic pairs: a 6-D spring/damper acting on the pair coordinates of ``child``
 #: (diagonal entries x, y, z, rx, ry, rz; N/m, N·m/rad, N·s/m, N·m·s/rad). The zero rz
 #: stiffness of the platform is the free azimuth bearing.
