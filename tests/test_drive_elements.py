@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 import rt70.cli
-from rt70.errors import ExtensionError
+from rt70.drives import DcDrive, scene_drives
+from rt70.errors import ExtensionError, Rt70Error
 from rt70.reference import drives as ref_drives
 from rt70.scene import load_scene
 from rt70.scenes.generate import lumped_drive
@@ -236,3 +237,31 @@ def test_positive_torque_drives_both_axes_positive(servo):
     for drive in servo.description.drives:
         _, Q = ref_drives.drive_force(servo.reference, servo.reference_data, q, drive, 1.0)
         assert Q[names.index(drive.joint)] > 0.99
+
+
+# --- the scene's drives as components --------------------------------------------------
+
+
+def test_scene_drive_on_a_joint_is_the_coordinate_drive():
+    """The azimuth element as a component pushes what DcDrive(coordinate=...) pushes."""
+    scene = load_scene(TURRET)
+    rng = np.random.default_rng(2)
+    q, qd, s = rng.standard_normal(4), rng.standard_normal(4), rng.standard_normal(3)
+    for side in ("textbook", "reference"):
+        az = scene_drives(scene, side, voltage=5.0)[0]
+        plain = DcDrive("azimuth", scene.coordinate_names, "az", az.p, 5.0)
+        assert az.names == plain.names and az.index == plain.index == 0
+        assert az.force(0.0, q, qd, s) == pytest.approx(plain.force(0.0, q, qd, s), abs=1e-15)
+        assert az.derivative(0.0, q, qd, s, None) == pytest.approx(
+            plain.derivative(0.0, q, qd, s, None), rel=1e-15
+        )
+
+
+def test_scene_drives_refuse_unknown_names():
+    scene = load_scene(TURRET)
+    with pytest.raises(Rt70Error, match="no drive named ghost"):
+        scene_drives(scene, "textbook", voltage={"ghost": 1.0})
+    with pytest.raises(Rt70Error, match="unknown side 'numpy'"):
+        scene_drives(scene, "numpy")
+    with pytest.raises(Rt70Error, match="give a coordinate or a coupling"):
+        DcDrive("d", None, None, scene_drives(scene, "textbook")[0].p)
