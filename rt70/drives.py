@@ -186,6 +186,25 @@ def scene_drives(
     ]
 
 
+def scene_drive(scene, name: str):
+    """The scene's ``<rt70:drive>`` called ``name`` (:class:`rt70.urdf.Drive`).
+
+    For a drive built by hand on a scene element, e.g. a servo:
+    ``ServoDrive(name, None, None, drive_parameters(d, J), gains, reference,
+    coupling=SceneCoupling(scene, d, side))`` with ``d = scene_drive(scene, name)``.
+
+    Raises
+    ------
+    Rt70Error
+        If the scene has no drive of that name.
+    """
+    for drive in scene.description.drives:
+        if drive.name == name:
+            return drive
+    known = ", ".join(d.name for d in scene.description.drives) or "none"
+    raise Rt70Error(f"{scene.name}: no drive named {name} (drives: {known})")
+
+
 def drive_parameters(drive, load_inertia: float = 1.0, load_damping: float = 0.0):
     """:class:`DriveParameters` of a ``<rt70:drive>`` (:class:`rt70.urdf.Drive`).
 

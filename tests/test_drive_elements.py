@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import rt70.cli
-from rt70.drives import DcDrive, scene_drives
+from rt70.drives import DcDrive, scene_drive, scene_drives
 from rt70.errors import ExtensionError, Rt70Error
 from rt70.reference import drives as ref_drives
 from rt70.scene import load_scene
@@ -261,6 +261,9 @@ def test_scene_drives_refuse_unknown_names():
     scene = load_scene(TURRET)
     with pytest.raises(Rt70Error, match="no drive named ghost"):
         scene_drives(scene, "textbook", voltage={"ghost": 1.0})
+    with pytest.raises(Rt70Error, match=r"no drive named ghost \(drives: azimuth, elevation\)"):
+        scene_drive(scene, "ghost")
+    assert scene_drive(scene, "elevation").sector.link == "cw"
     with pytest.raises(Rt70Error, match="unknown side 'numpy'"):
         scene_drives(scene, "numpy")
     with pytest.raises(Rt70Error, match="give a coordinate or a coupling"):

@@ -18,7 +18,7 @@ import pytest
 
 from rt70.couplings import CoordinateCoupling, SceneCoupling
 from rt70.drive_energy import AuditedDrive, energy_balance
-from rt70.drives import DcDrive, drive_parameters, scene_drives
+from rt70.drives import DcDrive, drive_parameters, scene_drive, scene_drives
 from rt70.scene import load_scene
 from rt70.servo import ServoDrive, cascade_gains
 from rt70.simulate import simulate
@@ -114,7 +114,7 @@ def test_twist_on_the_coordinate_with_the_sector_force_breaks_the_balance(turret
 def test_servo_reads_the_drive_angle_and_its_energy_balances(turret):
     """A ServoDrive on the scene's elevation sector: its position loop reads θ_d, not the
     coordinate; the audit (voltage read back from the loop) closes the balance."""
-    el = turret.description.drives[1]
+    el = scene_drive(turret, "elevation")
     inertia = 0.5 + 3 * (0.2**2 + 0.5**2) + 0.1 + 2 * 1.1**2  # rough rigid el inertia
     p = drive_parameters(el, inertia)
     gains = cascade_gains(p, inertia, position_hz=0.3)
