@@ -1,4 +1,4 @@
-"""A DC motor driving one coordinate through a compliant reducer, as simulation states.
+"""A DC motor driving one axis through a compliant reducer, as simulation states.
 
 The drive of formalism §4.5 ((4.137)–(4.143)) on one axis: an armature circuit
 (inductance L_a, resistance R_a, back-EMF c_e ω_m), a rotor (inertia J_m, viscous D_m,
@@ -9,16 +9,19 @@ it pushes the reducer torque
 
     τ_r = C_r (α_m / i_r − α) + D_r (ω_m / i_r − α̇)
 
-on the driven coordinate (the extra-state seam's ``force``, :mod:`rt70.states`) and
-feels ``τ_r / i_r`` back on the rotor:
+on the structure as the generalised force ``τ_r ∂α/∂q`` (the extra-state seam's
+``force``, :mod:`rt70.states`) and feels ``τ_r / i_r`` back on the rotor:
 
     L_a İ = u − R_a I − c_e ω_m,   α̇_m = ω_m,   J_m ω̇_m = c_m I − D_m ω_m − τ_r / i_r.
 
-The structure's own forces (gravity, springs, the load's damping) come from the scene.
-The same drive assembled as a bond graph (:mod:`rt70.bondgraph`) and in Lagrange form
-(:func:`rt70.bondgraph.lagrange.drive_lagrange`) gives the linear equations this
-component must reproduce on a rigid load (tests/test_drives.py). Dry friction, backlash
-and the servo loops come next (issue 10).
+The angle α(q) is the drive's coupling (:mod:`rt70.couplings`): one coordinate
+(``coordinate=``), or a scene's ``<rt70:drive>`` computed on one side — a joint's
+coordinate (4.143) or a gear sector's mesh angle (4.150) — built by
+:func:`scene_drives`. The structure's own forces (gravity, springs, the load's damping)
+come from the scene. The same drive assembled as a bond graph (:mod:`rt70.bondgraph`)
+and in Lagrange form (:func:`rt70.bondgraph.lagrange.drive_lagrange`) gives the linear
+equations this component must reproduce on a rigid load (tests/test_drives.py). Dry
+friction and backlash are not modelled.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from collections.abc import Callable
 import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
+from rt70.couplings import CoordinateCoupling, SceneCoupling
 from rt70.errors import Rt70Error
 from rt70.states import MechanicsForces, StateComponent
 
@@ -36,17 +40,17 @@ Voltage = Callable[[float, np.ndarray, np.ndarray, np.ndarray], float]
 
 
 class DcDrive(StateComponent):
-    """A DC motor and compliant reducer driving one coordinate (formalism §4.5).
+    """A DC motor and compliant reducer driving one axis (formalism §4.5).
 
     Parameters
     ----------
     name : str
         Prefix of the state names (``name:current``, ``name:motor_angle``,
         ``name:motor_speed``).
-    coordinates : sequence of str
-        The scene's coordinate names (``scene.coordinate_names``).
-    coordinate : str
-        The driven coordinate (an axis angle, rad).
+    coordinates : sequence of str or None
+        The scene's coordinate names (``scene.coordinate_names``); None with ``coupling``.
+    coordinate : str or None
+        The driven coordinate (an axis angle, rad); None with ``coupling``.
     parameters : DriveParameters
         L_a, R_a, c_m, c_e, J_m, D_m, i_r, C_r, D_r (``J_l``, ``D_l`` are the scene's:
         its inertia and damping; they are not used here).
@@ -57,6 +61,9 @@ class DcDrive(StateComponent):
         that holds a torque at rest.
     atol : array_like, optional
         Absolute tolerances of the states (default 1e-9 A, rad, rad/s).
+    coupling : CoordinateCoupling or SceneCoupling, optional
+        The angle α(q) the reducer acts on (:mod:`rt70.couplings`); default the
+        coordinate ``coordinate``. :attr:`index` is its axis coordinate.
     """
 
     #: The drive's states (after ``name:``); a subclass appends its own.
@@ -71,12 +78,17 @@ class DcDrive(StateComponent):
         voltage: float | Voltage = 0.0,
         initial=None,
         atol=None,
+        *,
+        coupling: CoordinateCoupling | SceneCoupling | None = None,
     ) -> None:
-        if coordinate not in coordinates:
-            raise Rt70Error(f"drive '{name}': no coordinate '{coordinate}'")
+        if coupling is None:
+            if coordinates is None or coordinate is None:
+                raise Rt70Error(f"drive '{name}': give a coordinate or a coupling")
+            coupling = CoordinateCoupling(list(coordinates), coordinate, name)
+        self.coupling = coupling
         self.names = tuple(f"{name}:{state}" for state in self.STATES)
-        self.index = coordinates.index(coordinate)
-        self.n = len(coordinates)
+        self.index = coupling.index
+        self.n = coupling.n
         self.p = parameters
         self.voltage = voltage if callable(voltage) else (lambda t, q, qd, s, u=float(voltage): u)
         k = len(self.STATES)
@@ -93,16 +105,19 @@ class DcDrive(StateComponent):
         p = parameters
         return np.array([torque / (p.i_r * p.c_m), p.i_r * (angle + torque / p.C_r), 0.0])
 
+    def twist(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> tuple[float, float]:
+        """The reducer's twist and its rate, ``(Δ, Δ̇) = (α − α_m/i_r, α̇ − ω_m/i_r)`` (4.139)."""
+        p, c = self.p, self.coupling
+        return c.angle(q) - s[1] / p.i_r, c.rate(q, qd) - s[2] / p.i_r
+
     def reducer_torque(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> float:
-        """``τ_r = C_r (α_m/i_r − α) + D_r (ω_m/i_r − α̇)``, on the driven coordinate."""
-        p, k = self.p, self.index
-        return p.C_r * (s[1] / p.i_r - q[k]) + p.D_r * (s[2] / p.i_r - qd[k])
+        """``τ_r = C_r (α_m/i_r − α) + D_r (ω_m/i_r − α̇) = −C_r Δ − D_r Δ̇`` (4.143)."""
+        delta, rate = self.twist(q, qd, s)
+        return -self.p.C_r * delta - self.p.D_r * rate
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The reducer torque as a generalised force on the driven coordinate."""
-        Q = np.zeros(self.n)
-        Q[self.index] = self.reducer_torque(q, qd, s)
-        return Q
+        """The reducer torque as a generalised force, ``τ_r ∂α/∂q``."""
+        return self.coupling.force(q, self.reducer_torque(q, qd, s))
 
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
@@ -122,3 +137,81 @@ class DcDrive(StateComponent):
                 (p.c_m * current - p.D_m * speed - tau / p.i_r) / p.J_m,
             )
         )
+
+
+def scene_drives(
+    scene,
+    side: str,
+    voltage: float | Voltage | dict[str, float | Voltage] = 0.0,
+    load_inertia: float = 1.0,
+) -> list[DcDrive]:
+    """The scene's ``<rt70:drive>`` elements as simulation components, on one side.
+
+    Each is a :class:`DcDrive` named after the element (states ``name:current``,
+    ``name:motor_angle``, ``name:motor_speed``) with a :class:`SceneCoupling`: the
+    reducer acts on θ_d computed by ``side``'s kinematics.
+
+    Parameters
+    ----------
+    scene : rt70.scene.Scene
+        The scene.
+    side : {"textbook", "reference", "pinocchio"}
+        The side whose kinematics computes θ_d (use the simulation's backend).
+    voltage : float, callable or dict
+        Armature voltage of every drive, or a dict by drive name (missing: 0 V).
+    load_inertia : float
+        ``J_l`` of the :class:`DriveParameters` (not used by the drive; the scene's
+        inertia is the load).
+
+    Raises
+    ------
+    Rt70Error
+        If ``voltage`` names a drive the scene does not have.
+    """
+    drives = scene.description.drives
+    volts = voltage if isinstance(voltage, dict) else {d.name: voltage for d in drives}
+    unknown = sorted(set(volts) - {d.name for d in drives})
+    if unknown:
+        raise Rt70Error(f"{scene.name}: no drive named {', '.join(unknown)}")
+    return [
+        DcDrive(
+            d.name,
+            None,
+            None,
+            drive_parameters(d, load_inertia),
+            volts.get(d.name, 0.0),
+            coupling=SceneCoupling(scene, d, side),
+        )
+        for d in drives
+    ]
+
+
+def scene_drive(scene, name: str):
+    """The scene's ``<rt70:drive>`` called ``name`` (:class:`rt70.urdf.Drive`).
+
+    For a drive built by hand on a scene element, e.g. a servo:
+    ``ServoDrive(name, None, None, drive_parameters(d, J), gains, reference,
+    coupling=SceneCoupling(scene, d, side))`` with ``d = scene_drive(scene, name)``.
+
+    Raises
+    ------
+    Rt70Error
+        If the scene has no drive of that name.
+    """
+    for drive in scene.description.drives:
+        if drive.name == name:
+            return drive
+    known = ", ".join(d.name for d in scene.description.drives) or "none"
+    raise Rt70Error(f"{scene.name}: no drive named {name} (drives: {known})")
+
+
+def drive_parameters(drive, load_inertia: float = 1.0, load_damping: float = 0.0):
+    """:class:`DriveParameters` of a ``<rt70:drive>`` (:class:`rt70.urdf.Drive`).
+
+    The load's ``J_l``, ``D_l`` are not in the element (the scene is the load): pass
+    them when a design needs them (:func:`rt70.servo.cascade_gains` takes its own).
+    """
+    keys = ("L_a", "R_a", "c_m", "c_e", "J_m", "D_m", "i_r", "C_r", "D_r")
+    return DriveParameters(
+        **{k: getattr(drive, k) for k in keys}, J_l=load_inertia, D_l=load_damping
+    )

@@ -109,6 +109,8 @@ def cascade_gains(
 class ServoDrive(DcDrive):
     """A DC drive closed by the current–rate–position cascade on its coordinate.
 
+    The position loop reads the drive's angle (``coupling.angle``: the coordinate, or a
+    scene drive's θ_d; pass ``coupling=`` as to :class:`rt70.drives.DcDrive`).
     States: the drive's ``[I, α_m, ω_m]`` then the integrals of the position, rate and
     current errors. The position reference is ``reference(t)`` (rad), e.g. a step or a
     sidereal ramp.
@@ -126,16 +128,20 @@ class ServoDrive(DcDrive):
         reference,
         initial=None,
         atol=None,
+        *,
+        coupling=None,
     ) -> None:
         # the armature voltage comes from the cascade (derivative), not from a voltage law
-        super().__init__(name, coordinates, coordinate, parameters, 0.0, initial, atol)
+        super().__init__(
+            name, coordinates, coordinate, parameters, 0.0, initial, atol, coupling=coupling
+        )
         self.g = gains
         self.reference = reference
 
     def _loops(self, t: float, q: np.ndarray, s: np.ndarray):
         """References and clamps of the three loops: (errors, saturated flags, voltage)."""
         g, p = self.g, self.p
-        e_p = float(self.reference(t)) - q[self.index]
+        e_p = float(self.reference(t)) - self.coupling.angle(q)
         rate_ref = g.kp_p * e_p + g.ki_p * s[3]
         sat_p = abs(rate_ref) > g.rate_limit
         rate_ref = float(np.clip(rate_ref, -g.rate_limit, g.rate_limit))

@@ -2,7 +2,9 @@
 
 For each scene and each of N random states (q, q̇) both sides compute the same
 quantities — the dynamics, the positions of the links' origins and of the scene's
-optical points (:mod:`rt70.outputs`) and the generalised force of a random load (:mod:`rt70.loads`);
+optical points (:mod:`rt70.outputs`), the generalised force of a random load (:mod:`rt70.loads`)
+and the angle and generalised force at unit torque of the scene's drives (``<rt70:drive>``)
+and of a random gear sector;
 every row of the report gives the largest absolute error, the largest
 error relative to the reference's max-norm, and the mean wall time per evaluation of
 each side.
@@ -21,7 +23,9 @@ from rt70.errors import Rt70Error
 from rt70.loads import Wrench
 from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
 from rt70.scene import Scene, require_coordinates
+from rt70.textbook import drives as tb_drives
 from rt70.textbook import dynamics, forces, points
+from rt70.urdf.description import DRIVE_PARAMETERS, Drive, DriveSector
 
 #: Default agreement tolerance, relative to the reference's max-norm.
 DEFAULT_TOLERANCE = 1e-10
@@ -38,6 +42,7 @@ QUANTITIES = (
     "potential_energy",
     "points",
     "load_force",
+    "drives",
 )
 
 
@@ -103,6 +108,30 @@ def state_wrench(scene: Scene, q: np.ndarray) -> Wrench:
     return random_wrench(scene, np.random.default_rng(bits))
 
 
+def state_drive(scene: Scene, q: np.ndarray) -> Drive:
+    """A random gear-sector drive compared at the state q (row ``drives``).
+
+    Seeded from q as :func:`state_wrench`: the sector on a moving link drawn uniformly,
+    its stator another link with a frame (the ground too), mesh point within ±1 m,
+    random unit tangent and an axis normal to it, radius in [0.5, 2] m. Only its
+    geometry is used (the motor's parameters are ones), so every scene has a drive to
+    compare.
+    """
+    bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
+    rng = np.random.default_rng(bits[::-1].copy())
+    frames = scene.textbook.link_frames
+    moving = [name for name, (body, _, _) in frames.items() if body >= 0]
+    link = moving[int(rng.integers(len(moving)))]
+    others = [name for name, (body, _, _) in frames.items() if body != frames[link][0]]
+    stator = others[int(rng.integers(len(others)))] if others else scene.description.root
+    xyz, direction, axis = rng.uniform(-1.0, 1.0, (3, 3))
+    direction /= np.linalg.norm(direction)
+    axis -= (axis @ direction) * direction
+    axis /= np.linalg.norm(axis)
+    sector = DriveSector(link, xyz, direction, axis, float(rng.uniform(0.5, 2.0)), stator)
+    return Drive("probe", "", *np.ones(len(DRIVE_PARAMETERS)), sector=sector)
+
+
 def compared_points(scene: Scene) -> list[Output]:
     """The positions compared in row ``points``.
 
@@ -139,12 +168,14 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     The load of ``load_force`` is :func:`state_wrench`.
     """
     from rt70 import reference
+    from rt70.reference import drives as ref_drives
     from rt70.reference import points as ref_points
 
     tm, td = scene.textbook, scene.textbook_data
     ref, rd = scene.reference, scene.reference_data
     wrench = state_wrench(scene, q)
     located = compared_points(scene)
+    compared_drives = [*scene.description.drives, state_drive(scene, q)]
 
     def tb_forward():
         Qc, Qd = forces.spring_damper_force(tm, td, q, qd)
@@ -190,7 +221,17 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: points.generalized_force(tm, td, q, wrench),
             lambda: ref_points.generalized_force(ref, rd, q, wrench),
         ),
+        # θ_d and Q at unit reducer torque (4.143), (4.150): the scene's drives and a probe
+        "drives": (
+            lambda: _stacked_drives(tb_drives.drive_force, tm, td, q, compared_drives),
+            lambda: _stacked_drives(ref_drives.drive_force, ref, rd, q, compared_drives),
+        ),
     }
+
+
+def _stacked_drives(drive_force: Callable, model, data, q: np.ndarray, drives) -> np.ndarray:
+    """One side's ``[θ_d, Q]`` at unit torque of every drive, stacked."""
+    return np.concatenate([np.hstack(drive_force(model, data, q, d)) for d in drives])
 
 
 #: Every value is measured against at least this fraction of its natural scale: with the
@@ -278,6 +319,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "potential_energy": g0 + reference.spring_potential(ref, rd, q),
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
         "load_force": _load_scale(scene, q),
+        "drives": norm("drives"),
     }
 
 

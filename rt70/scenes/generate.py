@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from rt70.atomic import atomic_write_text
-from rt70.scenes import mechanisms, rt70_data
+from rt70.scenes import mechanisms, rt70_data, rt70_drives
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.pairs import pair_joint_names
 from rt70.scenes.urdf_writer import ROOT_LINK, ZERO3, check_name, fmt, fmt_vec
@@ -66,19 +66,85 @@ def rt70_servo_scene() -> str:
     side, so nothing balances the swinging part: its gravity moment with the axis
     horizontal is 2.66 times the book's nominal drive torque (errata item 12). This
     scene is the listing with the counterweight's offset mirrored to ``[0, 0, −16]`` m
-    (the only change; :data:`rt70_data.SERVO_BODIES`), the control object of issue 10.
+    (:data:`rt70_data.SERVO_BODIES`), the control object of issue 10, with its two
+    drives (``<rt70:drive>``, :func:`_servo_drives`).
     """
     return _rt70_text(
         "rt70_servo",
         "RT-70 radio telescope as a control object: the 42-DOF listing of section 4.2.3 "
         "with the counterweight below the elevation axis (errata item 12 in "
-        "docs/rt70-errata.md)",
+        "docs/rt70-errata.md) and the azimuth and elevation drives",
         rt70_data.SERVO_BODIES,
+        drives=_servo_drives,
     )
 
 
-def _rt70_text(name: str, description: str, listing_bodies: Sequence[dict]) -> str:
-    """The 42-DOF RT-70 URDF text with the given bodies (the listing's or a variant)."""
+def lumped_drive(axis: rt70_drives.AxisDrive) -> dict[str, float]:
+    """One equivalent motor for an axis's ``n`` identical motors on one armature voltage.
+
+    The motors drive the axis through their own gear trains with the same ratio, so
+    they turn at one speed: ``n`` armatures in parallel carry ``n`` times the current of
+    one, with the same EMF, and their rotors add up. The equivalent motor has
+    ``L_a / n``, ``R_a / n``, the same ``c_m``, ``c_e``, and ``n J_m``, ``n D_m``
+    (its nominal torque, ``c_m`` times ``n`` rated currents, is ``n`` motors' torque;
+    its reflected inertia ``n J_m i_r²`` is docs/drives.md's ``*.reflected_inertia``).
+    The reducer's stiffness and damping are the axis's (axis-referred, both trains).
+    The counter-torque of the two trains (backlash remedy) is not modelled here.
+    """
+    m, n = axis.motor, axis.motors_per_axis
+    return {
+        "L_a": m.armature_inductance / n,
+        "R_a": m.armature_resistance / n,
+        "c_m": m.torque_constant,
+        "c_e": m.back_emf_constant,
+        "J_m": n * m.rotor_inertia,
+        "D_m": n * m.viscous_friction,
+        "i_r": axis.reducer.ratio,
+        "C_r": axis.reducer.stiffness,
+        "D_r": axis.reducer.damping,
+    }
+
+
+def _servo_drives(w: uw.Writer) -> None:
+    """The RT-70's azimuth and elevation drives (book 4.1.7, Fig. 4.8; docs/drives.md).
+
+    Azimuth: the reducer torque about ``platform_rz``'s axis, on the platform (4.143).
+    Elevation: a gear sector of radius 16 m on the counterweight (4.150), meshing with a
+    pinion on the platform at the counterweight's origin, 16 m below the elevation axis
+    (``base_rx``): its tangent is the counterweight's +y, which a positive ``base_rx``
+    turns positively about x, so a positive motor angle raises ``base_rx``.
+    """
+    w.comment("Drives (section 4.1.7; parameters: docs/drives.md, lumped motors)")
+    az, el = rt70_drives.AZIMUTH_DRIVE, rt70_drives.ELEVATION_DRIVE
+    for axis, joint in ((az, "platform_rz"), (el, "base_rx")):
+        attrs = [("name", axis.name), ("joint", joint)]
+        attrs += [(key, fmt(value)) for key, value in lumped_drive(axis).items()]
+        if axis.sector_radius is None:
+            w.empty("rt70:drive", *attrs)
+            continue
+        w.open("rt70:drive", *attrs)
+        w.empty(
+            "rt70:sector",
+            ("link", "counterweight"),
+            ("xyz", fmt_vec(ZERO3)),
+            ("direction", "0 1 0"),
+            ("axis", "1 0 0"),
+            ("radius", fmt(axis.sector_radius)),
+            ("stator", "platform"),
+        )
+        w.close("rt70:drive")
+
+
+def _rt70_text(
+    name: str,
+    description: str,
+    listing_bodies: Sequence[dict],
+    drives: Callable[[uw.Writer], None] | None = None,
+) -> str:
+    """The 42-DOF RT-70 URDF text with the given bodies (the listing's or a variant).
+
+    ``drives`` writes the scene's ``<rt70:drive>`` elements, after the optical points.
+    """
     d = rt70_data
     bodies = {b["name"]: b for b in listing_bodies}
     w = uw.Writer()
@@ -137,6 +203,8 @@ def _rt70_text(name: str, description: str, listing_bodies: Sequence[dict]) -> s
             ("link", check_name(point["link"])),
             ("xyz", fmt_vec(point["xyz"])),
         )
+    if drives is not None:
+        drives(w)
     return uw.end(w)
 
 

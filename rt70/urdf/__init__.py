@@ -9,6 +9,8 @@ points) from here. Nothing in this package imports Pinocchio.
 from rt70.urdf.coordinates import coordinate_names
 from rt70.urdf.description import (
     Bushing,
+    Drive,
+    DriveSector,
     FrameRef,
     Inertial,
     InertiaRepair,
@@ -24,6 +26,8 @@ from rt70.urdf.reader import RT70_NS, read_urdf, read_urdf_string
 __all__ = [
     "RT70_NS",
     "Bushing",
+    "Drive",
+    "DriveSector",
     "FrameRef",
     "Inertial",
     "InertiaRepair",

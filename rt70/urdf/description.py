@@ -138,6 +138,64 @@ class OpticalPoint:
     xyz: np.ndarray
 
 
+#: Motor and reducer parameters of a ``<rt70:drive>``, in the order of
+#: :class:`rt70.bondgraph.parameters.DriveParameters` (without the load's ``J_l``, ``D_l``).
+DRIVE_PARAMETERS = ("L_a", "R_a", "c_m", "c_e", "J_m", "D_m", "i_r", "C_r", "D_r")
+
+
+@dataclass(frozen=True)
+class DriveSector:
+    """Where an elevation-type drive acts: a gear sector on a link, a pinion on a stator.
+
+    The sector belongs to ``link``; it meshes with a pinion carried by ``stator`` at the
+    mesh point ``xyz`` (``link`` frame, in the construction q = 0). ``direction`` is the
+    unit tangent of the pitch circle there and ``axis`` the unit axis of the circle,
+    both in the ``link`` frame; ``radius`` its radius r. The circle's centre is
+    ``xyz + r (axis × direction)`` (docs/urdf-extensions.md, ``<rt70:drive>``).
+    """
+
+    link: str
+    xyz: np.ndarray
+    direction: np.ndarray
+    axis: np.ndarray
+    radius: float
+    stator: str
+
+
+@dataclass(frozen=True)
+class Drive:
+    """A DC motor and compliant reducer driving one axis (formalism §4.5, (4.137)–(4.150)).
+
+    Attributes
+    ----------
+    name : str
+        The drive's name.
+    joint : str
+        The driven axis' 1-DOF joint (its coordinate is the axis angle a servo reads).
+    L_a, R_a, c_m, c_e, J_m, D_m, i_r, C_r, D_r : float
+        Armature inductance and resistance, torque and back-EMF constants, rotor inertia
+        and viscous friction, reducer ratio (motor / axis angle), reducer stiffness and
+        damping (axis side); as :class:`rt70.bondgraph.parameters.DriveParameters`.
+    sector : DriveSector or None
+        None: the reducer torque acts about the joint's axis (on the joint's child, its
+        reaction on the parent), a generalised force on the joint's coordinate (4.143);
+        a sector: the torque K acts as the force K/r at the mesh (4.150).
+    """
+
+    name: str
+    joint: str
+    L_a: float
+    R_a: float
+    c_m: float
+    c_e: float
+    J_m: float
+    D_m: float
+    i_r: float
+    C_r: float
+    D_r: float
+    sector: DriveSector | None = None
+
+
 @dataclass(frozen=True)
 class RobotDescription:
     """Everything rt70 reads from one URDF scene.
@@ -164,6 +222,8 @@ class RobotDescription:
         Named output points.
     inertia_repairs : list of InertiaRepair
         Inertias repaired on request (``balance_inertia``), in document order.
+    drives : list of Drive
+        Motor drives of the axes (``<rt70:drive>``), in document order.
     """
 
     name: str
@@ -176,6 +236,7 @@ class RobotDescription:
     joint_springs: list[JointSpring] = field(default_factory=list)
     optical_points: list[OpticalPoint] = field(default_factory=list)
     inertia_repairs: list[InertiaRepair] = field(default_factory=list)
+    drives: list[Drive] = field(default_factory=list)
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

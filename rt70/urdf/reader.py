@@ -35,6 +35,7 @@ from rt70.urdf.description import (
     OpticalPoint,
     RobotDescription,
 )
+from rt70.urdf.drives import read_drive
 from rt70.urdf.inertia import balanced_moments, inertia_defect, principal_moments
 from rt70.urdf.text import (
     EXPAND_XACRO,
@@ -57,7 +58,7 @@ ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
 #: any term of the equations of motion multiplies, so no evaluation can overflow.
 MAX_MAGNITUDE = 1e30
 
-_EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point")
+_EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point", "drive")
 _ZERO3 = np.zeros(3)
 
 
@@ -423,6 +424,8 @@ class _Reader:
                 desc.bushings.append(self.bushing(elem, desc))
             elif kind == "strut_package":
                 desc.bushings.extend(self.strut_package(elem, desc))
+            elif kind == "drive":
+                desc.drives.append(read_drive(self, elem, desc, joints))
             else:
                 name = self.name_of(elem)
                 link = self.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")

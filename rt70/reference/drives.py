@@ -1,0 +1,97 @@
+"""A scene drive's angle θ_d and generalised force on the reference side (formalism §4.5).
+
+The same quantities as :mod:`rt70.textbook.drives`, from Pinocchio's own kinematics:
+
+- a torque drive on a joint (4.143): the joint's torque enters Pinocchio's ``tau`` at
+  the joint's velocity index and is mapped to the book's coordinates, ``Q = Jᵀ τ``
+  (:func:`rt70.reference.coordinates.to_pinocchio`); θ_d is Pinocchio's joint
+  configuration (an angle, or atan2 of the cos/sin of a continuous joint);
+- a gear sector (4.150): the link's and the stator's placements ``oMi · placement``
+  (``pin.forwardKinematics``) give the mesh angle of :class:`rt70.loads.SectorMesh`;
+  the mesh Wrenches become ``Q = Jᵀ f`` by :func:`rt70.reference.points.generalized_force`.
+
+Independent of the textbook side.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from rt70.errors import UnknownLinkError
+from rt70.loads import Pose, SectorMesh
+from rt70.reference.coordinates import to_pinocchio
+from rt70.reference.model import ReferenceData, ReferenceModel
+from rt70.reference.points import generalized_force
+from rt70.urdf.description import Drive
+
+
+def link_pose(model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: str) -> Pose:
+    """Rotation and origin of ``link``'s frame in ground axes at q (Pinocchio's placements)."""
+    m, d = model.pin_model, data.pin_data
+    if not m.existBodyName(link):
+        raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
+    frame = m.frames[m.getBodyId(link)]
+    qp = to_pinocchio(model, q)[0]
+    pin.forwardKinematics(m, d, qp)
+    placed = d.oMi[frame.parentJoint] * frame.placement
+    return placed.rotation.copy(), placed.translation.copy()
+
+
+def sector_mesh(model: ReferenceModel, data: ReferenceData, drive: Drive) -> SectorMesh:
+    """The sector's pitch circle in the stator frame, from Pinocchio's poses at q = 0."""
+    s = drive.sector
+    q0 = np.zeros(model.nv)
+    link, stator = link_pose(model, data, q0, s.link), link_pose(model, data, q0, s.stator)
+    return SectorMesh.at_construction(s.xyz, s.direction, s.axis, s.radius, link, stator)
+
+
+def _joint_torque(
+    model: ReferenceModel, q: np.ndarray, joint: str, torque: float
+) -> tuple[float, np.ndarray]:
+    """θ_d and ``Q = Jᵀ τ`` of a torque on Pinocchio's joint ``joint``."""
+    m = model.pin_model
+    jm = m.joints[m.getJointId(joint)]
+    qp, _, J, _ = to_pinocchio(model, q)
+    if jm.nq == 2:  # continuous: (cos, sin)
+        angle = float(np.arctan2(qp[jm.idx_q + 1], qp[jm.idx_q]))
+    else:
+        angle = float(qp[jm.idx_q])
+    tau = np.zeros(m.nv)
+    tau[jm.idx_v] = torque
+    return angle, tau if J is None else J.T @ tau
+
+
+def drive_angle(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, drive: Drive, mesh=None
+) -> float:
+    """θ_d at q, rad: the joint's configuration, or the sector's mesh angle."""
+    if drive.sector is None:
+        return _joint_torque(model, q, drive.joint, 0.0)[0]
+    s = drive.sector
+    mesh = sector_mesh(model, data, drive) if mesh is None else mesh
+    link, stator = link_pose(model, data, q, s.link), link_pose(model, data, q, s.stator)
+    return mesh.angle(s.xyz, link, stator)[0]
+
+
+def drive_force(
+    model: ReferenceModel,
+    data: ReferenceData,
+    q: np.ndarray,
+    drive: Drive,
+    torque: float = 1.0,
+    mesh=None,
+) -> tuple[float, np.ndarray]:
+    """``(θ_d, Q)`` at q: the angle and the generalised force of the reducer torque K.
+
+    ``Q = Jᵀ τ`` of the joint torque (4.143), or ``Jᵀ f`` of the mesh force and its
+    reaction (4.150), ``K ∂θ_d/∂q``; with ``torque = 1`` Q is the gradient.
+    """
+    if drive.sector is None:
+        return _joint_torque(model, q, drive.joint, torque)
+    s = drive.sector
+    mesh = sector_mesh(model, data, drive) if mesh is None else mesh
+    link, stator = link_pose(model, data, q, s.link), link_pose(model, data, q, s.stator)
+    angle = mesh.angle(s.xyz, link, stator)[0]
+    wrenches = mesh.wrenches(s.link, s.stator, s.xyz, torque, link, stator)
+    return angle, sum(generalized_force(model, data, q, w) for w in wrenches)
