@@ -117,6 +117,9 @@ def _modes(args: argparse.Namespace) -> int:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
             q0 = lin.equilibrium(scene, held)
             model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
+            drives = bool(scene.description.drives) and not args.lock_axes
+            if drives:  # the motors held: the reducers hold the axes (locked rotor)
+                model = lin.locked_rotor(scene, model)
     except SingularConfigurationError as exc:  # a state on the way: name the scene
         raise SingularConfigurationError(f"{scene.name}: {exc}") from None
     require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
@@ -151,11 +154,20 @@ def _modes(args: argparse.Namespace) -> int:
         "proportional": bool(result.proportional),
     }
     if args.json:
-        out = {"scene": scene.name, "held": held, "modes": rows, "damped": damped_summary}
+        out = {
+            "scene": scene.name,
+            "held": held,
+            "locked_rotor": drives,
+            "modes": rows,
+            "damped": damped_summary,
+        }
         print(json.dumps(out, indent=2))
         return 0
     where = f", elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
     axes = " (axes locked)" if args.lock_axes and held else ""
+    if drives:
+        names = ", ".join(d.name for d in scene.description.drives)
+        axes = f" (locked rotor: the motors of {names} held, their reducers hold the axes)"
     print(f"{scene.name}: {len(rows)} modes at static equilibrium{where}{axes}")
     print(f"{'mode':>4} {'f, Hz':>10} {'ξ':>8}  {'kind':<8} dominant coordinate (energy)")
     for r in rows:
@@ -403,8 +415,10 @@ def build_parser() -> argparse.ArgumentParser:
         "modes",
         help="eigenfrequencies and mode shapes at static equilibrium",
         description="Linearise a scene at its static equilibrium under gravity (the "
-        "RT-70 at a given pointing, its drives holding azimuth and elevation) and print "
-        "the eigenfrequencies of K v = ω² M v.",
+        "RT-70 at a given pointing, held there) and print the eigenfrequencies of "
+        "K v = ω² M v. A scene with <rt70:drive> elements (rt70_servo) gives its "
+        "locked-rotor spectrum: the motors held, the reducers' stiffness holding the axes. "
+        "Without drives (rt70, the listing) the axes are free unless --lock-axes.",
     )
     mod.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
     _add_pointing_arguments(mod)

@@ -175,6 +175,39 @@ def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Lin
     )
 
 
+def locked_rotor(scene: Scene, lm: Linearization) -> Linearization:
+    """The linear model with every scene drive's motor held: the locked-rotor structure.
+
+    A drive (``<rt70:drive>``, formalism §4.5) whose rotor does not turn holds its axis
+    through the reducer: the twist ``Δ = θ_d(q) − α_m / i_r`` with α_m fixed adds the
+    spring ``C_r g gᵀ`` and the damper ``D_r g gᵀ`` to K and D, with ``g = ∂θ_d/∂q`` at
+    q0 (:func:`rt70.textbook.drives.drive_force` at unit torque; for a torque drive g is
+    the unit vector of its coordinate). The spectrum of this model is the locked-rotor
+    spectrum servo engineers compare (docs/drives.md §3). The geometric stiffness of the
+    reducer's static pre-torque through the sector's curvature is left out: K₀ ∂²θ_d/∂q²
+    with K₀ ≲ 2·10⁷ N·m and curvature ~1/r² is some 10⁻⁵ of ``C_r``.
+    """
+    from rt70.textbook.drives import drive_force
+
+    model, data = scene.textbook, scene.textbook_data
+    columns = coordinate_indices(scene, lm.coordinates)
+    K, D = lm.K.copy(), lm.D.copy()
+    for drive in scene.description.drives:
+        g = drive_force(model, data, lm.q0, drive)[1][columns]
+        K += drive.C_r * np.outer(g, g)
+        D += drive.D_r * np.outer(g, g)
+    return Linearization(
+        scene=lm.scene,
+        q0=lm.q0,
+        coordinates=lm.coordinates,
+        M=lm.M,
+        K=K,
+        D=D,
+        K_gravity=lm.K_gravity,
+        locked=lm.locked,
+    )
+
+
 def _gravity_stiffness(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
     """``−∂Q_g/∂q`` by central differences (the geometric stiffness of gravity)."""
     model, data = scene.textbook, scene.textbook_data
