@@ -45,20 +45,25 @@ def plants():
     return locked, free
 
 
-@pytest.mark.parametrize("order", [4, 8, 16])
-def test_balanced_truncation_error_lies_between_its_bounds(plants, order):
-    """σ_{k+1} ≤ ‖G − G_r‖∞ ≤ 2 Σ_{i>k} σ_i (Glover) on the locked plant.
+@pytest.mark.parametrize(("which", "order"), [(0, 4), (0, 8), (0, 16), (1, 8), (1, 16), (1, 24)])
+def test_balanced_truncation_error_lies_between_its_bounds(plants, which, order):
+    """σ_{k+1} ≤ ‖G − G_r‖∞ ≤ 2 Σ_{i>k} σ_i (Glover) over the stable part's σ_i.
 
-    Measured: order 4: 0.60 (σ_5 = 0.30, bound 1.59); 8: 0.0249 (0.0122, 0.112);
-    16: 2.58e-3 (1.35e-3, 8.09e-3), in mm or arcsec per kN.
+    Measured, locked (mm or arcsec per kN): order 4: 0.60 (σ_5 = 0.30, bound 1.59);
+    8: 0.0249 (0.0122, 0.112); 16: 2.58e-3 (1.35e-3, 8.09e-3). Free (arcsec or mm per
+    MN·m; the rigid azimuth's 2 states kept whole): 8: 12.7 (5.65, 55.1); 16: 0.553
+    (0.343, 2.75); 24: 0.0403 (0.0111, 0.0490) — above the split's own floor of 0.040
+    (1.6e-10 of ‖G‖∞) only because of the principal coordinates of ``_conditioned``:
+    in the physical ones the floor was 24.7 and the bound failed from order 12 on.
     """
-    locked, _ = plants
-    red = rd.balanced_truncation(locked, order)
-    err = rd.hinf_error(locked, red.ss)
-    assert red.order == red.ss.n_states == order and red.n_unstable == 0
-    assert red.hsv[order] <= err.peak <= red.bound
-    assert red.ss.input_names == locked.input_names
-    assert red.ss.output_names == locked.output_names
+    ss = plants[which]
+    red = rd.balanced_truncation(ss, order)
+    err = rd.hinf_error(ss, red.ss)
+    assert red.order == red.ss.n_states == order and red.n_unstable == 2 * which
+    k = order - red.n_unstable
+    assert red.hsv[k] <= err.peak <= red.bound
+    assert red.ss.input_names == ss.input_names
+    assert red.ss.output_names == ss.output_names
 
 
 def test_modal_truncation_keeps_the_static_gain_and_all_modes_are_exact(plants):

