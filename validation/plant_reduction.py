@@ -43,7 +43,7 @@ ARCSEC = 206264.80624709636
 ELEVATION, AZIMUTH = 45.0, 0.0
 UNITS = {"locked": "mm or arcsec per kN", "free": "arcsec or mm per MN·m"}
 LABELS = {"modal": "modal truncation + static correction", "balanced": "balanced truncation"}
-BODE = ("locked", "wind_y", "pointing_correction:0", 8, 16)  # plant, in, out, r, order
+BODE = ("locked", "wind_y", "pointing_correction:1", 8, 16)  # plant, in, out, r, order
 
 
 def plants() -> dict[str, StateSpace]:
@@ -151,9 +151,23 @@ def figure(rows: list[dict], full: dict[str, StateSpace], floors: dict[str, rd.H
             )
         sel = [r for r in rows if r["plant"] == name and r["method"] == "balanced"]
         orders = [r["order"] for r in sel]
-        ax.semilogy(orders, [r["bound_2sum"] for r in sel], "k--", lw=1, label="bound 2Σσ_i, i>k")
-        ax.semilogy(orders, [r["hsv_next"] for r in sel], "k:", lw=1, label="σ_{k+1} (lower bound)")
-        ax.axhline(floors[name].peak, color="grey", lw=0.8, ls="-.", label="numerical floor")
+        ax.semilogy(
+            orders,
+            [r["bound_2sum"] for r in sel],
+            "k--",
+            lw=1,
+            label=r"bound $2\sum_{i>k}\sigma_i$",
+        )
+        ax.semilogy(
+            orders, [r["hsv_next"] for r in sel], "k:", lw=1, label=r"$\sigma_{k+1}$ (lower bound)"
+        )
+        ax.axhline(
+            floors[name].peak,
+            color="grey",
+            lw=0.8,
+            ls="-.",
+            label="numerical floor (split, no truncation)",
+        )
         ax.set_xlabel("order of the reduced plant (states)")
         ax.set_ylabel(f"‖G − G_r‖∞ ({UNITS[name]})")
         n = full[name].n_states
