@@ -241,6 +241,13 @@ def _plant(args: argparse.Namespace) -> int:
     from rt70.outputs import optical_point_outputs
     from rt70.scene import load_scene
 
+    method = args.method or "balanced"
+    if args.method is not None and args.reduce is None:
+        raise Rt70Error("--method needs --reduce N")
+    if method == "modal" and args.reduce is not None and args.reduce % 2:
+        raise Rt70Error(
+            f"--reduce {args.reduce}: modal truncation keeps whole modes, 2 states each"
+        )
     scene = load_scene(args.scene)
     has_axes, elevation, azimuth, held = _pointing(args, scene, "plant")
     names = scene.textbook.coordinate_names
@@ -278,6 +285,26 @@ def _plant(args: argparse.Namespace) -> int:
         "units": "inputs N or N·m; angles rad, points m, focal_offset mm, "
         "pointing_correction arcsec (Δα, Δβ); states m, rad and their rates",
     }
+    if args.reduce is not None:  # modal or balanced truncation, and what it costs
+        from rt70.linear import reduce as rd
+
+        full = ss
+        red = (
+            rd.modal_truncation(ss, args.reduce // 2)
+            if method == "modal"
+            else rd.balanced_truncation(ss, args.reduce)
+        )
+        ss, err = red.ss, rd.hinf_error(full, red.ss)
+        info["states"] = list(ss.state_names)
+        info["reduced"] = {
+            "method": method,
+            "order": red.order,
+            "full_order": full.n_states,
+            "hinf_error": err.peak,
+            "hinf_error_relative": err.relative,
+            "peak_hz": err.freq_hz,
+            "bound_2sum_hsv": red.bound,
+        }
     if args.out:
         from rt70.atomic import atomic_write
 
@@ -295,6 +322,14 @@ def _plant(args: argparse.Namespace) -> int:
     )
     print("  inputs:  " + ", ".join(ss.input_names))
     print("  outputs: " + ", ".join(ss.output_names))
+    if args.reduce is not None:
+        r = info["reduced"]
+        bound = "" if r["bound_2sum_hsv"] is None else f" (bound 2Σσ {r['bound_2sum_hsv']:.3g})"
+        print(
+            f"  reduced by {r['method']} truncation to {r['order']} states: H∞ error "
+            f"{r['hinf_error']:.3g}{bound}, {r['hinf_error_relative']:.2e} of ‖G‖∞, "
+            f"peak at {r['peak_hz']:.3g} Hz (in the outputs' units per input unit)"
+        )
     if args.out:
         print(f"wrote {args.out}")
     return 0
@@ -443,6 +478,18 @@ def build_parser() -> argparse.ArgumentParser:
     _add_pointing_arguments(pla)
     pla.add_argument("--json", action="store_true", help="print JSON")
     pla.add_argument("--out", help="write A, B, C, D and the names to FILE.npz")
+    pla.add_argument(
+        "--reduce",
+        type=options.positive_int,
+        metavar="N",
+        help="reduce to N states and print the H∞ error (--out writes the reduced plant)",
+    )
+    pla.add_argument(
+        "--method",
+        choices=("modal", "balanced"),
+        help="with --reduce: modal truncation with static correction, or balanced "
+        "truncation by Hankel singular values (default)",
+    )
     pla.set_defaults(func=_plant)
     sim = sub.add_parser(
         "simulate",

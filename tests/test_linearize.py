@@ -30,7 +30,7 @@ def test_gravity_stiffness_matches_pinocchio_analytic(rt70):
     """The finite-difference geometric stiffness equals −∂Q_g/∂q from Pinocchio's derivatives."""
     rng = np.random.default_rng(3)
     q = rng.uniform(-0.3, 0.3, rt70.textbook.nv)
-    K_g = lin._gravity_stiffness(rt70, q)
+    K_g = lin._gravity_stiffness(rt70, q, side="textbook")
     ref, pd = rt70.reference, rt70.reference_data.pin_data
     qp, _, J, _ = reference.to_pinocchio(ref, q)
     dg = pin.computeGeneralizedGravityDerivatives(ref.pin_model, pd, qp)  # ∂g/∂q, g = −Q_g

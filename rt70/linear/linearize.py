@@ -5,12 +5,20 @@ springs (formalism §4.3–§4.4):
 
 - ``M = A(q0)`` (4.79);
 - ``K = −∂(Q_g + Q_c)/∂q`` at q0 — the springs' stiffness plus the geometric stiffness
-  of gravity — by **central finite differences** of the textbook forces (step
+  of gravity — by **central finite differences** of the static forces (step
   ``h = 1e-6`` per coordinate; the truncation error is O(h²) ≈ 1e-12 relative, the
-  rounding error O(ε/h) ≈ 1e-10 relative). The tests check the gravity part against
-  Pinocchio's analytic ``computeGeneralizedGravityDerivatives`` and the spring part at
-  rest against the exact ``Σ Jᵀ C J``;
-- ``D = −∂Q_d/∂q̇`` at q0 — exact (Q_d is linear in q̇): its columns are ``−Q_d(q0, e_i)``.
+  rounding error O(ε/h) ≈ 1e-10 relative). The differences are taken of the reference
+  side's forces (Pinocchio's kinematics, all bushings at once: 0.34 ms a force against
+  the textbook side's 2.25 ms on the RT-70), which the cross-check holds equal to the
+  textbook's to ~1e-12 relative; ``side="textbook"`` differences the textbook's own
+  (tests/test_fast_linearize.py: the two K agree to 1e-8 of max|K|). The tests check
+  the gravity part against Pinocchio's analytic ``computeGeneralizedGravityDerivatives``
+  and the spring part at rest against the exact ``Σ Jᵀ C J``;
+- ``D = −∂Q_d/∂q̇`` at q0 — exact (Q_d is linear in q̇): ``Σ Jᵀ D J`` of the textbook's
+  elements, their Jacobians evaluated once.
+
+The equilibrium is the textbook's (its residual is the textbook's static force); the
+stiffness only steers Newton's steps.
 
 Coordinates held by drives (for the RT-70 its azimuth and elevation axes,
 :func:`rt70.scenes.rt70_state.rt70_pointing`) are given by name: held at given values
@@ -32,6 +40,9 @@ from rt70.textbook import dynamics, forces, points
 
 #: Finite-difference step of the stiffness matrix, per coordinate (m or rad).
 FD_STEP = 1e-6
+#: :func:`equilibrium` keeps its stiffness matrix while each Newton step cuts the force
+#: residual at least this much (a factor 10).
+REUSE_RATIO = 0.1
 
 
 def static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
@@ -39,6 +50,31 @@ def static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
     model, data = scene.textbook, scene.textbook_data
     Qc, _ = forces.spring_damper_force(model, data, q, np.zeros(model.nv))
     return dynamics.gravity_force(model, data, q) + Qc
+
+
+def reference_static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
+    """``Q_g + Q_c`` at rest from the reference side (Pinocchio), in book coordinates."""
+    from rt70.reference import dynamics as ref_dynamics
+    from rt70.reference import forces as ref_forces
+
+    model, data = scene.reference, scene.reference_data
+    Qc, _ = ref_forces.spring_damper_force(model, data, q, np.zeros(q.size))
+    return ref_dynamics.gravity_force(model, data, q) + Qc
+
+
+def _reference_gravity(scene: Scene, q: np.ndarray) -> np.ndarray:
+    from rt70.reference import dynamics as ref_dynamics
+
+    return ref_dynamics.gravity_force(scene.reference, scene.reference_data, q)
+
+
+#: The sides whose static forces :func:`stiffness_matrix` can difference.
+SIDES = ("reference", "textbook")
+
+
+def _check_side(side: str) -> None:
+    if side not in SIDES:
+        raise Rt70Error(f"unknown side {side!r} (choose from {', '.join(SIDES)})")
 
 
 def _negative_jacobian(force, q: np.ndarray, h: float) -> np.ndarray:
@@ -51,19 +87,35 @@ def _negative_jacobian(force, q: np.ndarray, h: float) -> np.ndarray:
     return 0.5 * (K + K.T)
 
 
-def stiffness_matrix(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
-    """``K = −∂(Q_g + Q_c)/∂q`` by central differences, symmetrised (see module docstring)."""
-    return _negative_jacobian(lambda x: static_force(scene, x), np.asarray(q, dtype=float), h)
+def stiffness_matrix(
+    scene: Scene, q: np.ndarray, h: float = FD_STEP, side: str = "reference"
+) -> np.ndarray:
+    """``K = −∂(Q_g + Q_c)/∂q`` by central differences, symmetrised (see module docstring).
+
+    ``side`` chooses whose static forces are differenced: ``"reference"`` (Pinocchio,
+    fast) or ``"textbook"``.
+    """
+    _check_side(side)
+    force = reference_static_force if side == "reference" else static_force
+    return _negative_jacobian(lambda x: force(scene, x), np.asarray(q, dtype=float), h)
 
 
 def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
-    """``D = −∂Q_d/∂q̇``, exact: the columns are ``−Q_d(q, e_i)``."""
+    """``D = −∂Q_d/∂q̇ = Σ Jᵀ D J``, exact: column i is ``−Q_d(q, e_i)``.
+
+    The elements' deformation Jacobians are evaluated once; every column reuses them.
+    """
     model, data = scene.textbook, scene.textbook_data
+    q = np.asarray(q, dtype=float)
+    found = forces.elements(model, data, q)
     D = np.empty((model.nv, model.nv))
     for i in range(model.nv):
         e = np.zeros(model.nv)
         e[i] = 1.0
-        D[:, i] = -forces.spring_damper_force(model, data, q, e)[1]
+        Qd = np.zeros(model.nv)
+        for el in found:
+            el.subtract_jt(model, Qd, el.damping * el.rate(model, e))
+        D[:, i] = -Qd
     return 0.5 * (D + D.T)
 
 
@@ -94,14 +146,18 @@ def equilibrium(
     q_start: np.ndarray | None = None,
     tol: float = 1e-10,
     max_iter: int = 50,
+    side: str = "reference",
 ) -> np.ndarray:
     """Static equilibrium ``Q_g(q) + Q_c(q) = 0`` over the coordinates not held.
 
-    Newton's method with the stiffness matrix of :func:`stiffness_matrix`. Held
+    Newton's method with the stiffness matrix of :func:`stiffness_matrix` (differenced on
+    ``side``; the residual is always the textbook's static force). Held
     coordinates (``{name: value}``, the drives) keep their values; their generalised
     force is what the drives must supply. Converged when the force residual is below
     ``tol`` times the force scale (the largest |Q_g + Q_c| at the start, or 1); the
-    rounding floor of the RT-70's stiff springs is about 2e-12 of it.
+    rounding floor of the RT-70's stiff springs is about 2e-12 of it. K is recomputed
+    only when the residual fell by less than ``1/REUSE_RATIO`` in the last step (the
+    RT-70's sag is small: one K usually suffices).
 
     Raises
     ------
@@ -109,16 +165,22 @@ def equilibrium(
         If the free coordinates have no stiffness against some direction (singular K),
         or Newton does not converge.
     """
+    _check_side(side)
     hold = locking_map(scene, held or {})
     nv = scene.textbook.nv
     q = np.zeros(nv) if q_start is None else np.array(q_start, dtype=float)
     q = hold.expand(hold.T.T @ q)  # the free values kept, the held ones set
     scale = max(float(np.max(np.abs(static_force(scene, q)))), 1.0)
+    K, previous = None, np.inf
     for _ in range(max_iter):
         residual = hold.reduce_force(static_force(scene, q))
-        if np.max(np.abs(residual), initial=0.0) <= tol * scale:
+        size = float(np.max(np.abs(residual), initial=0.0))
+        if size <= tol * scale:
             return q
-        K = hold.reduce_matrix(stiffness_matrix(scene, q))
+        if K is not None and size <= REUSE_RATIO * previous:
+            previous = size  # the last K still converges fast: keep it (modified Newton)
+        else:
+            K, previous = hold.reduce_matrix(stiffness_matrix(scene, q, side=side)), size
         if not np.isfinite(K).all():
             raise Rt70Error(
                 f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
@@ -153,13 +215,18 @@ class Linearization:
     locked: list[str] = field(default_factory=list)
 
 
-def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Linearization:
+def linearize(
+    scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = (), side: str = "reference"
+) -> Linearization:
     """The linear model about ``q0``; ``locked`` coordinates are removed (f = 0, §4.1).
 
     Locking a coordinate of the pair structure is the book's holonomic constraint in 3-D:
     its column of the mobility matrix f is deleted, so its rows and columns of A, K and
     D are deleted — ``Tᵀ M T`` of :func:`locking_map` (:mod:`rt70.constraints`).
+    ``side`` is whose static forces K is differenced from (:func:`stiffness_matrix`);
+    M and D are the textbook's.
     """
+    _check_side(side)
     model, data = scene.textbook, scene.textbook_data
     lock = locking_map(scene, list(locked))
     M = dynamics.mass_matrix(model, data, q0)
@@ -168,9 +235,9 @@ def linearize(scene: Scene, q0: np.ndarray, locked: tuple[str, ...] = ()) -> Lin
         q0=np.array(q0, dtype=float),
         coordinates=list(lock.names),
         M=lock.reduce_matrix(M),
-        K=lock.reduce_matrix(stiffness_matrix(scene, q0)),
+        K=lock.reduce_matrix(stiffness_matrix(scene, q0, side=side)),
         D=lock.reduce_matrix(damping_matrix(scene, q0)),
-        K_gravity=lock.reduce_matrix(_gravity_stiffness(scene, q0)),
+        K_gravity=lock.reduce_matrix(_gravity_stiffness(scene, q0, side=side)),
         locked=list(locked),
     )
 
@@ -208,12 +275,17 @@ def locked_rotor(scene: Scene, lm: Linearization) -> Linearization:
     )
 
 
-def _gravity_stiffness(scene: Scene, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+def _gravity_stiffness(
+    scene: Scene, q: np.ndarray, h: float = FD_STEP, side: str = "reference"
+) -> np.ndarray:
     """``−∂Q_g/∂q`` by central differences (the geometric stiffness of gravity)."""
+    _check_side(side)
     model, data = scene.textbook, scene.textbook_data
-    return _negative_jacobian(
-        lambda x: dynamics.gravity_force(model, data, x), np.asarray(q, dtype=float), h
-    )
+    if side == "reference":
+        force = lambda x: _reference_gravity(scene, x)  # noqa: E731
+    else:
+        force = lambda x: dynamics.gravity_force(model, data, x)  # noqa: E731
+    return _negative_jacobian(force, np.asarray(q, dtype=float), h)
 
 
 #: Arc seconds per radian (the listing's TURNE0 output unit).
