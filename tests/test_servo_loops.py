@@ -20,7 +20,7 @@ from rt70.drives import DcDrive
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.linear import loops, lqg
-from rt70.linear import servo_compare as sc
+from rt70.reports import servo_loops as rs
 from rt70.scene import load_scene
 
 FREQS = np.array([0.013, 0.37, 1.1, 4.7, 23.0])  # Hz
@@ -34,7 +34,7 @@ def scene():
 @pytest.fixture(scope="module")
 def azimuth45(scene):
     """The azimuth loop at 45° (validation/servo_loops.py has 10°, 45°, 80° and elevation)."""
-    return loops.axis_plant(scene, "azimuth", 45.0)
+    return rs.axis_plant(scene, "azimuth", 45.0)
 
 
 def _rel(a: np.ndarray, b: np.ndarray) -> float:
@@ -120,7 +120,7 @@ def test_cascade_margins_at_the_design_bandwidth(azimuth45):
     Measured (azimuth, 45°): position GM 16.2 dB, PM 61° at 0.19 Hz; rate −12.3 dB
     gain-reduction margin, PM 47°; current PM 121°; bandwidth 0.349 Hz.
     """
-    r = loops.analyse_cascade(azimuth45, sc.CASCADE_POSITION_HZ)
+    r = loops.analyse_cascade(azimuth45, rs.CASCADE_POSITION_HZ)
     assert r.stable and r.adequate
     for m in r.margins.values():
         assert np.isfinite(m.pm_deg) and m.pm_deg >= loops.MIN_PM_DEG
@@ -142,7 +142,7 @@ def test_lqg_on_a_reduced_plant_closes_the_full_plant_near_one_hertz(azimuth45):
     Measured (azimuth, 45°): bandwidth 1.392 Hz, input PM 99° at 0.61 Hz, no phase
     crossover (GM ∞).
     """
-    ctrl = lqg.design(azimuth45, weights=sc.LQG_WEIGHTS)
+    ctrl = lqg.design(azimuth45, weights=rs.LQG_WEIGHTS)
     assert ctrl.reduced.nstates < azimuth45.system.nstates / 3
     closed = lqg.lqg_system(azimuth45, ctrl)
     assert loops.stable(closed)
@@ -163,6 +163,6 @@ def test_reduction_keeps_the_low_frequency_response(azimuth45):
 
 def test_unknown_axis_and_loop_are_refused(scene, azimuth45):
     with pytest.raises(Rt70Error, match="unknown axis 'roll'"):
-        loops.axis_plant(scene, "roll", 45.0)
+        rs.axis_plant(scene, "roll", 45.0)
     with pytest.raises(Rt70Error, match="unknown loop 'torque'"):
         loops.cascade_system(azimuth45, loops.cascade_design(azimuth45, 0.1), "torque")

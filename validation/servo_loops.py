@@ -21,6 +21,7 @@ from rt70.atomic import atomic_write, atomic_write_text
 from rt70.linear import loops, lqg
 from rt70.linear import servo_compare as sc
 from rt70.plotting.servo_loops import plot_closed_loops, plot_open_loops
+from rt70.reports import servo_loops as rs
 from rt70.scene import load_scene
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -32,10 +33,10 @@ FIGURE_ELEVATION = 10.0
 
 
 def _figures(scene, axis: str) -> dict[str, object]:
-    ap = loops.axis_plant(scene, axis, FIGURE_ELEVATION)
+    ap = rs.axis_plant(scene, axis, FIGURE_ELEVATION)
     f = loops.FREQ_HZ
-    gains = loops.cascade_design(ap, sc.CASCADE_POSITION_HZ)
-    ctrl = lqg.design(ap, weights=sc.LQG_WEIGHTS)
+    gains = loops.cascade_design(ap, rs.CASCADE_POSITION_HZ)
+    ctrl = lqg.design(ap, weights=rs.LQG_WEIGHTS)
     open_loops = {f"cascade {k} loop": loops.loop_transfer(ap, gains, k) for k in loops.LOOPS}
     open_loops["LQG at the plant input"] = lqg.input_loop(ap, ctrl)
     responses = {k: loops.frequency_response(L) for k, L in open_loops.items()}
@@ -45,7 +46,7 @@ def _figures(scene, axis: str) -> dict[str, object]:
         f,
         responses,
         margins,
-        f"{where}: open loops (cascade at {sc.CASCADE_POSITION_HZ} Hz design; LQG)",
+        f"{where}: open loops (cascade at {rs.CASCADE_POSITION_HZ} Hz design; LQG)",
     )
     cascade = loops.cascade_system(ap, gains)
     closed = lqg.lqg_system(ap, ctrl)
@@ -92,7 +93,7 @@ def main(argv: list[str]) -> int:
     result: dict = {"scene": "rt70_servo", "min_gm_db": loops.MIN_GM_DB}
     result["min_pm_deg"] = loops.MIN_PM_DEG
     if not quick:
-        plants = [loops.axis_plant(scene, a, e) for a in AXES for e in ELEVATIONS]
+        plants = [rs.axis_plant(scene, a, e) for a in AXES for e in ELEVATIONS]
         say("bisection of the cascade's design position bandwidth")
         reach = loops.reachable_position_hz(plants, low=0.1, high=0.4, steps=6)
         result["cascade_reachable_position_hz"] = reach
@@ -100,7 +101,7 @@ def main(argv: list[str]) -> int:
     result["cases"] = []
     for axis in AXES:
         for elevation in ELEVATIONS:
-            case = sc.compare(scene, axis, elevation)
+            case = rs.compare(scene, axis, elevation)
             result["cases"].append(case)
             c, q = case["cascade"], case["lqg"]
             say(

@@ -1,27 +1,23 @@
-"""The RT-70 drive closed around its linear structure, and the PI cascade in frequency analysis.
+"""A DC drive closed around a linear structure, and the PI cascade in frequency analysis.
 
-One job: the linear servo plant of one RT-70 axis and the current–rate–position cascade
+One job: the linear servo plant of one axis and the current–rate–position cascade
 (:mod:`rt70.servo`) closed around it as linear blocks, with the Bode data and margins a
-servo engineer reads.
+servo engineer reads. The RT-70's axes, drives and pointings are chosen in
+:mod:`rt70.reports.servo_loops`; nothing here knows the telescope.
 
-The plant of one axis (:func:`axis_plant`) joins two linear models by python-control's
-``interconnect``:
+The plant of one axis (:class:`AxisPlant`) joins two linear models by python-control's
+``interconnect`` (:func:`connect_drive`):
 
-- the structure, linearised at a pointing (:func:`rt70.linear.plant.plant` on the
-  ``rt70_servo`` scene at :func:`rt70.linear.linearize.equilibrium` of
-  :func:`rt70.scenes.rt70_state.rt70_pointing`), the driven axis coordinate free and the
-  other axis locked; inputs the reducer torque on the axis coordinate and a wind torque
-  about the axis on the main mirror (a :class:`rt70.loads.Wrench`); outputs the axis
-  angle and rate and the pointing corrections Δα, Δβ (4.159)–(4.163), in arc seconds;
+- the structure, linearised at an equilibrium (:func:`structure_plant`, on
+  :func:`rt70.linear.plant.plant`), the driven axis coordinate free; inputs the reducer
+  torque on the axis coordinate and a disturbance load (``wind_torque``, a
+  :class:`rt70.loads.Wrench` per unit input); outputs the axis angle and rate and a
+  two-component pointing output (:data:`POINTING`, e.g. the corrections Δα, Δβ
+  (4.159)–(4.163) in arc seconds);
 - the drive (formalism §4.5, (4.137)–(4.143), :class:`rt70.drives.DcDrive` linear as it
-  is): the armature ``L_a İ = u − R_a I − c_e ω_m``, the rotor
+  is; :func:`drive_block`): the armature ``L_a İ = u − R_a I − c_e ω_m``, the rotor
   ``J_m ω̇_m = c_m I − D_m ω_m − τ_r / i_r`` and the reducer torque
   ``τ_r = C_r (α_m / i_r − α) + D_r (ω_m / i_r − α̇)`` fed by the axis angle and rate.
-
-The axis's ``motors_per_axis`` identical motors on one reducer are one equivalent motor
-(:func:`drive_parameters`: armatures in parallel on one voltage). The elevation drive's
-torque enters as a torque on the elevation coordinate ``base_rx`` (between the platform
-and the swinging part), not yet as the gear sector's force on the counterweight (4.150).
 
 The cascade (:func:`cascade_system`) is linear: the limits and the anti-windup of
 :class:`rt70.servo.ServoDrive` act only in saturation and are not part of a frequency
@@ -33,7 +29,7 @@ high-order, lightly damped plant (see :mod:`rt70.linear.plant`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import control
 import numpy as np
@@ -41,18 +37,12 @@ import scipy.linalg
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.errors import Rt70Error
-from rt70.linear import linearize as lin
 from rt70.linear.plant import CoordinateInput, CoordinateOutput, LoadInput, plant, to_control
 from rt70.loads import Wrench
 from rt70.outputs import Output
 from rt70.scene import Scene
-from rt70.scenes.rt70_drives import DRIVES, AxisDrive
-from rt70.scenes.rt70_optics import rt70_mirror_outputs
-from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
 from rt70.servo import CascadeGains, cascade_gains
 
-#: The driven coordinate of each axis.
-AXIS_COORDINATES = {"azimuth": AZIMUTH_COORDINATE, "elevation": ELEVATION_COORDINATE}
 #: Frequencies of the margins and bandwidths, Hz: 200 points per decade, a step of 1.2 %,
 #: a third of the half-power width 2ζ of the plant's least damped resonance (ζ ≈ 0.03).
 FREQ_HZ = np.logspace(-3, 2, 1001)
@@ -63,37 +53,6 @@ LOOPS = ("position", "rate", "current")
 #: Adequate margins (antenna practice): gain margin, dB, and phase margin, degrees.
 MIN_GM_DB = 6.0
 MIN_PM_DEG = 30.0
-
-
-def drive_parameters(axis: AxisDrive, load_inertia: float) -> DriveParameters:
-    """The axis's drive as one equivalent motor and its reducer (docs/drives.md).
-
-    The ``n = motors_per_axis`` identical motors drive one reducer; with their
-    armatures in parallel on one voltage they are one motor of ``L_a/n``, ``R_a/n``,
-    ``n J_m``, ``n D_m`` and the same ``c_m``, ``c_e`` (n times the current, n times the
-    torque). C_r and D_r are the axis's totals (axis-referred).
-
-    Parameters
-    ----------
-    axis : AxisDrive
-        ``rt70.scenes.rt70_drives.AZIMUTH_DRIVE`` or ``ELEVATION_DRIVE``.
-    load_inertia : float
-        J_l, kg·m²: the rigid structure about the axis (the servo design's load).
-    """
-    m, n = axis.motor, axis.motors_per_axis
-    return DriveParameters(
-        L_a=m.armature_inductance / n,
-        R_a=m.armature_resistance / n,
-        c_m=m.torque_constant,
-        c_e=m.back_emf_constant,
-        J_m=n * m.rotor_inertia,
-        D_m=n * m.viscous_friction,
-        i_r=axis.reducer.ratio,
-        C_r=axis.reducer.stiffness,
-        D_r=axis.reducer.damping,
-        J_l=load_inertia,
-        D_l=0.0,
-    )
 
 
 def drive_block(p: DriveParameters) -> control.StateSpace:
@@ -132,47 +91,51 @@ def drive_block(p: DriveParameters) -> control.StateSpace:
     )
 
 
-def wind_wrench(axis: str, azimuth_deg: float) -> Wrench:
-    """A unit torque (N·m) about the axis, on the main mirror: the wind's moment on the dish.
-
-    Azimuth: about the ground z axis; elevation: about the elevation bearing, the
-    platform's x axis turned by the azimuth (``Rz(A) e_x``).
-    """
-    if axis == "azimuth":
-        direction = np.array([0.0, 0.0, 1.0])
-    else:
-        a = np.radians(azimuth_deg)
-        direction = np.array([np.cos(a), np.sin(a), 0.0])
-    return Wrench("main_mirror", np.zeros(3), force=np.zeros(3), torque=direction)
-
-
 def structure_plant(
-    scene: Scene, axis: str, elevation_deg: float, azimuth_deg: float = 0.0
-) -> tuple[control.StateSpace, float, np.ndarray]:
-    """The structure about a pointing, its axis free; its rigid inertia and equilibrium.
+    scene: Scene,
+    q0: np.ndarray,
+    coordinate: str,
+    disturbance: Wrench,
+    pointing: Output,
+    locked: tuple[str, ...] = (),
+) -> tuple[control.StateSpace, float]:
+    """The structure about ``q0`` with its axis coordinate free, and its rigid inertia.
 
-    Returns the plant, the rigid inertia about the axis and the equilibrium q0.
-    Inputs ``reducer_torque`` (on the axis coordinate) and ``wind_torque`` (about the
-    axis on the main mirror, :func:`wind_wrench`); outputs ``axis_angle``, ``axis_rate``
-    and :data:`POINTING`. The other axis is locked. The load inertia is the mass
-    matrix's diagonal entry of the axis coordinate (everything it turns, held rigid).
+    Parameters
+    ----------
+    scene : Scene
+        The structure.
+    q0 : ndarray
+        A static equilibrium (:func:`rt70.linear.linearize.equilibrium`).
+    coordinate : str
+        The driven axis coordinate (free in the plant).
+    disturbance : Wrench
+        The load of a unit ``wind_torque`` input (e.g. a torque about the axis on the
+        dish).
+    pointing : Output
+        A two-component output (the pointing corrections), labelled :data:`POINTING`.
+    locked : tuple of str
+        Coordinates locked (e.g. the other axis).
+
+    Returns
+    -------
+    (control.StateSpace, float)
+        Inputs ``reducer_torque`` (on the axis coordinate) and ``wind_torque``; outputs
+        ``axis_angle``, ``axis_rate`` and :data:`POINTING`. The load inertia is the
+        mass matrix's diagonal entry of the axis coordinate (everything it turns, held
+        rigid).
     """
-    if axis not in AXIS_COORDINATES:
-        raise Rt70Error(f"unknown axis '{axis}' (azimuth or elevation)")
-    coordinate = AXIS_COORDINATES[axis]
-    other = [c for c in AXIS_COORDINATES.values() if c != coordinate]
-    q0 = lin.equilibrium(scene, rt70_pointing(elevation_deg, azimuth_deg))
-    optics = {o.name: o for o in rt70_mirror_outputs(scene, elevation_deg, azimuth_deg)}
-    pointing: Output = replace(optics["pointing_correction"], name="pointing")
+    if pointing.size != len(POINTING):
+        raise Rt70Error(f"{scene.name}: the pointing output must have {len(POINTING)} components")
     ss = plant(
         scene,
         q0,
         inputs=[
             CoordinateInput("reducer_torque", coordinate),
-            LoadInput("wind_torque", wind_wrench(axis, azimuth_deg)),
+            LoadInput("wind_torque", disturbance),
         ],
         outputs=[CoordinateOutput("axis_angle", coordinate), pointing],
-        locked=other,
+        locked=locked,
     )
     n = ss.n_states // 2
     k = list(ss.state_names).index(coordinate)
@@ -192,7 +155,7 @@ def structure_plant(
         outputs=["axis_angle", "axis_rate", *POINTING],
         name="structure",
     )
-    return structure, load_inertia, q0
+    return structure, load_inertia
 
 
 def connect_drive(structure: control.StateSpace, p: DriveParameters) -> control.StateSpace:
@@ -237,7 +200,9 @@ class AxisPlant:
     parameters : DriveParameters
         The equivalent drive (:func:`drive_parameters`).
     axis : str
+        Its name.
     elevation_deg, azimuth_deg : float
+        The pointing.
     q0 : ndarray
         The equilibrium linearised about (all the scene's coordinates).
     """
@@ -254,26 +219,6 @@ class AxisPlant:
     def load_inertia(self) -> float:
         """The rigid structure's inertia about the axis, kg·m²."""
         return self.parameters.J_l
-
-
-def axis_plant(
-    scene: Scene, axis: str, elevation_deg: float, azimuth_deg: float = 0.0
-) -> AxisPlant:
-    """The linear plant of one RT-70 axis (drive + structure) at a pointing.
-
-    Parameters
-    ----------
-    scene : Scene
-        The control object, ``load_scene("rt70_servo")``.
-    axis : {"azimuth", "elevation"}
-        The driven axis (the other one is locked).
-    elevation_deg, azimuth_deg : float
-        The pointing (:func:`rt70.scenes.rt70_state.rt70_pointing`).
-    """
-    structure, load_inertia, q0 = structure_plant(scene, axis, elevation_deg, azimuth_deg)
-    p = drive_parameters(DRIVES[axis], load_inertia)
-    system = connect_drive(structure, p)
-    return AxisPlant(system, structure, p, axis, elevation_deg, azimuth_deg, q0)
 
 
 # ------------------------------------------------------------------------ the PI cascade
