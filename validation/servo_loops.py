@@ -6,8 +6,8 @@ PI cascade reaches with GM ≥ 6 dB and PM ≥ 30° in every loop (bisection), a
 designed on a reduced plant and checked on the full plant (margins at the plant input,
 bandwidth, step, wind-torque pointing error). Writes
 validation/results/servo_loops.json and servo_loops_{open,closed}_{azimuth,elevation}.png.
-Run: ``python validation/servo_loops.py [--quick]`` (about 10 minutes on 2 busy cores;
---quick skips the bisection and uses the recorded design bandwidth).
+Run: ``python validation/servo_loops.py [--quick | --figures]`` (about 7 minutes on 2
+busy cores; --quick skips the bisection, --figures writes the figures only).
 """
 
 import json
@@ -50,18 +50,16 @@ def _figures(scene, axis: str) -> dict[str, object]:
     )
     cascade = loops.cascade_system(ap, gains)
     closed = lqg.lqg_system(ap, ctrl)
+    # the pointing correction of the driven axis (4.159)–(4.163): Δα for azimuth, Δβ for
+    # elevation; it is minus the beam's motion (arcsec per arcsec of reference)
+    name, sym = ("pointing_da", "Δα") if axis == "azimuth" else ("pointing_db", "Δβ")
     curves = {
-        "cascade: reference → axis angle": loops.frequency_response(
-            cascade["axis_angle", "reference"]
-        ),
-        "LQG: reference → axis angle": loops.frequency_response(closed["axis_angle", "reference"]),
-        "cascade: reference → pointing Δβ (arcsec per arcsec)": loops.frequency_response(
-            cascade["pointing_db", "reference"] / sc.ARCSEC_PER_RAD
-        ),
-        "LQG: reference → pointing Δβ (arcsec per arcsec)": loops.frequency_response(
-            closed["pointing_db", "reference"] / sc.ARCSEC_PER_RAD
-        ),
+        "cascade: reference → axis angle": cascade["axis_angle", "reference"],
+        "LQG: reference → axis angle": closed["axis_angle", "reference"],
+        f"cascade: reference → −{sym} (pointing)": -cascade[name, "reference"] / sc.ARCSEC_PER_RAD,
+        f"LQG: reference → −{sym} (pointing)": -closed[name, "reference"] / sc.ARCSEC_PER_RAD,
     }
+    curves = {k: loops.frequency_response(T) for k, T in curves.items()}
     fig_closed = plot_closed_loops(
         f, curves, f"{where}: closed loops, PI cascade against LQG (full plant)"
     )
@@ -84,12 +82,22 @@ def _finite(x):
 
 def main(argv: list[str]) -> int:
     quick = "--quick" in argv
+    figures_only = "--figures" in argv
     start = time.perf_counter()
 
     def say(msg: str) -> None:
         print(f"  [{time.perf_counter() - start:6.1f} s] {msg}", file=sys.stderr, flush=True)
 
     scene = load_scene("rt70_servo")
+    OUT.mkdir(exist_ok=True)
+    for axis in AXES:
+        for name, fig in _figures(scene, axis).items():
+            path = atomic_write(
+                OUT / name, lambda tmp, fig=fig: fig.savefig(tmp, dpi=110, format="png")
+            )
+            print(f"wrote {path}")
+    if figures_only:
+        return 0
     result: dict = {"scene": "rt70_servo", "min_gm_db": loops.MIN_GM_DB}
     result["min_pm_deg"] = loops.MIN_PM_DEG
     if not quick:
@@ -112,13 +120,6 @@ def main(argv: list[str]) -> int:
                 f"overshoot {q['overshoot_pct']:.1f} %, settling {q['settling_s']:.2f} s, "
                 f"wind axis peak {q['wind_axis_peak_arcsec']:.0f}″"
             )
-    OUT.mkdir(exist_ok=True)
-    for axis in AXES:
-        for name, fig in _figures(scene, axis).items():
-            path = atomic_write(
-                OUT / name, lambda tmp, fig=fig: fig.savefig(tmp, dpi=110, format="png")
-            )
-            print(f"wrote {path}")
     text = json.dumps(_finite(result), indent=1, allow_nan=False)
     print(f"wrote {atomic_write_text(OUT / 'servo_loops.json', text)}")
     print(f"total run time {time.perf_counter() - start:.1f} s")

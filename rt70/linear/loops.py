@@ -198,7 +198,7 @@ class AxisPlant:
     structure : control.StateSpace
         The structure alone (:func:`structure_plant`).
     parameters : DriveParameters
-        The equivalent drive (:func:`drive_parameters`).
+        The drive (for the RT-70: :func:`rt70.reports.servo_loops.drive_parameters`).
     axis : str
         Its name.
     elevation_deg, azimuth_deg : float
@@ -244,7 +244,7 @@ def cascade_system(
     Parameters
     ----------
     ap : AxisPlant
-        The plant (:func:`axis_plant`).
+        The plant (for the RT-70: :func:`rt70.reports.servo_loops.axis_plant`).
     gains : CascadeGains
         The loops' gains (:func:`cascade_design`).
     open_loop : {"position", "rate", "current"} or None

@@ -1,21 +1,26 @@
-"""LQG servo of one RT-70 axis: designed on a reduced plant, checked on the full one.
+"""LQG servo of one axis: designed on a reduced plant, checked on the full one.
 
-One job: the model-based alternative to the PI cascade (antenna-servo.md: the DSN 34-m
-antennas reached a position-loop bandwidth of about 1 Hz with a high-gain LQG
-controller, Gawronski, *Modeling and Control of Antennas and Telescopes*, 2008, ch. 8).
+One job: the model-based alternative to the PI cascade. The DSN 34-m beam-waveguide
+antenna needed a position-loop bandwidth of about 1 Hz and reached it with a high-gain
+LQG controller (TMO Progress Report 42-137, 1999; Gawronski, *Modeling and Control of
+Antennas and Telescopes*, Springer 2008: LQG and H∞ about 10× better than PI — via
+antenna-servo.md).
 
 - :func:`reduce_plant` keeps the slow modes of the drive + structure plant
-  (:func:`rt70.linear.loops.axis_plant`) by modal truncation with static correction
-  (the fast modes residualised: their DC contribution kept as feedthrough). It is the
-  one place a reduction enters: a better one (balanced truncation, Hankel-norm modal
-  selection) replaces this function alone.
-- :func:`design` solves the LQR on the reduced plant augmented by the integral of the
-  axis-angle error, with a reference feedforward ``(N_x, N_u)`` to the steady state of
-  a unit angle, and the Kalman filter (``control.lqe``) from the encoder angle and the
-  motor speed, with process noise at the voltage and wind-torque inputs.
+  (:class:`rt70.linear.loops.AxisPlant`) that the measurements see, by modal truncation
+  with static correction (the fast or invisible modes residualised: their DC
+  contribution kept as feedthrough). It is the one place a reduction enters: a better
+  one (balanced truncation, Hankel singular values) replaces this function alone.
+- :func:`design` solves the LQR (``control.lqr``) on the reduced plant augmented by the
+  integral of the axis-angle error, with a reference feedforward ``(N_x, N_u)`` to the
+  steady state of a unit angle, and the Kalman filter (``control.lqe``) from the
+  encoder angle and the motor speed, with process noise at the voltage and wind-torque
+  inputs; the reduced states are scaled first (:func:`_scaled`) so that both Riccati
+  equations are well conditioned.
 - :func:`lqg_system` closes the controller around the FULL plant; :func:`input_loop`
   breaks it at the plant input (the armature voltage) for margins. The checks (poles,
-  margins, bandwidth, step, wind torque) use :mod:`rt70.linear.loops`.
+  margins, bandwidth) use :mod:`rt70.linear.loops`, the step and wind numbers
+  :mod:`rt70.linear.servo_compare`.
 """
 
 from __future__ import annotations

@@ -97,5 +97,6 @@ def plot_closed_loops(
     for label, H in responses.items():
         line = mag.semilogx(freq_hz, 20 * np.log10(np.abs(H)), label=label)[0]
         phase.semilogx(freq_hz, np.degrees(np.unwrap(np.angle(H))), color=line.get_color())
+    mag.set_ylim(-60, 10)  # the servo band; the roll-off far below says little
     mag.legend(fontsize=8, loc="lower left")
     return fig

@@ -36,8 +36,8 @@ from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt7
 #: The driven coordinate of each axis.
 AXIS_COORDINATES = {"azimuth": AZIMUTH_COORDINATE, "elevation": ELEVATION_COORDINATE}
 #: The cascade's design position bandwidth, Hz: below the largest with GM ≥ 6 dB and
-#: PM ≥ 30° in every loop on both axes at 10°, 45° and 80° (validation/servo_loops.py
-#: measures that by bisection).
+#: PM ≥ 30° in every loop on both axes at 10°, 45° and 80°, 0.172 Hz (bisection in
+#: validation/servo_loops.py; the azimuth at 10° limits it), rounded down.
 CASCADE_POSITION_HZ = 0.15
 #: The LQG's weights: an axis-angle error of 1e-3 rad costs as much as 440 V, integral
 #: time 3 s (about 1 Hz closed-loop bandwidth, as the DSN's LQG, antenna-servo.md).
