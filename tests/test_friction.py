@@ -94,8 +94,8 @@ def _rotor(inertia):
 
 def test_regularised_run_converges_to_the_switched_motion():
     """A sinusoidal torque of 1.5 F_s makes the axis slip and stick; the regularised run's
-    error against the exact switched motion falls ten-fold with ω_ε (measured: 0.056″ and
-    0.0056″ for a linear zone of 1e-4 and 1e-5 of top speed over 2 s)."""
+    error against the exact switched motion falls ten-fold with ω_ε (measured: 0.060″ and
+    0.0060″ for a linear zone of 1e-4 and 1e-5 of top speed over 2 s)."""
     scene = _rotor(J)
     t = np.linspace(0.0, 2.0, 201)
 

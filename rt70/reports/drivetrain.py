@@ -36,7 +36,8 @@ from rt70.simulate import SimulationResult, simulate
 #: Sidereal rate, rad/s (15.04″/s).
 SIDEREAL = 7.2921e-5
 #: The friction law's default regularisation: a linear zone 1e-6 of the top speed wide
-#: (docs/drive-train.md §2: its creep is 1e-3″ per 100 s at half the static torque).
+#: (docs/drive-train.md §2: 6e-4″ from the exact stick–slip motion on the rig; an axis
+#: held by half the static torque creeps at 3.2e-4″/s instead of sticking).
 WIDTH = 1e-6 * FRICTION.top_speed
 KIND = "linear"
 #: Position-loop bandwidth of the rig, Hz (a factor ~2 below the rigid load's 2.5 Hz
