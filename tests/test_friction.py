@@ -1,0 +1,137 @@
+"""Dry friction of an axis (rt70.friction): the book's law, its regularisations, energy."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rt70.errors import Rt70Error
+from rt70.friction import (
+    AxisFriction,
+    creep_speed,
+    friction_torque,
+    relay_torque,
+    switched_rigid_axis,
+)
+from rt70.scene import scene_from_text
+from rt70.scenes.rt70_drives import FRICTION, KGF_M
+from rt70.simulate import simulate
+
+TOP = FRICTION.top_speed
+
+
+def test_law_at_the_books_points():
+    """7·10⁴ kgf·m at rest (either direction), 1.5·10⁵ kgf·m (in the book's (1–2)·10⁵) at
+    top speed, opposing the motion (book §2.4, p. 51)."""
+    tiny = 1e-15 * TOP
+    assert relay_torque(FRICTION, tiny) == pytest.approx(-7e4 * KGF_M, rel=1e-12)
+    assert relay_torque(FRICTION, -tiny) == pytest.approx(7e4 * KGF_M, rel=1e-12)
+    at_top = -relay_torque(FRICTION, TOP) / KGF_M
+    assert at_top == pytest.approx(1.5e5, rel=1e-6) and 1e5 <= at_top <= 2e5
+    assert relay_torque(FRICTION, -TOP) == -relay_torque(FRICTION, TOP)
+    # linear between the two points: the middle speed gives the middle torque
+    mid = -relay_torque(FRICTION, 0.5 * TOP) / KGF_M
+    assert mid == pytest.approx(0.5 * (7e4 + 1.5e5), rel=1e-6)
+
+
+@pytest.mark.parametrize("kind", ["linear", "tanh"])
+def test_regularisation_tends_to_the_relay(kind):
+    """Away from zero speed the regularised law tends to the relay as ω_ε → 0, and the
+    creep under half the static torque shrinks in proportion to ω_ε."""
+    F_s = FRICTION.static_torque
+    for delta in (1e-3 * TOP, 1e-5 * TOP, 1e-7 * TOP):  # the law on |ω| ≥ δ
+        speeds = np.concatenate([-np.logspace(0, 4, 60), np.logspace(0, 4, 60)]) * delta
+        relay = relay_torque(FRICTION, speeds)
+        wide = np.abs(friction_torque(FRICTION, speeds, 10 * delta, kind) - relay).max()
+        narrow = np.abs(friction_torque(FRICTION, speeds, 0.01 * delta, kind) - relay).max()
+        assert wide > 0.8 * F_s  # ω_ε = 10 δ: near ω = δ the law is still far from the relay
+        assert narrow < 1e-12 * F_s  # ω_ε = δ / 100: the relay to rounding
+    creep = [
+        creep_speed(FRICTION, 0.5 * FRICTION.static_torque, w * TOP, kind) for w in (1e-4, 1e-6)
+    ]
+    expected = 0.5 if kind == "linear" else np.arctanh(0.5)  # ω_c / ω_ε, slope neglected
+    assert creep[0] / (1e-4 * TOP) == pytest.approx(expected, rel=1e-2)
+    assert creep[1] / creep[0] == pytest.approx(1e-2, rel=1e-3)
+
+
+def test_bad_requests():
+    with pytest.raises(Rt70Error, match="regularisation"):
+        friction_torque(FRICTION, 0.0, 1e-9, "sign")
+    with pytest.raises(Rt70Error, match="width"):
+        friction_torque(FRICTION, 0.0, 0.0)
+    with pytest.raises(Rt70Error, match="below F_s"):
+        creep_speed(FRICTION, 2 * FRICTION.static_torque, 1e-9)
+    with pytest.raises(Rt70Error, match="no coordinate 'elevation'"):
+        AxisFriction("f", ["azimuth"], "elevation", FRICTION, 1e-9)
+
+
+J = 7.0e9  # kg·m²: about the RT-70 azimuth with its rotors (docs/drives.md)
+
+
+def test_switched_reference_against_closed_forms():
+    """From rest, a constant torque above F_s: ω = (τ−F_s)/k (1 − e^(−kt/J)); below F_s the
+    axis never leaves rest."""
+    t = np.linspace(0.0, 40.0, 81)
+    tau = 1.2 * FRICTION.static_torque
+    run = switched_rigid_axis(J, FRICTION, lambda s: tau, t)
+    k = FRICTION.slope
+    speed = (tau - FRICTION.static_torque) / k * (1 - np.exp(-k * t / J))
+    assert np.abs(run.speed - speed).max() < 1e-8 * speed.max()
+    assert run.switches == 1
+    still = switched_rigid_axis(J, FRICTION, lambda s: 0.9 * FRICTION.static_torque, t)
+    assert not still.angle.any() and still.switches == 0
+
+
+def _rotor(inertia):
+    return scene_from_text(
+        f"""<robot name="r"><link name="g"/><link name="b"><inertial><mass value="1"/>
+        <inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/>
+        </inertial></link><joint name="azimuth" type="continuous"><parent link="g"/>
+        <child link="b"/><axis xyz="0 0 1"/></joint></robot>""",
+        "rotor",
+    )
+
+
+def test_regularised_run_converges_to_the_switched_motion():
+    """A sinusoidal torque of 1.5 F_s makes the axis slip and stick; the regularised run's
+    error against the exact switched motion falls ten-fold with ω_ε (measured: 0.060″ and
+    0.0060″ for a linear zone of 1e-4 and 1e-5 of top speed over 2 s)."""
+    scene = _rotor(J)
+    t = np.linspace(0.0, 2.0, 201)
+
+    def torque(s):
+        return 1.5 * FRICTION.static_torque * np.sin(np.pi * s)
+
+    exact = switched_rigid_axis(J, FRICTION, torque, t)
+    assert exact.switches >= 2  # it sticks and slips again within the run
+    errors = []
+    for w in (1e-4, 1e-5):
+        f = AxisFriction("f", scene.coordinate_names, "azimuth", FRICTION, w * TOP, "linear")
+        run = simulate(
+            scene, (0.0, 2.0), components=[f], t_eval=t, rtol=1e-6, atol=1e-12,
+            inputs=lambda s, q, qd: np.array([torque(s)]),
+        )  # fmt: skip
+        errors.append(np.abs(run.q[:, 0] - exact.angle).max() / np.radians(1 / 3600))
+    assert 0.02 < errors[0] < 0.1
+    assert errors[1] == pytest.approx(0.1 * errors[0], rel=0.2)
+
+
+def test_friction_dissipation_closes_the_energy_balance():
+    """A spinning axis left to its friction stops; the kinetic energy lost is the heat the
+    friction state counts, and the audit (friction power in the input work) balances."""
+    scene = _rotor(J)
+    f = AxisFriction("f", scene.coordinate_names, "azimuth", FRICTION, 1e-6 * TOP, "linear")
+    w0 = 0.5 * TOP
+    run = simulate(
+        scene, (0.0, 20.0), x0=(np.zeros(1), np.array([w0])), components=[f], rtol=1e-8,
+        atol=1e-13,
+    )  # fmt: skip
+    T0 = 0.5 * J * w0**2
+    heat = run.states["f:dissipated"]
+    assert abs(run.qd[-1, 0]) < 1e-6 * w0  # stopped (to the creep of the linear zone)
+    assert heat[-1] == pytest.approx(T0, rel=1e-6)
+    assert run.input_work[-1] == pytest.approx(-heat[-1], rel=1e-9)
+    assert np.abs(run.balance).max() < 1e-6 * T0
+    # it stops within the time the relay law gives: t ≤ J ω₀ / F_s (slope helps)
+    stop = run.t[np.flatnonzero(np.abs(run.qd[:, 0]) > 1e-3 * w0)[-1]]
+    assert stop < J * w0 / FRICTION.static_torque
