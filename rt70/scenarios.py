@@ -25,8 +25,7 @@ Pointing error: the main mirror's focal axis ``n5`` (from its focus and vertex, 
 ground axes) against the axis the structure has in static equilibrium at the
 *reference* pointing — the source direction (4.153) less the gravity sag, which a
 pointing model calibrates (:attr:`ScenarioRun.static_misalignment` reports it, (4.157)).
-Its two components are taken along the sky's cross-elevation and elevation directions of
-the reference pointing.
+Its two components are the cross-elevation and elevation errors (:func:`sky_error`).
 """
 
 from __future__ import annotations
@@ -322,18 +321,27 @@ def mirror_axis_output(scene: Scene) -> Output:
     return Output(MIRROR_AXIS, "1", 3, (system.main_focus, system.main_vertex), formula)
 
 
-def sky_axes(elevation_deg, azimuth_deg) -> tuple[np.ndarray, np.ndarray]:
-    """Unit cross-elevation and elevation directions on the sky of a pointing (rows per t).
+def elevation_azimuth(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Elevation E and azimuth A (rad) of mirror-axis directions (rows).
 
-    For the mirror axis ``Rz(A) (0, −cos E, sin E)`` of
-    :func:`rt70.scenes.rt70_state.rt70_pointing`: ``u_A = ∂n/∂A / cos E = Rz(A) e_x`` and
-    ``u_E = ∂n/∂E = Rz(A) (0, sin E, cos E)``; both defined at the zenith too.
+    The inverse of the pointing's axis ``Rz(A) (0, −cos E, sin E)``
+    (:func:`rt70.scenes.rt70_state.rt70_pointing`).
     """
-    E, A = np.radians(np.atleast_1d(elevation_deg)), np.radians(np.atleast_1d(azimuth_deg))
-    cA, sA, cE, sE = np.cos(A), np.sin(A), np.cos(E), np.sin(E)
-    u_a = np.stack([cA, sA, np.zeros_like(A)], axis=-1)
-    u_e = np.stack([-sA * sE, cA * sE, cE], axis=-1)
-    return u_a, u_e
+    axis = np.atleast_2d(axis)
+    return np.arcsin(np.clip(axis[:, 2], -1.0, 1.0)), np.arctan2(axis[:, 0], -axis[:, 1])
+
+
+def sky_error(axis: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Cross-elevation and elevation error (arcsec) of mirror axes against targets (rows).
+
+    ``[(A − A_t) cos E_t, E − E_t]``: what the encoders of an elevation-over-azimuth
+    mount see on the sky (a move in azimuth alone has no elevation error, unlike a
+    projection of the chord ``axis − target``, whose second-order term is 15″ at 1°).
+    """
+    e, a = elevation_azimuth(axis)
+    e_t, a_t = elevation_azimuth(target)
+    da = (a - a_t + np.pi) % (2 * np.pi) - np.pi
+    return np.column_stack([da * np.cos(e_t), e - e_t]) / ARCSEC
 
 
 @dataclass
@@ -434,9 +442,7 @@ def run_scenario(
     a_ref = sc.azimuth_deg + np.array([sc.azimuth(x) for x in t])
     target = _target_axes(scene, q0, t, e_ref, a_ref)
     n = result.outputs[MIRROR_AXIS]
-    u_a, u_e = sky_axes(e_ref, a_ref)
-    d = n - target
-    pointing = np.column_stack([(d * u_a).sum(1), (d * u_e).sum(1)]) / ARCSEC
+    pointing = sky_error(n, target)
     cosang = np.clip((n * target).sum(1), -1.0, 1.0)
     total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / ARCSEC
     torque, current, limits = _drive_torques(components, result, names)

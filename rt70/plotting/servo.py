@@ -33,7 +33,7 @@ def servo_figure(run) -> Figure:
     colors = {"azimuth": "C0", "elevation": "C1"}
     for axis, ref in run.axis_reference.items():
         angle = ref - run.axis_error[axis] * signs[axis] / _ARCSEC
-        start = ref[0] if sc.name != "track" else angle[0]
+        start = angle[0]
         s, c = signs[axis], colors[axis]
         ax_a.plot(t, s * (ref - start) * _ARCSEC, "--", color=c, lw=1.0, label=f"{axis} reference")
         ax_a.plot(t, s * (angle - start) * _ARCSEC, color=c, lw=1.4, label=f"{axis} axis")
