@@ -309,7 +309,7 @@ def _simulate(args: argparse.Namespace) -> int:
             (0.0, 10.0 if args.t_end is None else args.t_end),
             start_state(scene),
             backend=args.backend,
-            method=args.method,
+            method=args.method or "BDF",
             rtol=args.rtol,
             progress=args.progress or sys.stderr.isatty(),
         )
@@ -318,7 +318,7 @@ def _simulate(args: argparse.Namespace) -> int:
             raise
         raise ResourceError(f"{exc}; '--backend textbook' does without Pinocchio") from None
     print(
-        f"{scene.name}: {args.method} ({args.backend}), rtol {args.rtol:g}, "
+        f"{scene.name}: {result.method} ({args.backend}), rtol {args.rtol:g}, "
         f"0 … {result.t[-1]:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"
     )
     _print_solver(result)
@@ -367,7 +367,7 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
     print(
         f"{scene.name}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
         f"{sc.azimuth_deg:g}°, drives and servo holding ({scenarios.tuning_text()}); "
-        f"{args.method} ({args.backend}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
+        f"{result.method} ({args.backend}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
     )
     _print_solver(result)
     for line in scenarios.summary_lines(run):
@@ -523,7 +523,9 @@ def build_parser() -> argparse.ArgumentParser:
         "default for rt70, the listing as printed, which its drives cannot hold)",
     )
     sim.add_argument(
-        "--method", default="BDF", choices=METHODS, help="solve_ivp method (default BDF)"
+        "--method",
+        choices=METHODS,
+        help="solve_ivp method (default BDF; LSODA for the servo scenarios)",
     )
     sim.add_argument("--backend", default="pinocchio", choices=("pinocchio", "textbook"))
     sim.add_argument(

