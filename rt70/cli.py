@@ -201,12 +201,12 @@ def _modes(args: argparse.Namespace) -> int:
 ZENITH_KEYHOLE_DEG = 89.0
 
 
-def _add_pointing_arguments(parser: argparse.ArgumentParser) -> None:
+def _add_pointing_arguments(parser: argparse.ArgumentParser, default: str = "zenith") -> None:
     """``--elevation`` and ``--azimuth`` of the RT-70 (read back by :func:`_pointing`)."""
     parser.add_argument(
         "--elevation",
         type=options.elevation,
-        help="RT-70 elevation, degrees, 0 (horizon) to 90 (zenith; the default)",
+        help=f"RT-70 elevation, degrees, 0 (horizon) to 90 (zenith); default {default}",
     )
     parser.add_argument(
         "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
@@ -342,14 +342,21 @@ def _simulate(args: argparse.Namespace) -> int:
     from rt70.scenes.rt70_state import start_state
     from rt70.simulate import simulate
 
+    if args.free_axes and (args.scenario or args.elevation is not None or args.azimuth is not None):
+        raise Rt70Error(
+            "--free-axes runs the structural benchmark: no --scenario/--elevation/--azimuth"
+        )
     scene = load_scene(args.scene)
+    scenario = _servo_scenario(args, scene)
+    if scenario is not None:
+        return _simulate_scenario(args, scene, scenario)
     try:
         result = simulate(
             scene,
-            (0.0, args.t_end),
+            (0.0, 10.0 if args.t_end is None else args.t_end),
             start_state(scene),
             backend=args.backend,
-            method=args.method,
+            method=args.method or "BDF",
             rtol=args.rtol,
             progress=args.progress or sys.stderr.isatty(),
         )
@@ -358,32 +365,87 @@ def _simulate(args: argparse.Namespace) -> int:
             raise
         raise ResourceError(f"{exc}; '--backend textbook' does without Pinocchio") from None
     print(
-        f"{scene.name}: {args.method} ({args.backend}), rtol {args.rtol:g}, "
-        f"0 … {args.t_end:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"
+        f"{scene.name}: {result.method} ({args.backend}), rtol {args.rtol:g}, "
+        f"0 … {result.t[-1]:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"
     )
-    print(
-        f"  {result.n_steps} steps, {result.nfev} evaluations, {result.njev} Jacobians, "
-        f"{result.nlu} LU; {result.wall_time_s:.3f} s wall, "
-        f"{result.real_time_factor:.1f}× real time"
-    )
+    _print_solver(result)
     print(
         f"  energy: T0 = {result.kinetic[0]:.6g} J, dissipated {result.dissipated[-1]:.6g} J, "
         f"balance drift {result.relative_drift:.2e} of {result.balance_scale:.6g} J"
         + ("  [FLAGGED: more than the tolerance explains]" if result.drift_flagged else "")
     )
     if args.out:
-        from rt70.atomic import atomic_write_all
-
-        out = Path(args.out)
-        writers = {out: result.writer(out)}
+        figure = None
         if not args.no_plot:
             from rt70.plotting.simulation import simulation_figure
 
-            fig = simulation_figure(result)
-            writers[out.with_suffix(".png")] = lambda tmp: fig.savefig(tmp, dpi=110)
-        for path in atomic_write_all(writers):  # the trajectory and its plot appear together
-            print(f"  wrote {path}")
+            figure = simulation_figure(result)
+        _write_simulation(Path(args.out), result, figure)
     return 0 if result.success else 1
+
+
+def _servo_scenario(args: argparse.Namespace, scene):
+    """The servo scenario to run on ``scene`` or None (:func:`rt70.scenarios.choose`)."""
+    from rt70 import scenarios
+
+    if args.free_axes:
+        return None
+    sc, hint = scenarios.choose(scene, args.scenario, args.elevation, args.azimuth, args.t_end)
+    if hint:
+        print(f"{scene.name}: {hint}")
+    return sc
+
+
+def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
+    """Run a servo scenario and print what it measured (:mod:`rt70.scenarios`)."""
+    from pathlib import Path
+
+    from rt70 import scenarios
+
+    run = scenarios.run_scenario(
+        scene,
+        sc,
+        rtol=args.rtol,
+        backend=args.backend,
+        method=args.method,
+        progress=args.progress or sys.stderr.isatty(),
+    )
+    result = run.result
+    print(
+        f"{scene.name}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
+        f"{sc.azimuth_deg:g}°, drives and servo holding ({scenarios.tuning_text()}); "
+        f"{result.method} ({args.backend}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
+    )
+    _print_solver(result)
+    for line in scenarios.summary_lines(run):
+        print("  " + line)
+    if args.out:
+        figure = None
+        if not args.no_plot:
+            from rt70.plotting.servo import servo_figure
+
+            figure = servo_figure(run)
+        _write_simulation(Path(args.out), result, figure)
+    return 0
+
+
+def _print_solver(result) -> None:
+    print(
+        f"  {result.n_steps} steps, {result.nfev} evaluations, {result.njev} Jacobians, "
+        f"{result.nlu} LU; {result.wall_time_s:.3f} s wall, "
+        f"{result.real_time_factor:.1f}× real time"
+    )
+
+
+def _write_simulation(out, result, figure) -> None:
+    """The trajectory and its figure (``.png`` beside it), written together atomically."""
+    from rt70.atomic import atomic_write_all
+
+    writers = {out: result.writer(out)}
+    if figure is not None:
+        writers[out.with_suffix(".png")] = lambda tmp: figure.savefig(tmp, dpi=110)
+    for path in atomic_write_all(writers):  # the trajectory and its plot appear together
+        print(f"  wrote {path}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -494,16 +556,37 @@ def build_parser() -> argparse.ArgumentParser:
     sim = sub.add_parser(
         "simulate",
         help="integrate the equations of motion with an energy audit",
-        description="Simulate a scene (the RT-70 from the listing's initial state by "
-        "default) and report solver statistics and the energy balance; optionally write "
-        "the trajectory (CSV or NPZ, atomically) and a plot.",
+        description="Simulate a scene and report solver statistics and the energy "
+        "balance; optionally write the trajectory (CSV or NPZ, atomically) and a plot. A "
+        "scene with the RT-70 axes that its drives can hold (rt70_servo) runs a servo "
+        "scenario (hold by default, elevation 45°): settling, overshoot, torque, pointing "
+        "error in arc seconds. Other scenes, rt70 (the listing as printed) and "
+        "--free-axes run the structural benchmark (the listing's initial state for rt70).",
     )
     sim.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
     sim.add_argument(
-        "--t-end", type=options.positive_float, default=10.0, help="end time, s (default 10)"
+        "--t-end",
+        type=options.positive_float,
+        help="end time, s (default 10; a scenario's own: hold 60, steps 40/25, track 40)",
     )
     sim.add_argument(
-        "--method", default="BDF", choices=METHODS, help="solve_ivp method (default BDF)"
+        "--scenario",
+        choices=("hold", "step-azimuth", "step-elevation", "track"),
+        help="servo scenario of a scene with the RT-70 axes (default hold where the drives "
+        "can hold the scene, e.g. rt70_servo): hold, a 1° step in azimuth or elevation, "
+        "sidereal tracking (15″/s in azimuth)",
+    )
+    _add_pointing_arguments(sim, default="45")
+    sim.add_argument(
+        "--free-axes",
+        action="store_true",
+        help="no drives: the structural benchmark from the listing's start state (the "
+        "default for rt70, the listing as printed, which its drives cannot hold)",
+    )
+    sim.add_argument(
+        "--method",
+        choices=METHODS,
+        help="solve_ivp method (default BDF; LSODA for the servo scenarios)",
     )
     sim.add_argument("--backend", default="pinocchio", choices=("pinocchio", "textbook"))
     sim.add_argument(
