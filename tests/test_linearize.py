@@ -131,3 +131,21 @@ def test_inputs_and_outputs_of_the_rt70(rt70):
     # a state-space model from the drive torque to the focus displacement
     ss = responses.state_space(lm.M, lm.K, lm.D, b, C)
     assert ss.A.shape == (2 * len(lm.coordinates),) * 2 and ss.C.shape[0] == 3
+
+
+@pytest.mark.parametrize("elevation", [30.0, 90.0])
+def test_equilibrium_stops_at_the_rounding_floor(elevation):
+    """rt70_servo at 30°: the residual stalls at 1.2e-10 of its scale (rounding of the
+    strut forces), above the default tol; Newton stops when its step is below STEP_TOL.
+    At the zenith, a start already in equilibrium has no force scale (1 N): same stop."""
+    from rt70.scenes.rt70_state import rt70_pointing
+
+    scene = load_scene("rt70_servo")
+    held = rt70_pointing(elevation)
+    q = lin.equilibrium(scene, held)
+    again = lin.equilibrium(scene, held, q_start=q)  # from a converged start
+    hold = lin.locking_map(scene, held)
+    scale = np.abs(lin.static_force(scene, hold.expand(np.zeros(hold.T.shape[1])))).max()
+    for x in (q, again):
+        assert np.abs(hold.reduce_force(lin.static_force(scene, x))).max() <= 3e-10 * scale
+    assert np.abs(again - q).max() <= 1e-12

@@ -38,6 +38,9 @@ from rt70.loads import Wrench
 from rt70.scene import Scene
 from rt70.textbook import dynamics, forces, points
 
+#: Newton in :func:`equilibrium` stops when its step is below this (relative, m or rad).
+STEP_TOL = 1e-12
+
 #: Finite-difference step of the stiffness matrix, per coordinate (m or rad).
 FD_STEP = 1e-6
 #: :func:`equilibrium` keeps its stiffness matrix while each Newton step cuts the force
@@ -155,7 +158,11 @@ def equilibrium(
     coordinates (``{name: value}``, the drives) keep their values; their generalised
     force is what the drives must supply. Converged when the force residual is below
     ``tol`` times the force scale (the largest |Q_g + Q_c| at the start, or 1); the
-    rounding floor of the RT-70's stiff springs is about 2e-12 of it. K is recomputed
+    rounding floor of the RT-70's stiff springs is about 2e-12 of it, but up to 1.2e-10 at
+    some pointings of ``rt70_servo`` (30° elevation: the strut packages' force terms, some
+    10⁵ times the residual's scale, cancel): so Newton also stops when its step moves no
+    coordinate by more than :data:`STEP_TOL` (relative to the largest |q|, at least 1) —
+    the configuration is then fixed to rounding (measured steps there: 1e-14). K is recomputed
     only when the residual fell by less than ``1/REUSE_RATIO`` in the last step (the
     RT-70's sag is small: one K usually suffices).
 
@@ -194,6 +201,8 @@ def equilibrium(
                 "stiffness in some direction (hold or lock it)"
             ) from None
         q += hold.expand(step, offset=False)
+        if float(np.max(np.abs(step), initial=0.0)) <= STEP_TOL * max(1.0, np.abs(q).max()):
+            return q  # the position is fixed to rounding; what is left is the forces' rounding
     raise Rt70Error(f"{scene.name}: static equilibrium not found in {max_iter} Newton steps")
 
 
