@@ -46,6 +46,7 @@ from rt70.bondgraph import (
 from rt70.bondgraph.equations import _AlgebraicLoop, _Former
 from rt70.bondgraph.lagrange import book_motor_matrices, reducer_deformations
 from rt70.errors import Rt70Error
+from rt70.scenes import mechanisms
 
 KGF = 9.80665  # N per kgf
 AZIMUTH_INERTIA_KGF = 0.2100e8 + 0.4000e7 + 0.9472e7 + 0.1600e8 + 0.3200e7 + 0.1060e5 + 0.4700e7
@@ -337,14 +338,10 @@ def test_malformed_graphs_and_parameters_are_refused():
 
 # --- Example 1a: the non-rigid gear reducer (book §1.4) --------------------------------
 
-#: TEST VALUES (the book gives no numbers for Example 1a): gears 1..4, shafts/meshes
-#: C1..C5, D1..D5, radii R1..R4; overall ratio i = R1 R3 / (R2 R4) = 15.
-REDUCER = dict(
-    inertia=(4.0, 1.0, 2.0, 0.1),
-    stiffness=(1e5, 4e4, 1e4, 2e5, 5e4),
-    damping=(10.0, 5.0, 2.0, 20.0, 8.0),
-    radii=(0.3, 0.1, 0.25, 0.05),
-)
+#: The book gives no numbers for Example 1a: the project's values of the gear_reducer
+#: scene (gears 1..4, shafts/meshes C1..C5, D1..D5, radii R1..R4; overall ratio 15),
+#: with the output angle prescribed (no load inertia) unless a test adds one.
+REDUCER = {k: mechanisms.GEAR_REDUCER[k] for k in ("inertia", "stiffness", "damping", "radii")}
 
 
 def test_reducer_transfer_functions_equal_lagrange():

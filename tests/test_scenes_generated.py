@@ -26,6 +26,7 @@ EXPECTED_NV = {
     "double_pendulum": 2,
     "three_masses": 3,
     "two_body_gravity": 12,
+    "gear_reducer": 5,
 }
 
 RT70_BODIES = (

@@ -432,6 +432,79 @@ def two_body_gravity_scene() -> str:
     return uw.end(w)
 
 
+def gear_reducer_scene() -> str:
+    """Build the non-rigid gear reducer of §1.4 (Fig. 1.3, formalism Example 1a).
+
+    Returns
+    -------
+    str
+        URDF text: the load and four gears, each on a revolute joint about x from the
+        ground (``beta_out``, ``beta_1`` … ``beta_4``) on three parallel shafts; the
+        shafts C1 (load–gear 1), C2 (gears 2–3) and C3 (gear 4 to the held motor) as
+        rx-only bushings; each mesh as a bushing between the two gears' points at the
+        contact, stiff only along the common tangent (z), with ``C4/R1²`` (``C5/R3²``):
+        the tangential slip ``R1 β1 + R2 β2 = R1 δ4`` stores ``½ C4 δ4²`` as the book's
+        mesh spring does (and likewise the dampers). Gravity along −z acts on centres
+        of mass on the fixed shafts: it does no work.
+    """
+    d = mechanisms.GEAR_REDUCER
+    R1, R2, R3, R4 = d["radii"]
+    C, D, dx = d["stiffness"], d["damping"], d["spacing"]
+    axis_b, axis_c = R1 + R2, R1 + R2 + R3 + R4  # shaft positions along y
+    gears = (
+        ("load", "beta_out", d["load_inertia"], (0.0, 0.0, 0.0)),
+        ("gear1", "beta_1", d["inertia"][0], (dx, 0.0, 0.0)),
+        ("gear2", "beta_2", d["inertia"][1], (dx, axis_b, 0.0)),
+        ("gear3", "beta_3", d["inertia"][2], (2 * dx, axis_b, 0.0)),
+        ("gear4", "beta_4", d["inertia"][3], (2 * dx, axis_c, 0.0)),
+    )
+    w = uw.Writer()
+    uw.begin(
+        w,
+        "gear_reducer",
+        "Non-rigid gear reducer (Dubarenko 2007, section 1.4, Fig. 1.3): four gears, "
+        "three shafts, two meshes, a free load; the motor shaft held",
+    )
+    for link, joint, inertia, xyz in gears:
+        uw.joint(w, joint, "revolute", ROOT_LINK, link, xyz=xyz, axis=(1, 0, 0))
+        uw.massive_link(w, link, 1.0, (inertia, inertia, inertia))
+    w.blank()
+    uw.gravity(w, (0.0, 0.0, -9.81))
+
+    def rx_only(value: float) -> tuple[float, ...]:
+        return (0.0, 0.0, 0.0, value, 0.0, 0.0)
+
+    def z_only(value: float) -> tuple[float, ...]:
+        return (0.0, 0.0, value, 0.0, 0.0, 0.0)
+
+    w.comment("Shafts: torsion about x between frames on one axis")
+    uw.bushing(w, "shaft_out", rx_only(C[0]), rx_only(D[0]), "load", "gear1", xyz1=(dx, 0, 0))
+    uw.bushing(w, "shaft_23", rx_only(C[1]), rx_only(D[1]), "gear2", "gear3", xyz1=(dx, 0, 0))
+    uw.bushing(w, "shaft_motor", rx_only(C[2]), rx_only(D[2]), ROOT_LINK, "gear4", xyz1=gears[4][3])
+    w.comment("Meshes: along the common tangent (z) at the contact point, C4/R1², C5/R3²")
+    uw.bushing(
+        w,
+        "mesh_12",
+        z_only(C[3] / R1**2),
+        z_only(D[3] / R1**2),
+        "gear1",
+        "gear2",
+        xyz1=(0.0, R1, 0.0),
+        xyz2=(0.0, -R2, 0.0),
+    )
+    uw.bushing(
+        w,
+        "mesh_34",
+        z_only(C[4] / R3**2),
+        z_only(D[4] / R3**2),
+        "gear3",
+        "gear4",
+        xyz1=(0.0, R3, 0.0),
+        xyz2=(0.0, -R4, 0.0),
+    )
+    return uw.end(w)
+
+
 #: Scene name → function returning the scene's URDF text.
 SCENES: dict[str, Callable[[], str]] = {
     "rt70": rt70_scene,
@@ -442,6 +515,7 @@ SCENES: dict[str, Callable[[], str]] = {
     "double_pendulum": double_pendulum_scene,
     "three_masses": three_masses_scene,
     "two_body_gravity": two_body_gravity_scene,
+    "gear_reducer": gear_reducer_scene,
 }
 
 

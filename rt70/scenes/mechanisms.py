@@ -4,9 +4,11 @@
   1), with its reference values :data:`DOUBLE_PENDULUM_REFERENCE`;
 * :data:`THREE_MASSES` — the book's §2.1 system of three point masses with elastic
   links (Fig. 2.1, topology matrix (2.3)), reduced to motion along x;
-* :data:`TWO_BODY_GRAVITY` — the two 6-DOF bodies of §4.2.3, exercises 1–2.
+* :data:`TWO_BODY_GRAVITY` — the two 6-DOF bodies of §4.2.3, exercises 1–2;
+* :data:`GEAR_REDUCER` — the non-rigid gear reducer of §1.4 (Fig. 1.3, formalism
+  Example 1a) turning a free load, motor shaft held.
 
-The book gives no numbers for the last two; the values here are this project's choice.
+The book gives no numbers for the last three; the values here are this project's choice.
 """
 
 from __future__ import annotations
@@ -108,4 +110,25 @@ TWO_BODY_GRAVITY: dict = {
     },
     "damping_ratio": 0.01,
     "gravity": (0.0, 0.0, -9.81),
+}
+
+
+# ---------------------------------------------------------------------------------------
+# The non-rigid gear reducer (book §1.4, Fig. 1.3; formalism Example 1a)
+# ---------------------------------------------------------------------------------------
+
+#: Four gears (inertias I1..I4 about their own x axes, kg·m²; gear 1 on the output
+#: shaft, gear 4 on the motor shaft), shafts C1 (output), C2 (gears 2–3), C3 (motor) and
+#: meshes C4 (gears 1–2, referred to gear 1's angle), C5 (gears 3–4, referred to gear 3's
+#: angle) in N·m/rad, dampers D1..D5 alongside (N·m·s/rad), pitch radii R1..R4 (m), and
+#: a free load on the output shaft. Overall ratio R1 R3 / (R2 R4) = 15. The same values
+#: are the test values of tests/test_bondgraph.py (the bond graph and Lagrange forms).
+GEAR_REDUCER: dict = {
+    "inertia": (4.0, 1.0, 2.0, 0.1),
+    "stiffness": (1e5, 4e4, 1e4, 2e5, 5e4),
+    "damping": (10.0, 5.0, 2.0, 20.0, 8.0),
+    "radii": (0.3, 0.1, 0.25, 0.05),
+    "load_inertia": 10.0,
+    #: shafts' axial spacing (m): the gears of one shaft sit this far apart along x
+    "spacing": 0.5,
 }
