@@ -411,7 +411,11 @@ def run_scenario(
     sc : Scenario
         From :func:`scenario`.
     drives : DriveFactory, optional
-        Builds the drive components; default :func:`servo_drives`.
+        Builds the drive components; default :func:`servo_drives`. A factory with a
+        ``start(scene, held)`` method returns the start state and the holding torques
+        itself (``(q0, {coordinate: torque})``, e.g. the equilibrium with a gear
+        sector's force, :mod:`rt70.scene_servo`); otherwise the start is the
+        equilibrium with the axes held by torques on their coordinates.
     rtol, backend, progress
         As :func:`rt70.simulate.simulate`.
     method : str, optional
@@ -430,9 +434,13 @@ def run_scenario(
     drives = servo_drives() if drives is None else drives
     ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
     held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)
-    q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
-    Q0 = static_force(scene, q0)
-    torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
+    start = getattr(drives, "start", None)
+    if start is None:
+        q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
+        Q0 = static_force(scene, q0)
+        torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
+    else:  # a factory whose drives do not push on the coordinates alone
+        q0, torques = start(scene, held)
     # references in coordinate radians: platform_rz = A, base_rx = π/2 − E
     a0, e0 = q0[ia], q0[ie]
     refs = {
