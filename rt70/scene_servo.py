@@ -42,7 +42,7 @@ from rt70.couplings import SceneCoupling
 from rt70.drives import drive_parameters
 from rt70.errors import Rt70Error
 from rt70.friction import AxisFriction
-from rt70.linear.linearize import equilibrium, static_force, stiffness_matrix
+from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
 from rt70.scenarios import AXIS_TUNING, EQUILIBRIUM_TOL, preset_servo_state, servo_tolerances
 from rt70.scene import Scene
 from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE, FRICTION, AxisDrive
@@ -104,7 +104,9 @@ def scene_equilibrium(
     torques : numpy.ndarray
         K_d, N·m on θ_d, in the order of ``couplings``.
     residual : float
-        ``max |R|`` relative to the largest static force at the start.
+        ``max |R|`` relative to the static force of the undeformed structure (the
+        weights: the scale of :func:`rt70.linear.linearize.equilibrium`). Newton also
+        stops, as there, when its step moves no coordinate by more than ``STEP_TOL``.
 
     Raises
     ------
@@ -121,7 +123,12 @@ def scene_equilibrium(
     q = equilibrium(scene, held, tol=tol)  # the coordinate equilibrium: a close start
     Q = static_force(scene, q)
     K = np.array([-float(Q[c.index]) for c in couplings])
-    scale = max(float(np.max(np.abs(Q))), 1.0)
+    # the force scale of equilibrium(): the static force of the undeformed structure
+    # (the weights); the held torques alone have none at the zenith
+    undeformed = np.zeros_like(q)
+    for name, value in held.items():
+        undeformed[names.index(name)] = value
+    scale = max(float(np.max(np.abs(static_force(scene, undeformed)))), 1.0)
     free = np.array([i for i in range(len(names)) if names[i] not in held])
     S = stiffness_matrix(scene, q)
     size = np.inf
@@ -135,6 +142,13 @@ def scene_equilibrium(
         step = scipy.linalg.solve(J, -R)
         q[free] += step[: free.size]
         K += step[free.size :]
+        if np.abs(step[: free.size]).max() <= STEP_TOL * max(1.0, np.abs(q).max()):
+            # the configuration is fixed to rounding (as equilibrium() stops)
+            R = (
+                static_force(scene, q)
+                + np.column_stack([c.angle_gradient(q)[1] for c in couplings]) @ K
+            )
+            return q, K, float(np.max(np.abs(R))) / scale
     raise Rt70Error(
         f"{scene.name}: drives' equilibrium not found in {MAX_ITER} Newton steps "
         f"(residual {size:.2g} of the force scale)"
