@@ -70,6 +70,9 @@ def test_start_is_the_equilibrium_with_the_sector_force(servo_scene, started):
     K = np.array([-Q[c.index] for c in couplings])
     off = np.abs(Q + G @ K).max() / scale  # the coordinate start under the sector's force
     assert off > 1e-3
+    factory_90 = SceneServoFactory()
+    _, zenith = factory_90.start(servo_scene, rt70_pointing(90.0, 0.0))  # no held torque
+    assert factory_90.residual < 1e-9 and abs(zenith["base_rx"]) < 1.0  # measured 2.5e-11
     with pytest.raises(Rt70Error, match="hold"):
         scene_equilibrium(servo_scene, couplings, {"platform_rz": 0.0})
 
