@@ -46,7 +46,7 @@ class BackCalculationServo(ServoDrive):
     def _clamped_loops(self, t: float, q: np.ndarray, s: np.ndarray):
         """The three loops: (errors, raw − clamped output of each, armature voltage)."""
         g, p = self.g, self.p
-        e_p = float(self.reference(t)) - q[self.index]
+        e_p = float(self.reference(t)) - self.encoder(q)
         raw_rate = g.kp_p * e_p + g.ki_p * s[3]
         rate_ref = min(max(raw_rate, -g.rate_limit), g.rate_limit)
         e_v = p.i_r * rate_ref - s[2]  # on the motor speed

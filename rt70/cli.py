@@ -342,14 +342,27 @@ def _simulate(args: argparse.Namespace) -> int:
     from rt70.scenes.rt70_state import start_state
     from rt70.simulate import simulate
 
-    if args.free_axes and (args.scenario or args.elevation is not None or args.azimuth is not None):
+    if args.free_axes and (
+        args.scenario
+        or args.elevation is not None
+        or args.azimuth is not None
+        or args.drives
+        or args.friction
+    ):
         raise Rt70Error(
-            "--free-axes runs the structural benchmark: no --scenario/--elevation/--azimuth"
+            "--free-axes runs the structural benchmark: no "
+            "--scenario/--elevation/--azimuth/--drives/--friction"
         )
     scene = load_scene(args.scene)
+    if args.drives == "scene":
+        from rt70.scene_servo import check_scene_drives
+
+        check_scene_drives(scene)
     scenario = _servo_scenario(args, scene)
     if scenario is not None:
         return _simulate_scenario(args, scene, scenario)
+    if args.drives or args.friction:
+        raise Rt70Error(f"{scene.name}: --drives/--friction need a servo scenario (RT-70 axes)")
     try:
         result = simulate(
             scene,
@@ -401,10 +414,13 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
     from pathlib import Path
 
     from rt70 import scenarios
+    from rt70.scene_servo import choose_drives
 
+    drives, label = choose_drives(scene, args.drives, args.friction, args.backend)
     run = scenarios.run_scenario(
         scene,
         sc,
+        drives=drives,
         rtol=args.rtol,
         backend=args.backend,
         method=args.method,
@@ -413,7 +429,7 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
     result = run.result
     print(
         f"{scene.name}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
-        f"{sc.azimuth_deg:g}°, drives and servo holding ({scenarios.tuning_text()}); "
+        f"{sc.azimuth_deg:g}°, {label} and servo holding ({scenarios.tuning_text()}); "
         f"{result.method} ({args.backend}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
     )
     _print_solver(result)
@@ -582,6 +598,18 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="no drives: the structural benchmark from the listing's start state (the "
         "default for rt70, the listing as printed, which its drives cannot hold)",
+    )
+    sim.add_argument(
+        "--drives",
+        choices=("scene", "coordinate"),
+        help="drive model of a servo scenario: the scene's <rt70:drive> elements, the "
+        "elevation acting through its gear sector, encoders on the axes (default where the "
+        "scene has them, e.g. rt70_servo), or torques on the axis coordinates",
+    )
+    sim.add_argument(
+        "--friction",
+        action="store_true",
+        help="add the book's dry friction on both axes to a servo scenario",
     )
     sim.add_argument(
         "--method",

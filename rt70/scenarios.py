@@ -411,7 +411,11 @@ def run_scenario(
     sc : Scenario
         From :func:`scenario`.
     drives : DriveFactory, optional
-        Builds the drive components; default :func:`servo_drives`.
+        Builds the drive components; default :func:`servo_drives`. A factory with a
+        ``start(scene, held)`` method returns the start state and the holding torques
+        itself (``(q0, {coordinate: torque})``, e.g. the equilibrium with a gear
+        sector's force, :mod:`rt70.scene_servo`); otherwise the start is the
+        equilibrium with the axes held by torques on their coordinates.
     rtol, backend, progress
         As :func:`rt70.simulate.simulate`.
     method : str, optional
@@ -430,9 +434,13 @@ def run_scenario(
     drives = servo_drives() if drives is None else drives
     ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
     held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)
-    q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
-    Q0 = static_force(scene, q0)
-    torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
+    start = getattr(drives, "start", None)
+    if start is None:
+        q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
+        Q0 = static_force(scene, q0)
+        torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
+    else:  # a factory whose drives do not push on the coordinates alone
+        q0, torques = start(scene, held)
     # references in coordinate radians: platform_rz = A, base_rx = π/2 − E
     a0, e0 = q0[ia], q0[ie]
     refs = {
@@ -468,7 +476,8 @@ def run_scenario(
     }
     e_ref = sc.elevation_deg + np.array([sc.elevation(x) for x in t])
     a_ref = sc.azimuth_deg + np.array([sc.azimuth(x) for x in t])
-    target = _target_axes(scene, q0, t, e_ref, a_ref)
+    rest = None if start is None else (lambda held: start(scene, held)[0])
+    target = _target_axes(scene, q0, t, e_ref, a_ref, rest)
     n = result.outputs[MIRROR_AXIS]
     pointing = sky_error(n, target)
     cosang = np.clip((n * target).sum(1), -1.0, 1.0)
@@ -493,11 +502,13 @@ def run_scenario(
     return run
 
 
-def _target_axes(scene, q0, t, e_ref, a_ref) -> np.ndarray:
+def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
     """The main mirror's axis in equilibrium at the reference pointing, per sample.
 
     Equilibria at the distinct reference pointings of a few knots (first, last, and
     where the reference changes), linearly interpolated in between and normalised.
+    ``rest(held)`` gives the equilibrium when the drive factory has its own start (the
+    drives' forces in it); default the axes held by torques on their coordinates.
     """
     out = mirror_axis_output(scene)
     knots = np.unique(np.r_[0, np.linspace(0, len(t) - 1, 5).astype(int), len(t) - 1])
@@ -506,7 +517,8 @@ def _target_axes(scene, q0, t, e_ref, a_ref) -> np.ndarray:
     for k in knots:
         key = (round(float(e_ref[k]), 12), round(float(a_ref[k]), 12))
         if key not in cache:
-            q = equilibrium(scene, rt70_pointing(*key), tol=EQUILIBRIUM_TOL)
+            held = rt70_pointing(*key)
+            q = equilibrium(scene, held, tol=EQUILIBRIUM_TOL) if rest is None else rest(held)
             cache[key] = evaluate(scene, q, [out], "reference")[MIRROR_AXIS]
         axes.append(cache[key])
     axes = np.array(axes)

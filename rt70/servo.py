@@ -110,7 +110,9 @@ class ServoDrive(DcDrive):
     """A DC drive closed by the current–rate–position cascade on its coordinate.
 
     The position loop reads the drive's angle (``coupling.angle``: the coordinate, or a
-    scene drive's θ_d; pass ``coupling=`` as to :class:`rt70.drives.DcDrive`).
+    scene drive's θ_d; pass ``coupling=`` as to :class:`rt70.drives.DcDrive`), or
+    ``encoder(q)`` if given: e.g. the axis coordinate while the reducer acts on a gear
+    sector's mesh angle, as a telescope's axis encoder reads the axis, not the mesh.
     States: the drive's ``[I, α_m, ω_m]`` then the integrals of the position, rate and
     current errors. The position reference is ``reference(t)`` (rad), e.g. a step or a
     sidereal ramp.
@@ -130,6 +132,7 @@ class ServoDrive(DcDrive):
         atol=None,
         *,
         coupling=None,
+        encoder=None,
     ) -> None:
         # the armature voltage comes from the cascade (derivative), not from a voltage law
         super().__init__(
@@ -137,11 +140,13 @@ class ServoDrive(DcDrive):
         )
         self.g = gains
         self.reference = reference
+        #: The angle the position loop reads, ``encoder(q)`` (rad).
+        self.encoder = self.coupling.angle if encoder is None else encoder
 
     def _loops(self, t: float, q: np.ndarray, s: np.ndarray):
         """References and clamps of the three loops: (errors, saturated flags, voltage)."""
         g, p = self.g, self.p
-        e_p = float(self.reference(t)) - self.coupling.angle(q)
+        e_p = float(self.reference(t)) - self.encoder(q)
         rate_ref = g.kp_p * e_p + g.ki_p * s[3]
         sat_p = abs(rate_ref) > g.rate_limit
         rate_ref = float(np.clip(rate_ref, -g.rate_limit, g.rate_limit))

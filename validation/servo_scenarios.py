@@ -1,13 +1,16 @@
 """The servo targets of issue 10 measured on the RT-70 held by its drives (rt70_servo).
 
-Runs :mod:`rt70.scenarios` with the default drives (one servo cascade per axis on the
-coordinates, rt70/scenes/rt70_drives.py): the 60 s hold at elevations 10, 30, 45, 60, 80
-and 90°, the 1° steps in azimuth and elevation and sidereal tracking (15″/s in azimuth)
-at 45°, and writes validation/results/servo_scenarios.json (every metric, every target
-with its measured value and whether it is met) and servo_scenarios.png (the hold drift
-against elevation, the step responses, the tracking error).
-Run: ``python validation/servo_scenarios.py [--quick]`` (about 10 minutes on 2 busy
-cores; --quick: 5 s holds at two elevations, short steps, not written to results).
+Runs :mod:`rt70.scenarios` with the drives ``rt70 simulate`` chooses for the scene: its
+own ``<rt70:drive>`` elements, one servo cascade each, the elevation through its gear
+sector (:mod:`rt70.scene_servo`; ``--drives coordinate``: torques on the axis
+coordinates). The 60 s hold at elevations 10, 30, 45, 60, 80 and 90°, the 1° steps in
+azimuth and elevation and sidereal tracking (15″/s in azimuth) at 45°; writes
+validation/results/servo_scenarios.json (every metric, every target with its measured
+value and whether it is met) and servo_scenarios.png (the hold drift against
+elevation, the step responses, the tracking error).
+Run: ``python validation/servo_scenarios.py [--quick] [--drives coordinate]`` (about 10
+minutes on 2 busy cores; --quick: 5 s holds at two elevations, short steps, not written
+to results).
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from rt70 import scenarios as S
 from rt70.atomic import atomic_write_all
 from rt70.errors import Rt70Error
 from rt70.scene import load_scene
+from rt70.scene_servo import choose_drives
 
 OUT = Path(__file__).resolve().parent / "results"
 HOLD_ELEVATIONS = (10.0, 30.0, 45.0, 60.0, 80.0, 90.0)
@@ -72,6 +76,9 @@ def main(argv: list[str]) -> int:
     quick = "--quick" in argv
     start = time.perf_counter()
     scene = load_scene("rt70_servo")
+    model = argv[argv.index("--drives") + 1] if "--drives" in argv else None
+    drives, label = choose_drives(scene, model)
+    print(f"{scene.name}: {label}")
     plan = [
         (f"hold-{e:g}", S.scenario("hold", e, 0.0, 5.0 if quick else 60.0))
         for e in (HOLD_ELEVATIONS[:2] if quick else HOLD_ELEVATIONS)
@@ -84,7 +91,7 @@ def main(argv: list[str]) -> int:
     for name, sc in plan:
         t0 = time.perf_counter()
         try:
-            runs[name] = S.run_scenario(scene, sc)
+            runs[name] = S.run_scenario(scene, sc, drives=drives)
         except Rt70Error as exc:  # a run the solver cannot finish is a result: not met
             failed[name] = str(exc)
             print(f"[{time.perf_counter() - start:7.1f} s] {name}: FAILED: {exc}")
@@ -116,6 +123,7 @@ def main(argv: list[str]) -> int:
         return 0
     report = {
         "scene": scene.name,
+        "drives": label,
         "tuning": {k: {"position_hz": v[0], "ratio": v[1]} for k, v in S.AXIS_TUNING.items()},
         "targets": rows,
         "runs": {

@@ -1,0 +1,140 @@
+"""Servo scenarios on the scene's own drives (rt70/scene_servo.py): sector, start, hold, CLI."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rt70 import scenarios as S
+from rt70.cli import main
+from rt70.errors import Rt70Error
+from rt70.linear.linearize import equilibrium, static_force
+from rt70.scene import load_scene
+from rt70.scene_servo import (
+    SceneServoFactory,
+    choose_drives,
+    scene_axis_gains,
+    scene_equilibrium,
+)
+from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE
+from rt70.scenes.rt70_state import rt70_pointing
+
+#: The sector's force has these components besides base_rx (rt70_servo at 45°).
+SECTOR_COORDINATES = ("base_y", "base_z", "counterweight_y")
+
+
+@pytest.fixture(scope="module")
+def servo_scene():
+    return load_scene("rt70_servo")
+
+
+@pytest.fixture(scope="module")
+def started(servo_scene):
+    """The factory, its start at elevation 45° and its components."""
+    factory = SceneServoFactory()
+    held = rt70_pointing(45.0, 0.0)
+    q0, torques = factory.start(servo_scene, held)
+    refs = {c: (lambda t, v=v: v) for c, v in held.items()}
+    return factory, q0, torques, factory(servo_scene, q0, torques, refs)
+
+
+def test_elevation_drive_pushes_through_the_sector(servo_scene, started):
+    """Q = K ∂θ_d/∂q has the sector's components; the encoder reads base_rx, not θ_d."""
+    _, q0, torques, components = started
+    names = servo_scene.coordinate_names
+    el = next(c for c in components if c.names[0].startswith("elevation:"))
+    Q = el.force(0.0, q0, np.zeros_like(q0), el.initial[:3])
+    K = el.reducer_torque(q0, np.zeros_like(q0), el.initial[:3])
+    assert K == pytest.approx(torques["base_rx"], rel=1e-9)
+    for name in SECTOR_COORDINATES:  # a force on the counterweight, not a torque on base_rx
+        assert abs(Q[names.index(name)]) > 1e-3 * abs(K)
+    assert Q[names.index("base_rx")] == pytest.approx(K, rel=1e-3)
+    k = names.index("base_rx")
+    assert el.encoder(q0) == q0[k]
+    assert abs(el.coupling.angle(q0) - q0[k]) > 10 * ARCSEC  # the sag between them (45″)
+    az = next(c for c in components if c.names[0].startswith("azimuth:"))
+    Qa = az.force(0.0, q0, np.zeros_like(q0), az.initial[:3])
+    assert np.count_nonzero(Qa) == 1 and Qa[names.index("platform_rz")] != 0.0
+
+
+def test_start_is_the_equilibrium_with_the_sector_force(servo_scene, started):
+    """Residual of the drives' equilibrium below 1e-9; the coordinate one is far from it."""
+    factory, q0, torques, _ = started
+    assert factory.residual < 1e-9  # measured 8.1e-12; at 0–90°: 1.5e-12 … 4.8e-10
+    held = rt70_pointing(45.0, 0.0)
+    couplings = factory.couplings(servo_scene)
+    q_coord = equilibrium(servo_scene, held, tol=S.EQUILIBRIUM_TOL)
+    Q = static_force(servo_scene, q_coord)
+    scale = np.abs(Q).max()
+    G = np.column_stack([c.angle_gradient(q_coord)[1] for c in couplings])
+    K = np.array([-Q[c.index] for c in couplings])
+    off = np.abs(Q + G @ K).max() / scale  # the coordinate start under the sector's force
+    assert off > 1e-3
+    factory_90 = SceneServoFactory()
+    _, zenith = factory_90.start(servo_scene, rt70_pointing(90.0, 0.0))  # no held torque
+    assert factory_90.residual < 1e-9 and abs(zenith["base_rx"]) < 1.0  # measured 2.5e-11
+    with pytest.raises(Rt70Error, match="hold"):
+        scene_equilibrium(servo_scene, couplings, {"platform_rz": 0.0})
+
+
+def test_torque_limit_is_the_tables_for_either_lumping(started):
+    """Parallel (scene) or series lumping: n T_peak i_r = 9.81e7 N·m on the axis."""
+    _, _, _, components = started
+    for c in components:
+        g, p = c.g, c.p
+        assert g.current_limit * p.c_m * p.i_r == pytest.approx(9.80666e7, rel=1e-5)
+        assert g.voltage_limit == pytest.approx(440.0)
+    for axis in (AZIMUTH_DRIVE, ELEVATION_DRIVE):
+        p = S.drive_parameters(axis)
+        g = scene_axis_gains(p, axis, 0.2, 5.0)
+        assert g.current_limit * p.c_m * p.i_r == pytest.approx(9.80666e7, rel=1e-5)
+        assert g.voltage_limit == pytest.approx(880.0)
+
+
+def test_hold_from_the_start_does_not_move(servo_scene):
+    """2 s hold at 45°: axis and pointing errors below 1e-4″ (measured 1.4e-7″ over 3 s).
+
+    The pointing target is the equilibrium with the sector's force too (its start): from
+    the coordinate equilibrium the same hold swings 16″ on the elevation encoder.
+    """
+    run = S.run_scenario(servo_scene, S.scenario("hold", 45.0, 0.0, 2.0), SceneServoFactory())
+    for axis in ("azimuth", "elevation"):
+        assert np.abs(run.axis_error[axis]).max() < 1e-4
+    assert run.pointing_error_total.max() < 1e-4
+
+
+def test_elevation_step_moves_toward_the_reference(servo_scene):
+    """A 1° elevation step: 3 s of the rate-limited slew (0.18 °/s), the other axis still."""
+    sc = S.scenario("step-elevation", 45.0, 0.0, 3.0)
+    run = S.run_scenario(servo_scene, sc, SceneServoFactory())
+    err = run.axis_error["elevation"]
+    assert err[0] == pytest.approx(3600.0)
+    assert np.all(np.diff(err) <= 1e-6)  # the error only shrinks
+    assert 3600.0 - err[-1] > 0.4 * 3600.0  # ≥ 0.4° of the 0.54° a 3 s slew can do
+    assert np.abs(run.axis_error["azimuth"]).max() < 0.01
+
+
+def test_choose_drives(servo_scene):
+    assert choose_drives(servo_scene, None)[1] == "scene drives"
+    assert choose_drives(servo_scene, "coordinate", friction=True)[1] == (
+        "coordinate drives, dry friction"
+    )
+    factory, _ = choose_drives(servo_scene, "scene", friction=True)
+    assert factory.friction
+    with pytest.raises(Rt70Error, match="rt70:drive"):
+        choose_drives(load_scene("rt70"), "scene")
+
+
+def test_cli_drives_option(capsys):
+    assert main(["simulate", "rt70_servo", "--t-end", "0.2"]) == 0
+    assert "scene drives and servo holding" in capsys.readouterr().out
+    assert main(["simulate", "rt70_servo", "--t-end", "0.2", "--drives", "coordinate"]) == 0
+    assert "coordinate drives and servo holding" in capsys.readouterr().out
+    for argv in (
+        ["simulate", "rt70_servo", "--free-axes", "--drives", "scene"],
+        ["simulate", "rt70", "--drives", "scene"],
+        ["simulate", "three_masses", "--friction"],
+    ):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("rt70: error:")
