@@ -206,14 +206,15 @@ class LqgDrive(DcDrive):
         Raises
         ------
         Rt70Error
-            If no such state exists (residual above ``tol`` relative).
+            If no such state exists (an equation's residual above ``tol`` of its terms).
         """
         A, B, C, D = (np.atleast_2d(np.asarray(m, dtype=float)) for m in matrices)
         v = np.asarray(inputs, dtype=float)
         M = np.vstack([A, C])
         rhs = np.r_[-B @ v, voltage - D @ v]
         x = np.linalg.lstsq(M, rhs, rcond=None)[0]
-        scale = max(np.abs(rhs).max(), np.abs(M).max() * np.abs(x).max(), 1e-300)
-        if np.abs(M @ x - rhs).max() > tol * scale:
+        # each equation against its own terms' size: the rounding of a consistent one
+        scale = np.abs(rhs) + np.abs(M) @ np.abs(x) + 1e-300
+        if (np.abs(M @ x - rhs) > tol * scale).any():
             raise Rt70Error("steady_controller: the controller has no rest state with that output")
         return x
