@@ -10,7 +10,7 @@ at elevation 45°, the LQG of :mod:`rt70.linear.lqg` on the azimuth
 
 and the LQG on a 1° step (voltage limit active), sidereal tracking and a short hold.
 Writes validation/results/servo_lqg.{json,png}. Run:
-``python validation/servo_lqg.py`` (about 15 minutes on 2 cores: the runs go in two
+``python validation/servo_lqg.py`` (28 minutes on 2 busy cores: the runs go in two
 processes; the LQG's fast estimator poles, ~6000 rad/s, make it stiff).
 """
 
