@@ -446,8 +446,10 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
 
 
 def _print_solver(result) -> None:
+    # with output times asked for (t_eval) scipy does not keep the step count: -1
+    steps = f"{result.n_steps} steps, " if result.n_steps >= 0 else ""
     print(
-        f"  {result.n_steps} steps, {result.nfev} evaluations, {result.njev} Jacobians, "
+        f"  {steps}{result.nfev} evaluations, {result.njev} Jacobians, "
         f"{result.nlu} LU; {result.wall_time_s:.3f} s wall, "
         f"{result.real_time_factor:.1f}× real time"
     )
