@@ -89,6 +89,19 @@ def equivalent_drive(p: DriveParameters, count: int = 2) -> DriveParameters:
                    J_m=n * p.J_m, D_m=n * p.D_m)  # fmt: skip
 
 
+def parallel_drive(p: DriveParameters, count: int = 2) -> DriveParameters:
+    """One drive equal to ``count`` identical motors with their armatures in parallel.
+
+    The motors turn at one speed (same ratio) on one voltage, so they share the EMF and
+    carry ``count`` times one motor's current: ``L_a / count``, ``R_a / count``, the same
+    ``c_m``, ``c_e``, and ``count`` times ``J_m``, ``D_m``; ``C_r, D_r`` are already the
+    axis totals. Its torque at a current is ``count`` motors' torque; its voltage a
+    motor's (the scene's ``<rt70:drive>``, docs/urdf-extensions.md).
+    """
+    n = count
+    return replace(p, L_a=p.L_a / n, R_a=p.R_a / n, J_m=n * p.J_m, D_m=n * p.D_m)
+
+
 def train_gains(
     p: DriveParameters, load_inertia: float, position_hz: float = 1.0, ratio: float = 5.0, **limits
 ) -> CascadeGains:

@@ -38,6 +38,7 @@ import numpy as np
 from rt70.antiwindup import BackCalculationServo
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.errors import Rt70Error
+from rt70.geartrains import equivalent_drive
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.outputs import Output, evaluate
 from rt70.scene import Scene
@@ -98,20 +99,8 @@ def drive_parameters(axis: AxisDrive) -> DriveParameters:
     counter-torque between the two gear trains is not modelled here (a factory with the
     gear trains takes its place). ``J_l`` is the table's reference inertia of the axis.
     """
-    m, n = axis.motor, axis.motors_per_axis
-    return DriveParameters(
-        L_a=n * m.armature_inductance,
-        R_a=n * m.armature_resistance,
-        c_m=n * m.torque_constant,
-        c_e=n * m.back_emf_constant,
-        J_m=n * m.rotor_inertia,
-        D_m=n * m.viscous_friction,
-        i_r=axis.reducer.ratio,
-        C_r=axis.reducer.stiffness,
-        D_r=axis.reducer.damping,
-        J_l=axis.reference_inertia,
-        D_l=0.0,
-    )
+    p = axis.motor_parameters(axis.reference_inertia)
+    return equivalent_drive(p, axis.motors_per_axis)
 
 
 def axis_gains(axis: AxisDrive, position_hz: float, ratio: float) -> CascadeGains:

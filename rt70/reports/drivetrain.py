@@ -52,13 +52,7 @@ AXIS_ATOL = 1e-12
 
 def drive_parameters() -> DriveParameters:
     """One RT-70 motor (``*.motor.*``) with the azimuth reducer's totals (``az.reducer.*``)."""
-    m, az = MOTOR, AZIMUTH_DRIVE
-    return DriveParameters(
-        L_a=m.armature_inductance, R_a=m.armature_resistance, c_m=m.torque_constant,
-        c_e=m.back_emf_constant, J_m=m.rotor_inertia, D_m=m.viscous_friction,
-        i_r=az.reducer.ratio, C_r=az.reducer.stiffness, D_r=az.reducer.damping,
-        J_l=az.reference_inertia, D_l=0.0,
-    )  # fmt: skip
+    return AZIMUTH_DRIVE.motor_parameters(AZIMUTH_DRIVE.reference_inertia)
 
 
 def axis_scene(inertia: float, name: str = "azimuth_rig") -> Scene:

@@ -24,6 +24,7 @@ import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.errors import Rt70Error
+from rt70.geartrains import parallel_drive
 from rt70.linear import linearize as lin
 from rt70.linear import loops, lqg
 from rt70.linear.servo_compare import performance
@@ -59,20 +60,7 @@ def drive_parameters(axis: AxisDrive, load_inertia: float) -> DriveParameters:
     load_inertia : float
         J_l, kg·m²: the rigid structure about the axis (the servo design's load).
     """
-    m, n = axis.motor, axis.motors_per_axis
-    return DriveParameters(
-        L_a=m.armature_inductance / n,
-        R_a=m.armature_resistance / n,
-        c_m=m.torque_constant,
-        c_e=m.back_emf_constant,
-        J_m=n * m.rotor_inertia,
-        D_m=n * m.viscous_friction,
-        i_r=axis.reducer.ratio,
-        C_r=axis.reducer.stiffness,
-        D_r=axis.reducer.damping,
-        J_l=load_inertia,
-        D_l=0.0,
-    )
+    return parallel_drive(axis.motor_parameters(load_inertia), axis.motors_per_axis)
 
 
 def wind_wrench(axis: str, azimuth_deg: float) -> Wrench:

@@ -18,10 +18,12 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from rt70.atomic import atomic_write_text
+from rt70.geartrains import parallel_drive
 from rt70.scenes import mechanisms, rt70_data, rt70_drives
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.pairs import pair_joint_names
 from rt70.scenes.urdf_writer import ROOT_LINK, ZERO3, check_name, fmt, fmt_vec
+from rt70.urdf.description import DRIVE_PARAMETERS
 
 #: Default output directory: ``urdf/`` at the repository root.
 DEFAULT_DIRECTORY = Path(__file__).resolve().parents[2] / "urdf"
@@ -91,18 +93,8 @@ def lumped_drive(axis: rt70_drives.AxisDrive) -> dict[str, float]:
     The reducer's stiffness and damping are the axis's (axis-referred, both trains).
     The counter-torque of the two trains (backlash remedy) is not modelled here.
     """
-    m, n = axis.motor, axis.motors_per_axis
-    return {
-        "L_a": m.armature_inductance / n,
-        "R_a": m.armature_resistance / n,
-        "c_m": m.torque_constant,
-        "c_e": m.back_emf_constant,
-        "J_m": n * m.rotor_inertia,
-        "D_m": n * m.viscous_friction,
-        "i_r": axis.reducer.ratio,
-        "C_r": axis.reducer.stiffness,
-        "D_r": axis.reducer.damping,
-    }
+    p = parallel_drive(axis.motor_parameters(axis.reference_inertia), axis.motors_per_axis)
+    return {key: getattr(p, key) for key in DRIVE_PARAMETERS}
 
 
 def _servo_drives(w: uw.Writer) -> None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from rt70.bondgraph.parameters import DriveParameters
 from rt70.errors import Rt70Error
 
 #: One kilogram-force metre in newton metres (standard gravity). Row ``*.kgf_m``.
@@ -276,6 +277,28 @@ class AxisDrive:
                 f"AxisDrive {self.name!r}: {self.motors_per_axis} motors for "
                 f"{self.trains.count} gear trains (one motor drives each train)"
             )
+
+    def motor_parameters(self, load_inertia: float) -> DriveParameters:
+        """ONE of the axis's motors with the axis's reducer (its totals, axis-referred).
+
+        The caller lumps the ``motors_per_axis`` motors as the drive needs:
+        :func:`rt70.geartrains.parallel_drive` (armatures on one voltage, the scene's
+        ``<rt70:drive>``) or :func:`rt70.geartrains.equivalent_drive` (in series).
+        """
+        m = self.motor
+        return DriveParameters(
+            L_a=m.armature_inductance,
+            R_a=m.armature_resistance,
+            c_m=m.torque_constant,
+            c_e=m.back_emf_constant,
+            J_m=m.rotor_inertia,
+            D_m=m.viscous_friction,
+            i_r=self.reducer.ratio,
+            C_r=self.reducer.stiffness,
+            D_r=self.reducer.damping,
+            J_l=load_inertia,
+            D_l=0.0,
+        )
 
     @property
     def reflected_motor_inertia(self) -> float:
