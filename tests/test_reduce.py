@@ -9,15 +9,8 @@ import numpy as np
 import pytest
 
 from rt70.errors import Rt70Error
-from rt70.linear import linearize as lin
-from rt70.linear import plant as pl
 from rt70.linear import reduce as rd
-from rt70.loads import Wrench
-from rt70.scene import load_scene
-from rt70.scenes.rt70_optics import rt70_mirror_outputs
-from rt70.scenes.rt70_state import rt70_pointing
-
-ARCSEC = 206264.80624709636
+from rt70.reports.reduction_plants import reduction_plants
 
 
 @pytest.fixture(scope="module")
@@ -25,24 +18,8 @@ def plants():
     """The rt70_servo plant at elevation 45°, azimuth 0: axes locked (wind on the main
     mirror in, kN; pointing out) and axes free (axis torques in, MN·m; angles in arcsec
     and pointing out)."""
-    scene = load_scene("rt70_servo")
-    held = rt70_pointing(45.0, 0.0)
-    q0 = lin.equilibrium(scene, held)
-    mirror = [
-        o
-        for o in rt70_mirror_outputs(scene, 45.0, 0.0)
-        if o.name in ("focal_offset", "pointing_correction")
-    ]
-    wind = [
-        pl.LoadInput("wind_y", Wrench("main_mirror", force=(0.0, 1.0, 0.0))),
-        pl.LoadInput("wind_x", Wrench("main_mirror", force=(1.0, 0.0, 0.0))),
-    ]
-    locked = rd.rescaled(pl.plant(scene, q0, wind, mirror, locked=tuple(held)), 1.0, 1e3)
-    torques = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
-    angles = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
-    free = pl.plant(scene, q0, torques, angles + mirror)
-    free = rd.rescaled(free, [ARCSEC, ARCSEC] + [1.0] * (free.n_outputs - 2), 1e6)
-    return locked, free
+    both = reduction_plants(45.0, 0.0)
+    return both["locked"], both["free"]
 
 
 @pytest.mark.parametrize(("which", "order"), [(0, 4), (0, 8), (0, 16), (1, 8), (1, 16), (1, 24)])

@@ -29,17 +29,11 @@ import numpy as np
 
 from rt70.atomic import atomic_write_all
 from rt70.errors import Rt70Error
-from rt70.linear import linearize as lin
-from rt70.linear import plant as pl
 from rt70.linear import reduce as rd
 from rt70.linear.responses import StateSpace, frequency_response
-from rt70.loads import Wrench
-from rt70.scene import load_scene
-from rt70.scenes.rt70_optics import rt70_mirror_outputs
-from rt70.scenes.rt70_state import rt70_pointing
+from rt70.reports.reduction_plants import reduction_plants
 
 OUT = Path(__file__).resolve().parent / "results"
-ARCSEC = 206264.80624709636
 ELEVATION, AZIMUTH = 45.0, 0.0
 UNITS = {"locked": "mm or arcsec per kN", "free": "arcsec or mm per MN·m"}
 LABELS = {"modal": "modal truncation + static correction", "balanced": "balanced truncation"}
@@ -48,24 +42,7 @@ BODE = ("locked", "wind_y", "pointing_correction:1", 8, 16)  # plant, in, out, r
 
 def plants() -> dict[str, StateSpace]:
     """The locked and the free plant, in the units of the module docstring."""
-    scene = load_scene("rt70_servo")
-    held = rt70_pointing(ELEVATION, AZIMUTH)
-    q0 = lin.equilibrium(scene, held)
-    mirror = [
-        o
-        for o in rt70_mirror_outputs(scene, ELEVATION, AZIMUTH)
-        if o.name in ("focal_offset", "pointing_correction")
-    ]
-    wind = [
-        pl.LoadInput("wind_y", Wrench("main_mirror", force=(0.0, 1.0, 0.0))),
-        pl.LoadInput("wind_x", Wrench("main_mirror", force=(1.0, 0.0, 0.0))),
-    ]
-    locked = rd.rescaled(pl.plant(scene, q0, wind, mirror, locked=tuple(held)), 1.0, 1e3)
-    torques = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
-    angles = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
-    free = pl.plant(scene, q0, torques, angles + mirror)
-    free = rd.rescaled(free, [ARCSEC, ARCSEC] + [1.0] * (free.n_outputs - 2), 1e6)
-    return {"locked": locked, "free": free}
+    return reduction_plants(ELEVATION, AZIMUTH)
 
 
 def sweep(name: str, ss: StateSpace, say) -> list[dict]:
