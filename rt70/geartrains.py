@@ -41,7 +41,7 @@ import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.errors import Rt70Error
-from rt70.servo import CascadeGains, cascade_gains
+from rt70.servo import CascadeGains, cascade_gains, clamped_pi
 from rt70.states import MechanicsForces, StateComponent
 
 #: Armature voltages of the two motors as a function of (t, q, q̇, the drive's states).
@@ -276,19 +276,15 @@ class TwoTrainServo(TwoTrainDrive):
         """The motors' rates under the cascade's voltages, then the four integrators."""
         g, p = self.g, self.p
         e_p = float(self.reference(t)) - q[self.index]
-        rate_ref = g.kp_p * e_p + g.ki_p * s[6]
-        sat_p = abs(rate_ref) > g.rate_limit
-        rate_ref = float(np.clip(rate_ref, -g.rate_limit, g.rate_limit))
+        rate_ref, sat_p = clamped_pi(g.kp_p, g.ki_p, e_p, s[6], g.rate_limit)
         e_v = p.i_r * rate_ref - 0.5 * (s[2] + s[5])  # on the mean motor speed
-        i_ref = g.kp_v * e_v + g.ki_v * s[7]
-        sat_v = abs(i_ref) > g.current_limit
-        i_ref = float(np.clip(i_ref, -g.current_limit, g.current_limit))
+        i_ref, sat_v = clamped_pi(g.kp_v, g.ki_v, e_v, s[7], g.current_limit)
         u, e_i, sat_i = [], [], []
         for j, ref in enumerate(self.current_references(i_ref)):
             e = ref - s[3 * j]
-            v = g.kp_i * e + g.ki_i * s[8 + j]
-            sat_i.append(abs(v) > g.voltage_limit)
-            u.append(float(np.clip(v, -g.voltage_limit, g.voltage_limit)))
+            v, sat = clamped_pi(g.kp_i, g.ki_i, e, s[8 + j], g.voltage_limit)
+            sat_i.append(sat)
+            u.append(v)
             e_i.append(e)
         drive = self.motor_rates(q, qd, s, u)
         errors = (e_p, e_v, *e_i)

@@ -106,6 +106,19 @@ def cascade_gains(
     )
 
 
+def clamped_pi(kp: float, ki: float, error: float, integral: float, limit: float):
+    """A loop's PI output ``K_p e + K_i ∫e`` clamped to ±limit, and whether it was clamped.
+
+    Returns
+    -------
+    (float, bool)
+        The clamped output and the flag that stops its integrator (anti-windup by
+        conditional integration).
+    """
+    out = kp * error + ki * integral
+    return float(np.clip(out, -limit, limit)), abs(out) > limit
+
+
 class ServoDrive(DcDrive):
     """A DC drive closed by the current–rate–position cascade on its coordinate.
 
@@ -147,17 +160,11 @@ class ServoDrive(DcDrive):
         """References and clamps of the three loops: (errors, saturated flags, voltage)."""
         g, p = self.g, self.p
         e_p = float(self.reference(t)) - self.encoder(q)
-        rate_ref = g.kp_p * e_p + g.ki_p * s[3]
-        sat_p = abs(rate_ref) > g.rate_limit
-        rate_ref = float(np.clip(rate_ref, -g.rate_limit, g.rate_limit))
+        rate_ref, sat_p = clamped_pi(g.kp_p, g.ki_p, e_p, s[3], g.rate_limit)
         e_v = p.i_r * rate_ref - s[2]  # on the motor speed
-        current_ref = g.kp_v * e_v + g.ki_v * s[4]
-        sat_v = abs(current_ref) > g.current_limit
-        current_ref = float(np.clip(current_ref, -g.current_limit, g.current_limit))
+        current_ref, sat_v = clamped_pi(g.kp_v, g.ki_v, e_v, s[4], g.current_limit)
         e_i = current_ref - s[0]
-        u = g.kp_i * e_i + g.ki_i * s[5]
-        sat_i = abs(u) > g.voltage_limit
-        u = float(np.clip(u, -g.voltage_limit, g.voltage_limit))
+        u, sat_i = clamped_pi(g.kp_i, g.ki_i, e_i, s[5], g.voltage_limit)
         return (e_p, e_v, e_i), (sat_p, sat_v, sat_i), u
 
     def derivative(
