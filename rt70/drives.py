@@ -34,6 +34,7 @@ from rt70.bondgraph.parameters import DriveParameters
 from rt70.couplings import CoordinateCoupling, SceneCoupling
 from rt70.errors import Rt70Error
 from rt70.states import MechanicsForces, StateComponent
+from rt70.urdf.description import DRIVE_PARAMETERS
 
 #: Armature voltage as a function of (t, q, q̇, the drive's states [I, α_m, ω_m]).
 Voltage = Callable[[float, np.ndarray, np.ndarray, np.ndarray], float]
@@ -211,7 +212,6 @@ def drive_parameters(drive, load_inertia: float = 1.0, load_damping: float = 0.0
     The load's ``J_l``, ``D_l`` are not in the element (the scene is the load): pass
     them when a design needs them (:func:`rt70.servo.cascade_gains` takes its own).
     """
-    keys = ("L_a", "R_a", "c_m", "c_e", "J_m", "D_m", "i_r", "C_r", "D_r")
     return DriveParameters(
-        **{k: getattr(drive, k) for k in keys}, J_l=load_inertia, D_l=load_damping
+        **{k: getattr(drive, k) for k in DRIVE_PARAMETERS}, J_l=load_inertia, D_l=load_damping
     )
