@@ -33,6 +33,8 @@ axes (:class:`rt70.friction.AxisFriction`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import scipy.linalg
 
@@ -87,15 +89,18 @@ def scene_equilibrium(
     couplings: list[SceneCoupling],
     held: dict[str, float],
     tol: float = EQUILIBRIUM_TOL,
+    load: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """Static equilibrium held by the scene's drives, encoders at ``held``.
 
-    Solves ``R(q, K) = Q_g(q) + Q_c(q) + Σ_d K_d ∂θ_d/∂q = 0`` for the coordinates not
+    Solves ``R(q, K) = Q_g(q) + Q_c(q) + Q_l(q) + Σ_d K_d ∂θ_d/∂q = 0`` for the coordinates not
     held and the drives' reducer torques K_d (one per coupling): n equations, n unknowns
     when each held coordinate is a drive's joint. Newton's method with the stiffness
     matrix (:func:`rt70.linear.linearize.stiffness_matrix`) and the columns ∂θ_d/∂q for
     the K_d, leaving out the term ``K_d ∂²θ_d/∂q²`` (the sector's geometric stiffness,
-    some 10⁻⁴ of the structure's: it slows the convergence, not the answer).
+    some 10⁻⁴ of the structure's: it slows the convergence, not the answer). ``Q_l`` is
+    an external static load (``load(q)``, a steady wind's generalised force, default
+    none); its stiffness is left out of Newton's matrix likewise.
 
     Returns
     -------
@@ -132,9 +137,13 @@ def scene_equilibrium(
     free = np.array([i for i in range(len(names)) if names[i] not in held])
     S = stiffness_matrix(scene, q)
     size = np.inf
+
+    def force(q: np.ndarray) -> np.ndarray:
+        return static_force(scene, q) if load is None else static_force(scene, q) + load(q)
+
     for _ in range(MAX_ITER):
         G = np.column_stack([c.angle_gradient(q)[1] for c in couplings])
-        R = static_force(scene, q) + G @ K
+        R = force(q) + G @ K
         size = float(np.max(np.abs(R))) / scale
         if size <= tol:
             return q, K, size
@@ -144,10 +153,7 @@ def scene_equilibrium(
         K += step[free.size :]
         if np.abs(step[: free.size]).max() <= STEP_TOL * max(1.0, np.abs(q).max()):
             # the configuration is fixed to rounding (as equilibrium() stops)
-            R = (
-                static_force(scene, q)
-                + np.column_stack([c.angle_gradient(q)[1] for c in couplings]) @ K
-            )
+            R = force(q) + np.column_stack([c.angle_gradient(q)[1] for c in couplings]) @ K
             return q, K, float(np.max(np.abs(R))) / scale
     raise Rt70Error(
         f"{scene.name}: drives' equilibrium not found in {MAX_ITER} Newton steps "

@@ -224,7 +224,7 @@ class AxisPlant:
 # ------------------------------------------------------------------------ the PI cascade
 
 
-def _pi(kp: float, ki: float, inp: str, out: str, scale: float = 1.0) -> control.StateSpace:
+def pi_block(kp: float, ki: float, inp: str, out: str, scale: float = 1.0) -> control.StateSpace:
     """``out = scale (kp e + ki ∫e)``: a PI controller as a state space."""
     return control.ss(
         [[0.0]], [[1.0]], [[scale * ki]], [[scale * kp]], inputs=[inp], outputs=[out], states=1
@@ -268,11 +268,11 @@ def cascade_system(
     blocks = [
         ap.system,
         control.summing_junction(["reference", "-axis_angle"], "e_p"),
-        _pi(g.kp_p, g.ki_p, err("position", "e_p"), "speed_ref", ap.parameters.i_r),
+        pi_block(g.kp_p, g.ki_p, err("position", "e_p"), "speed_ref", ap.parameters.i_r),
         control.summing_junction(["speed_ref", "-motor_speed"], "e_v"),
-        _pi(g.kp_v, g.ki_v, err("rate", "e_v"), "current_ref"),
+        pi_block(g.kp_v, g.ki_v, err("rate", "e_v"), "current_ref"),
         control.summing_junction(["current_ref", "-current"], "e_i"),
-        _pi(g.kp_i, g.ki_i, err("current", "e_i"), "voltage"),
+        pi_block(g.kp_i, g.ki_i, err("current", "e_i"), "voltage"),
     ]
     inputs = ["reference", "wind_torque"] + (["w"] if open_loop else [])
     outputs = ["axis_angle", *POINTING, "voltage", "current", "motor_speed", "e_p", "e_v", "e_i"]

@@ -1,0 +1,181 @@
+"""The scene's own drives and servos closed around its linear structure: both axes at once.
+
+One job: the linear closed loop that :class:`rt70.scene_servo.SceneServoFactory` runs in
+a nonlinear simulation, as one python-control ``StateSpace`` — the structure linearised
+at a drive-held equilibrium, every ``<rt70:drive>`` (its DC motor and compliant reducer,
+formalism §4.5, (4.137)–(4.150)) acting through its own angle θ_d(q), and each drive's
+PI cascade (:mod:`rt70.servo`) reading its encoder on the axis coordinate. Disturbances
+enter as generalised-force columns (a wind gust's, :mod:`rt70.pointing`); outputs are any
+:class:`rt70.outputs.Output` (the mirror system's errors) linearised by
+:func:`rt70.outputs.output_matrix`.
+
+The structure (``x = [δq; δq̇]``, all the scene's coordinates free)::
+
+    M δq̈ + D δq̇ + (K + K_extra) δq = Σ_d g_d τ_d + Σ_j b_j u_j
+
+with ``g_d = ∂θ_d/∂q`` at q0 (:class:`rt70.couplings.SceneCoupling`, textbook side),
+τ_d the reducer torque of drive d, ``b_j`` the disturbance columns and ``K_extra`` a
+stiffness the caller adds (the wind's aerodynamic stiffness, not symmetric). Each drive
+(:func:`rt70.linear.loops.drive_block`) is fed ``θ_d = g_dᵀ δq`` and ``θ̇_d = g_dᵀ δq̇``;
+its cascade reads the encoder δq_k of the drive's joint, exactly as the nonlinear servo
+(:class:`rt70.antiwindup.BackCalculationServo` while no loop is clamped). The sector's
+geometric stiffness ``τ_d ∂²θ_d/∂q²`` is left out, as in
+:func:`rt70.linear.linearize.locked_rotor` (about 10⁻⁵ of the reducer's).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import control
+import numpy as np
+
+from rt70.couplings import SceneCoupling
+from rt70.drives import drive_parameters
+from rt70.errors import Rt70Error
+from rt70.linear import linearize as lin
+from rt70.linear.loops import drive_block, pi_block
+from rt70.outputs import Output, column_labels, output_matrix
+from rt70.scenarios import AXIS_TUNING
+from rt70.scene import Scene
+from rt70.scene_servo import AXES, scene_axis_gains
+
+
+def _renamed(sys: control.StateSpace, prefix: str, name: str) -> control.StateSpace:
+    """``sys`` with every state, input and output name prefixed by ``prefix``."""
+    return control.ss(
+        sys.A,
+        sys.B,
+        sys.C,
+        sys.D,
+        states=[f"{prefix}{n}" for n in sys.state_labels],
+        inputs=[f"{prefix}{n}" for n in sys.input_labels],
+        outputs=[f"{prefix}{n}" for n in sys.output_labels],
+        name=name,
+    )
+
+
+def structure_system(
+    scene: Scene,
+    lm: lin.Linearization,
+    couplings: Sequence[SceneCoupling],
+    disturbances: Mapping[str, np.ndarray],
+    outputs: Sequence[Output],
+    K_extra: np.ndarray | None = None,
+) -> control.StateSpace:
+    """The structure with the drives' torques and the disturbances in, θ_d and outputs out.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    lm : Linearization
+        Its linear model about a drive-held equilibrium, no coordinate locked.
+    couplings : sequence of SceneCoupling
+        One per drive (``d.drive.name`` labels its signals).
+    disturbances : mapping name → (nv,) array
+        Generalised-force column of each unit disturbance input.
+    outputs : sequence of Output
+        Linearised on the textbook side (one row per component, ``name:x`` …).
+    K_extra : (nv, nv) array, optional
+        Added to K as it is (not symmetrised).
+
+    Returns
+    -------
+    control.StateSpace
+        Inputs ``<drive>_reducer_torque`` (τ_d) then the disturbances; outputs
+        ``<drive>_axis_angle`` (θ_d), ``<drive>_axis_rate`` (θ̇_d), ``<drive>_encoder``
+        (the joint's coordinate) for each drive, then the outputs' components. The
+        names match :func:`rt70.linear.loops.drive_block`'s, prefixed by the drive's
+        name, so :func:`closed_loop` connects them by name.
+    """
+    if lm.locked:
+        raise Rt70Error(f"{scene.name}: the closed loop needs every coordinate free")
+    n = len(lm.coordinates)
+    K = lm.K if K_extra is None else lm.K + K_extra
+    Minv = np.linalg.inv(lm.M)
+    G = np.column_stack([c.angle_gradient(lm.q0)[1] for c in couplings])
+    columns = [np.asarray(b, dtype=float).reshape(n) for b in disturbances.values()]
+    Bq = np.column_stack([G, *columns]) if columns else G
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ lm.D]])
+    B = np.vstack([np.zeros_like(Bq), Minv @ Bq])
+    rows, names = [], []
+    for k, c in enumerate(couplings):
+        d = c.drive.name
+        e = np.zeros(n)
+        e[c.index] = 1.0
+        rows += [np.r_[G[:, k], np.zeros(n)], np.r_[np.zeros(n), G[:, k]], np.r_[e, np.zeros(n)]]
+        names += [f"{d}_axis_angle", f"{d}_axis_rate", f"{d}_encoder"]
+    if outputs:
+        Cq = output_matrix(scene, lm.q0, list(outputs), "textbook")
+        for row in Cq:
+            rows.append(np.r_[row, np.zeros(n)])
+        names += [label for y in outputs for label in _labels(y)]
+    C = np.vstack(rows)
+    inputs = [f"{c.drive.name}_reducer_torque" for c in couplings] + list(disturbances)
+    states = [*lm.coordinates, *(f"{c}_dot" for c in lm.coordinates)]
+    return control.ss(
+        A, B, C, np.zeros((C.shape[0], B.shape[1])),
+        states=states, inputs=inputs, outputs=names, name="structure",
+    )  # fmt: skip
+
+
+def _labels(y: Output) -> list[str]:
+    return column_labels(y.name, y.size) if y.size > 1 else [y.name]
+
+
+def closed_loop(
+    scene: Scene,
+    lm: lin.Linearization,
+    disturbances: Mapping[str, np.ndarray],
+    outputs: Sequence[Output],
+    K_extra: np.ndarray | None = None,
+    tuning: Mapping[str, tuple[float, float]] | None = None,
+) -> control.StateSpace:
+    """The scene's drives with their PI cascades closed around the structure.
+
+    Each ``<rt70:drive>`` gets the cascade :class:`rt70.scene_servo.SceneServoFactory`
+    gives it (:func:`rt70.scene_servo.scene_axis_gains` with ``tuning``, default
+    :data:`rt70.scenarios.AXIS_TUNING`), without its clamps (a linear analysis).
+
+    Returns
+    -------
+    control.StateSpace
+        Inputs ``<drive>_reference`` (rad, on the encoder's coordinate, about its value
+        at q0) then the disturbances; outputs the requested outputs' components, then
+        each drive's ``encoder``, ``current`` (A) and ``voltage`` (V).
+
+    Raises
+    ------
+    Rt70Error
+        If the scene has no drive on an RT-70 axis.
+    """
+    drives = scene.description.drives
+    if not drives or any(d.joint not in AXES for d in drives):
+        raise Rt70Error(f"{scene.name}: the closed loop needs <rt70:drive> on the RT-70 axes")
+    tuning = {**AXIS_TUNING, **(tuning or {})}
+    couplings = [SceneCoupling(scene, d, "textbook") for d in drives]
+    blocks = [structure_system(scene, lm, couplings, disturbances, outputs, K_extra)]
+    extra_out = []
+    for c in couplings:
+        d = c.drive.name
+        axis = AXES[c.drive.joint]
+        p = drive_parameters(c.drive, axis.reference_inertia)
+        g = scene_axis_gains(p, axis, *tuning[axis.name])
+        drive = _renamed(drive_block(p), f"{d}_", f"{d}_drive")
+        # the drive's own names: voltage, axis_angle, axis_rate → reducer_torque, …
+        blocks += [
+            drive,
+            control.summing_junction([f"{d}_reference", f"-{d}_encoder"], f"{d}_e_p"),
+            pi_block(g.kp_p, g.ki_p, f"{d}_e_p", f"{d}_speed_ref", p.i_r),
+            control.summing_junction([f"{d}_speed_ref", f"-{d}_motor_speed"], f"{d}_e_v"),
+            pi_block(g.kp_v, g.ki_v, f"{d}_e_v", f"{d}_current_ref"),
+            control.summing_junction([f"{d}_current_ref", f"-{d}_current"], f"{d}_e_i"),
+            pi_block(g.kp_i, g.ki_i, f"{d}_e_i", f"{d}_voltage"),
+        ]
+        extra_out += [f"{d}_encoder", f"{d}_current", f"{d}_voltage"]
+    inputs = [f"{c.drive.name}_reference" for c in couplings] + list(disturbances)
+    outs = [label for y in outputs for label in _labels(y)] + extra_out
+    return control.interconnect(
+        blocks, inplist=inputs, outlist=outs, inputs=inputs, outputs=outs, check_unused=False
+    )
