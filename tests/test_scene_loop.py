@@ -88,7 +88,8 @@ def test_linear_loop_follows_the_nonlinear_servo(case):
     """6 s after a step load: the linear closed loop equals the nonlinear simulation."""
     scene, factory, held, q0, torques, outs, loop = case
     names = scene.coordinate_names
-    refs = {c: (lambda t, v=q0[names.index(c)]: v) for c in held}
+    values = {c: float(q0[names.index(c)]) for c in held}
+    refs = {c: (lambda t, v=v: v) for c, v in values.items()}
     components = factory(scene, q0, torques, refs) + [_Push(scene)]
     t = np.linspace(0.0, 6.0, 121)
     result = simulate(
@@ -102,9 +103,10 @@ def test_linear_loop_follows_the_nonlinear_servo(case):
         components=components,
     )
     assert result.success
-    y = result.outputs["main_mirror_error"] - evaluate(scene, q0, outs, "reference")[
-        "main_mirror_error"
-    ]
+    y = (
+        result.outputs["main_mirror_error"]
+        - evaluate(scene, q0, outs, "reference")["main_mirror_error"]
+    )
     rows = [f"main_mirror_error:{c}" for c in "xyz"]
     linear = control.forced_response(loop[rows, "push"], T=t, U=np.ones_like(t)).outputs.T
     assert np.abs(linear).max() > 10.0
