@@ -224,10 +224,19 @@ class AxisPlant:
 # ------------------------------------------------------------------------ the PI cascade
 
 
-def pi_block(kp: float, ki: float, inp: str, out: str, scale: float = 1.0) -> control.StateSpace:
-    """``out = scale (kp e + ki ∫e)``: a PI controller as a state space."""
+def pi_block(
+    kp: float, ki: float, inp: str, out: str, scale: float = 1.0, name: str | None = None
+) -> control.StateSpace:
+    """``out = scale (kp e + ki ∫e)``: a PI controller as a state space (state ``integral``)."""
     return control.ss(
-        [[0.0]], [[1.0]], [[scale * ki]], [[scale * kp]], inputs=[inp], outputs=[out], states=1
+        [[0.0]],
+        [[1.0]],
+        [[scale * ki]],
+        [[scale * kp]],
+        inputs=[inp],
+        outputs=[out],
+        states=["integral"],
+        name=name,
     )
 
 

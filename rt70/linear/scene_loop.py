@@ -42,13 +42,16 @@ from rt70.scene_servo import AXES, scene_axis_gains
 
 
 def _renamed(sys: control.StateSpace, prefix: str, name: str) -> control.StateSpace:
-    """``sys`` with every state, input and output name prefixed by ``prefix``."""
+    """``sys`` named ``name``, its input and output names prefixed by ``prefix``.
+
+    The states keep their names: the interconnection prefixes them with ``name``.
+    """
     return control.ss(
         sys.A,
         sys.B,
         sys.C,
         sys.D,
-        states=[f"{prefix}{n}" for n in sys.state_labels],
+        states=list(sys.state_labels),
         inputs=[f"{prefix}{n}" for n in sys.input_labels],
         outputs=[f"{prefix}{n}" for n in sys.output_labels],
         name=name,
@@ -162,16 +165,16 @@ def closed_loop(
         axis = AXES[c.drive.joint]
         p = drive_parameters(c.drive, axis.reference_inertia)
         g = scene_axis_gains(p, axis, *tuning[axis.name])
-        drive = _renamed(drive_block(p), f"{d}_", f"{d}_drive")
+        drive = _renamed(drive_block(p), f"{d}_", d)
         # the drive's own names: voltage, axis_angle, axis_rate → reducer_torque, …
         blocks += [
             drive,
             control.summing_junction([f"{d}_reference", f"-{d}_encoder"], f"{d}_e_p"),
-            pi_block(g.kp_p, g.ki_p, f"{d}_e_p", f"{d}_speed_ref", p.i_r),
+            pi_block(g.kp_p, g.ki_p, f"{d}_e_p", f"{d}_speed_ref", p.i_r, f"{d}_position_loop"),
             control.summing_junction([f"{d}_speed_ref", f"-{d}_motor_speed"], f"{d}_e_v"),
-            pi_block(g.kp_v, g.ki_v, f"{d}_e_v", f"{d}_current_ref"),
+            pi_block(g.kp_v, g.ki_v, f"{d}_e_v", f"{d}_current_ref", name=f"{d}_rate_loop"),
             control.summing_junction([f"{d}_current_ref", f"-{d}_current"], f"{d}_e_i"),
-            pi_block(g.kp_i, g.ki_i, f"{d}_e_i", f"{d}_voltage"),
+            pi_block(g.kp_i, g.ki_i, f"{d}_e_i", f"{d}_voltage", name=f"{d}_current_loop"),
         ]
         extra_out += [f"{d}_encoder", f"{d}_current", f"{d}_voltage"]
     inputs = [f"{c.drive.name}_reference" for c in couplings] + list(disturbances)
