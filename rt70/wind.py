@@ -287,22 +287,35 @@ class CoefficientTable:
     def ratios(self, cos_theta: float, sin_theta: float) -> tuple[float, float, float]:
         """``(C_A, C_N/sin θ, C_M/sin θ)`` at θ given by its cosine and (≥ 0) sine.
 
-        The odd coefficients are evaluated on the interval that starts at 0 (θ ≤ 90°)
-        or, through ``C(θ) = −C(2π − θ)``, at π, so a small C near either end is not a
-        difference of large spline terms; below :data:`SMALL_SINE` the ratio is the
-        derivative, ``C'(0)`` or ``−C'(π)``.
+        The odd coefficients are evaluated on the spline interval that starts at 0
+        (θ ≤ 90°) or, through ``C(θ) = −C(π + x)`` with ``x = π − θ`` taken as
+        ``atan2(sin θ, −cos θ)``, on the one that starts at π, as the interval's
+        polynomial in x itself: a small C near either end is then accurate to rounding
+        relative to itself (not ε·π / x), so the ratio is too. Below
+        :data:`SMALL_SINE` the ratio is the derivative, ``C'(0)`` or ``−C'(π)``.
         """
         axial, normal, moment = self._splines
         theta = math.atan2(sin_theta, cos_theta)
         c_a = float(axial(theta))
         if sin_theta < SMALL_SINE:
-            end, sign = (0.0, 1.0) if cos_theta > 0.0 else (math.pi, -1.0)
-            return c_a, sign * float(normal(end, 1)), sign * float(moment(end, 1))
+            if cos_theta > 0.0:
+                return c_a, float(normal(0.0, 1)), float(moment(0.0, 1))
+            m = len(self.theta_deg) - 1  # the interval [π, …] of the full circle
+            return c_a, -float(normal.c[2, m]), -float(moment.c[2, m])
         if cos_theta >= 0.0:
             c_n, c_m = float(normal(theta)), float(moment(theta))
         else:
-            c_n, c_m = -float(normal(2.0 * math.pi - theta)), -float(moment(2.0 * math.pi - theta))
+            x = math.atan2(sin_theta, -cos_theta)
+            c_n, c_m = -self._from_pi(normal, x), -self._from_pi(moment, x)
         return c_a, c_n / sin_theta, c_m / sin_theta
+
+    def _from_pi(self, spline: CubicSpline, x: float) -> float:
+        """``C(π + x)``, x ≥ 0: the polynomial of the interval at π in ``dx = x`` exactly."""
+        m = len(self.theta_deg) - 1
+        if x <= spline.x[m + 1] - spline.x[m]:
+            c = spline.c[:, m]
+            return float(((c[0] * x + c[1]) * x + c[2]) * x + c[3])
+        return float(spline(spline.x[m] + x))
 
 
 def builtin_table(name: str) -> CoefficientTable:
