@@ -51,13 +51,15 @@ import math
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from rt70.errors import Rt70Error
 from rt70.loads import Pose, Wrench
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicSpline
 
 #: ISA sea-level air density, kg/m³ (the default of ``<rt70:air density>``).
 DEFAULT_AIR_DENSITY = 1.225
@@ -188,6 +190,8 @@ class CoefficientTable:
     _splines: tuple = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        from scipy.interpolate import CubicSpline  # only when a scene has wind elements
+
         theta = np.radians(self.theta_deg)
         full = np.concatenate([theta, 2.0 * np.pi - theta[::-1][1:]])  # 0 … 2π
 
