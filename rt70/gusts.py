@@ -298,20 +298,32 @@ def _factor(S: np.ndarray) -> np.ndarray:
 def discretise(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Exact sampling of ``ẋ = A x + B w`` (unit white noise) at the interval dt.
 
-    Van Loan (1978): ``expm([[−A, B Bᵀ], [0, Aᵀ]] dt) = [[·, F₁₂], [0, F₂₂]]`` gives
-    ``Φ = F₂₂ᵀ = e^{A dt}`` and ``Q_d = Φ F₁₂ = ∫₀^dt e^{As} B Bᵀ e^{Aᵀs} ds``, so that
-    ``x_{k+1} = Φ x_k + e_k``, ``e_k ~ N(0, Q_d)`` independent.
+    Van Loan (1978): ``expm([[−A, B Bᵀ], [0, Aᵀ]] h) = [[·, F₁₂], [0, F₂₂]]`` gives
+    ``Φ(h) = F₂₂ᵀ = e^{A h}`` and ``Q(h) = Φ F₁₂ = ∫₀^h e^{As} B Bᵀ e^{Aᵀs} ds``. Its
+    block ``e^{−A h}`` grows like ``e^{|λ|h}`` for a fast stable pole and ``Φ F₁₂`` then
+    cancels catastrophically (at |λ|·h ≈ 300 the result is garbage), so Van Loan's formula
+    is applied at ``h = dt/2^k`` with ``‖A‖₁ h ≤ 1/2`` and doubled k times:
+    ``Q(2h) = Q(h) + Φ(h) Q(h) Φ(h)ᵀ``, ``Φ(2h) = Φ(h)²`` (sums of positive
+    semi-definite terms, no cancellation). Then ``x_{k+1} = Φ x_k + e_k``,
+    ``e_k ~ N(0, Q_d)`` independent, with ``Q_d = Q(dt)`` and ``Φ = e^{A dt}``
+    (``scipy.linalg.expm`` at dt).
 
     Returns
     -------
     Phi, Qd : ndarray
     """
     n = A.shape[0]
-    M = np.block([[-A, B @ B.T], [np.zeros((n, n)), A.T]]) * dt
+    norm = np.linalg.norm(A, 1) * dt
+    doublings = int(np.ceil(np.log2(norm / 0.5))) if norm > 0.5 else 0
+    h = dt / 2**doublings
+    M = np.block([[-A, B @ B.T], [np.zeros((n, n)), A.T]]) * h
     F = scipy.linalg.expm(M)
     Phi = F[n:, n:].T
     Qd = Phi @ F[:n, n:]
-    return Phi, 0.5 * (Qd + Qd.T)
+    for _ in range(doublings):
+        Qd = Qd + Phi @ Qd @ Phi.T
+        Phi = Phi @ Phi
+    return scipy.linalg.expm(A * dt), 0.5 * (Qd + Qd.T)
 
 
 def _propagate(Phi: np.ndarray, x0: np.ndarray, e: np.ndarray) -> np.ndarray:
@@ -357,7 +369,9 @@ def realise(filter: Any, t_end: float, dt: float, seed: int) -> GustSeries:
     Notes
     -----
     ``x₀ ~ N(0, P)`` with P the stationary covariance (so the series is stationary from
-    t = 0), ``x_{k+1} = Φ x_k + e_k`` with Φ and Q_d from :func:`discretise`.
+    t = 0), ``x_{k+1} = Φ x_k + e_k`` with Φ and Q_d from :func:`discretise`; the
+    recursion runs per mode (``scipy.signal.lfilter``) when Φ's eigenvectors are well
+    conditioned, else step by step.
     """
     s = _system(filter.matrices() if isinstance(filter, GustFilter) else filter)
     _no_feedthrough(s)
