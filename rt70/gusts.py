@@ -327,17 +327,27 @@ def discretise(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.
 
 
 def _propagate(Phi: np.ndarray, x0: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """States ``x_0 … x_N`` of ``x_{k+1} = Φ x_k + e_k`` (rows)."""
+    """States ``x_0 … x_N`` of ``x_{k+1} = Φ x_k + e_k`` (rows).
+
+    In modal coordinates ``z = V⁻¹ x`` each mode is a first-order recursion that
+    ``scipy.signal.lfilter`` runs in compiled code; a (nearly) defective Φ is stepped
+    through by :func:`_propagate_steps` instead.
+    """
     lam, V = np.linalg.eig(Phi)
-    if np.linalg.cond(V) < 1e8:  # modal coordinates, each a first-order recursion in C
-        Vinv = np.linalg.inv(V)
-        z0, u = Vinv @ x0, e @ Vinv.T
-        z = np.empty((len(e) + 1, len(x0)), dtype=complex)
-        z[0] = z0
-        for k, lk in enumerate(lam):
-            z[1:, k] = scipy.signal.lfilter([1.0], [1.0, -lk], u[:, k], zi=[lk * z0[k]])[0]
-        return np.real(z @ V.T)
-    x = np.empty((len(e) + 1, len(x0)))  # pragma: no cover - defective Φ, plain loop
+    if not np.linalg.cond(V) < 1e8:
+        return _propagate_steps(Phi, x0, e)
+    Vinv = np.linalg.inv(V)
+    z0, u = Vinv @ x0, e @ Vinv.T
+    z = np.empty((len(e) + 1, len(x0)), dtype=complex)
+    z[0] = z0
+    for k, lk in enumerate(lam):
+        z[1:, k] = scipy.signal.lfilter([1.0], [1.0, -lk], u[:, k], zi=[lk * z0[k]])[0]
+    return np.real(z @ V.T)
+
+
+def _propagate_steps(Phi: np.ndarray, x0: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`_propagate` one step at a time (any Φ; slow for long records)."""
+    x = np.empty((len(e) + 1, len(x0)))
     x[0] = x0
     for k, ek in enumerate(e):
         x[k + 1] = Phi @ x[k] + ek

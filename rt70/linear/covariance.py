@@ -299,6 +299,8 @@ def _pairs(eigenvalues: np.ndarray) -> list[list[int]]:
     lower = [i for i in range(len(eigenvalues)) if not real[i] and eigenvalues[i].imag < 0]
     groups = [[i] for i in np.flatnonzero(real)]
     for i in upper:
+        if not lower:
+            raise Rt70Error("the eigenvalues of A do not come in complex-conjugate pairs")
         j = min(lower, key=lambda k: abs(eigenvalues[k] - np.conj(eigenvalues[i])))
         lower.remove(j)
         groups.append([i, j])
