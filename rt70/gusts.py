@@ -91,16 +91,21 @@ def davenport_spectrum(
         S_u(n) in (m/s)²/Hz, the shape of ``n_hz``.
     """
     _check_wind(speed, kappa, length)
+    x = length * _frequencies(n_hz) / speed
+    return kappa * speed * length * 4.0 * x / (1.0 + x**2) ** (4.0 / 3.0)
+
+
+def _frequencies(n_hz: float | np.ndarray) -> np.ndarray:
     n = np.asarray(n_hz, dtype=float)
     if not np.all(np.isfinite(n)) or np.any(n < 0):
         raise Rt70Error("gust spectrum: frequencies must be finite and ≥ 0 Hz")
-    x = length * n / speed
-    return kappa * speed * length * 4.0 * x / (1.0 + x**2) ** (4.0 / 3.0)
+    return n
 
 
 def _check_wind(speed: float, kappa: float, length: float) -> None:
     for name, value in (("wind speed", speed), ("kappa", kappa), ("length scale", length)):
-        if not (isinstance(value, int | float | np.floating | np.integer) and np.isfinite(value)):
+        number = isinstance(value, int | float | np.floating | np.integer)
+        if isinstance(value, bool) or not (number and np.isfinite(value)):
             raise Rt70Error(f"gusts: {name} must be a finite number, got {value!r}")
         if value <= 0:
             raise Rt70Error(f"gusts: {name} must be positive, got {value}")
@@ -250,10 +255,11 @@ class GustFilter:
 
     def spectrum(self, n_hz: float | np.ndarray) -> np.ndarray:
         """The filter's one-sided output spectrum ``2|H(j2πn)|²`` ((m/s)²/Hz)."""
-        n = np.asarray(n_hz, dtype=float)
+        n = _frequencies(n_hz)
         params = np.log([FILTER_GAIN, *FILTER_ZEROS, *FILTER_POLES])
-        x = self.length * n / self.speed
-        return self.kappa * self.speed * self.length * _dimensionless_response(params, x, 2)
+        x = (self.length * n / self.speed).ravel()
+        response = _dimensionless_response(params, x, 2).reshape(n.shape)
+        return self.kappa * self.speed * self.length * response
 
     def variance(self) -> float:
         """The output's stationary variance ``C P Cᵀ`` (Lyapunov), (m/s)²."""

@@ -85,6 +85,7 @@ def test_filter_scaling(speed, length):
     inside = (x >= 1e-2) & (x <= 1e2)
     ratio = f.spectrum(n[inside]) / gusts.davenport_spectrum(n[inside], speed, length=length)
     assert np.max(np.abs(np.log10(ratio))) <= 0.1181
+    assert np.shape(f.spectrum(1.0)) == () and f.spectrum(0.0) == 0.0
     # a zero at s = 0: |H| ∝ ω at low frequency
     h1, h2 = np.abs(sys.horner(2j * np.pi * np.array([1e-9, 1e-8]))[0, 0])
     assert h2 / h1 == pytest.approx(10.0, rel=1e-4)
@@ -216,6 +217,8 @@ def test_multi_output_series():
         (lambda: gusts.GustFilter(10.0, kappa=-1.0), "kappa must be positive"),
         (lambda: gusts.GustFilter("10"), "wind speed must be a finite number"),
         (lambda: gusts.davenport_spectrum(-1.0, 10.0), "frequencies must be finite"),
+        (lambda: gusts.GustFilter(10.0).spectrum([np.nan]), "frequencies must be finite"),
+        (lambda: gusts.GustFilter(True), "wind speed must be a finite number"),
         (lambda: gusts.realise(gusts.GustFilter(10.0), 10.0, 20.0, 1), "need 0 < dt ≤ t_end"),
         (lambda: gusts.realise(gusts.GustFilter(10.0), 10.0, 0.0, 1), "need 0 < dt ≤ t_end"),
         (lambda: gusts.realise(gusts.GustFilter(10.0), 10.0, 0.1, None), "seed"),
