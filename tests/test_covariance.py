@@ -218,3 +218,30 @@ def test_sample_variance_error_vs_independent_records():
 def test_bad_input(call, match):
     with pytest.raises(Rt70Error, match=match):
         call()
+
+
+def test_rt70_state_space_is_accepted():
+    """rt70's own StateSpace (M q̈ + D q̇ + K q = B u) works as python-control's does."""
+    from rt70.linear.responses import state_space
+
+    M, K = np.diag([2.0, 1.0]), np.array([[30.0, -10.0], [-10.0, 10.0]])
+    D = 0.02 * K
+    ss = state_space(
+        M,
+        K,
+        D,
+        np.array([[1.0], [0.0]]),
+        np.array([[0.0, 1.0]]),
+        input_names=["wind"],
+        output_names=["tip"],
+    )
+    plant = control.ss(ss.A, ss.B, ss.C, ss.D, inputs=["wind"], outputs=["tip"])
+    assert cov.output_covariance(ss)[0, 0] == pytest.approx(
+        cov.output_covariance(plant)[0, 0], rel=1e-14
+    )
+    gust = GustFilter(10.0).system
+    ours, theirs = (cov.cascade_with_filter(p, gust, "wind") for p in (ss, plant))
+    assert ours.output_labels == ["tip"]
+    np.testing.assert_array_equal(ours.A, theirs.A)
+    modes = cov.mode_contributions(ss, "tip")
+    assert len(modes) == 2 and sum(m.share for m in modes) == pytest.approx(1.0, abs=1e-12)
