@@ -4,7 +4,8 @@ For each scene and each of N random states (q, q̇) both sides compute the same
 quantities — the dynamics, the positions of the links' origins and of the scene's
 optical points (:mod:`rt70.outputs`), the generalised force of a random load (:mod:`rt70.loads`)
 and the angle and generalised force at unit torque of the scene's drives (``<rt70:drive>``)
-and of a random gear sector;
+and of a random gear sector, and, for a scene with ``<rt70:wind>`` elements, the wind's
+generalised force under a random steady wind (row ``wind``);
 every row of the report gives the largest absolute error, the largest
 error relative to the reference's max-norm, and the mean wall time per evaluation of
 each side.
@@ -26,6 +27,7 @@ from rt70.scene import Scene, require_coordinates
 from rt70.textbook import drives as tb_drives
 from rt70.textbook import dynamics, forces, points
 from rt70.urdf.description import DRIVE_PARAMETERS, Drive, DriveSector
+from rt70.wind import WindCondition
 
 #: Default agreement tolerance, relative to the reference's max-norm.
 DEFAULT_TOLERANCE = 1e-10
@@ -44,6 +46,14 @@ QUANTITIES = (
     "load_force",
     "drives",
 )
+
+#: Compared after :data:`QUANTITIES` for a scene with ``<rt70:wind>`` elements only.
+WIND = "wind"
+
+
+def quantities(scene: Scene) -> tuple[str, ...]:
+    """The rows of ``scene``'s report: :data:`QUANTITIES`, and :data:`WIND` if it has wind."""
+    return QUANTITIES + ((WIND,) if scene.description.winds else ())
 
 
 @dataclass(frozen=True)
@@ -132,6 +142,17 @@ def state_drive(scene: Scene, q: np.ndarray) -> Drive:
     return Drive("probe", "", *np.ones(len(DRIVE_PARAMETERS)), sector=sector)
 
 
+def state_wind(q: np.ndarray) -> WindCondition:
+    """The steady wind compared at the state q (row ``wind``).
+
+    Seeded from q as :func:`state_wrench` (the bits in another order): speed uniform in
+    [1, 40] m/s, direction uniform in [0°, 360°), the scene's air density.
+    """
+    bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
+    rng = np.random.default_rng(np.roll(bits, 1))
+    return WindCondition(float(rng.uniform(1.0, 40.0)), float(rng.uniform(0.0, 360.0)))
+
+
 def compared_points(scene: Scene) -> list[Output]:
     """The positions compared in row ``points``.
 
@@ -170,6 +191,8 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     from rt70 import reference
     from rt70.reference import drives as ref_drives
     from rt70.reference import points as ref_points
+    from rt70.reference import wind as ref_wind
+    from rt70.textbook import wind as tb_wind
 
     tm, td = scene.textbook, scene.textbook_data
     ref, rd = scene.reference, scene.reference_data
@@ -181,7 +204,7 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
         Qc, Qd = forces.spring_damper_force(tm, td, q, qd)
         return dynamics.forward_dynamics(tm, td, q, qd, Qc + Qd)
 
-    return {
+    pairs = {
         "mass_matrix": (
             lambda: dynamics.mass_matrix(tm, td, q),
             lambda: reference.mass_matrix(ref, rd, q),
@@ -227,6 +250,13 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: _stacked_drives(ref_drives.drive_force, ref, rd, q, compared_drives),
         ),
     }
+    if scene.description.winds:  # Q_w = S W and Jᵀ f (4.132)–(4.136), a random wind
+        wind = state_wind(q)
+        pairs[WIND] = (
+            lambda: tb_wind.wind_force(tm, td, q, wind),
+            lambda: ref_wind.wind_force(ref, rd, q, wind),
+        )
+    return pairs
 
 
 def _stacked_drives(drive_force: Callable, model, data, q: np.ndarray, drives) -> np.ndarray:
@@ -320,6 +350,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
         "load_force": _load_scale(scene, q),
         "drives": norm("drives"),
+        **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
     }
 
 
@@ -330,6 +361,19 @@ def _load_scale(scene: Scene, q: np.ndarray) -> float:
     w = state_wrench(scene, q)
     Jv, Jw = ref_points.point_jacobian(scene.reference, scene.reference_data, q, w.link, w.xyz)
     terms = np.abs(Jv).T @ np.abs(w.force) + np.abs(Jw).T @ np.abs(w.torque)
+    return float(np.max(terms, initial=0.0))
+
+
+def _wind_scale(scene: Scene, q: np.ndarray) -> float:
+    """``‖Σ_i |J_v,i|ᵀ|F_i| + |J_ω,i|ᵀ|M_i|‖`` of the state's wind, Pinocchio's Jacobians."""
+    from rt70.reference import points as ref_points
+    from rt70.reference import wind as ref_wind
+
+    ref, rd = scene.reference, scene.reference_data
+    terms = np.zeros(ref.nv)
+    for w in ref_wind.wind_wrenches(ref, rd, q, state_wind(q)).values():
+        Jv, Jw = ref_points.point_jacobian(ref, rd, q, w.link, w.xyz)
+        terms += np.abs(Jv).T @ np.abs(w.force) + np.abs(Jw).T @ np.abs(w.torque)
     return float(np.max(terms, initial=0.0))
 
 
@@ -349,7 +393,7 @@ def _nonfinite(x: np.ndarray) -> bool:
 
 
 def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3) -> list[Record]:
-    """Compare every quantity of :data:`QUANTITIES` on ``samples`` random states.
+    """Compare every quantity of :func:`quantities` (scene's rows) on ``samples`` random states.
 
     The relative error is the max-norm of the difference over the larger of the
     max-norm of Pinocchio's value and ``FLOOR`` times the quantity's natural scale at
@@ -369,11 +413,12 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
         raise Rt70Error(f"samples must be at least 1, got {samples}")
     rng = np.random.default_rng(seed)
     nv = scene.textbook.nv
-    abs_err = dict.fromkeys(QUANTITIES, 0.0)
-    rel_err = dict.fromkeys(QUANTITIES, 0.0)
-    t_tb = dict.fromkeys(QUANTITIES, 0.0)
-    t_ref = dict.fromkeys(QUANTITIES, 0.0)
-    bad: dict[str, set[str]] = {name: set() for name in QUANTITIES}
+    rows = quantities(scene)
+    abs_err = dict.fromkeys(rows, 0.0)
+    rel_err = dict.fromkeys(rows, 0.0)
+    t_tb = dict.fromkeys(rows, 0.0)
+    t_ref = dict.fromkeys(rows, 0.0)
+    bad: dict[str, set[str]] = {name: set() for name in rows}
     for _ in range(samples):
         q, qd = random_state(nv, rng)
         values = {}
@@ -386,8 +431,8 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
             for side, x in zip(("textbook", "pinocchio"), values[name], strict=True):
                 if _nonfinite(x):
                     bad[name].add(side)
-        if any(bad[name] for name in QUANTITIES):  # no scale from non-finite values
-            scales = dict.fromkeys(QUANTITIES, 0.0)
+        if any(bad[name] for name in rows):  # no scale from non-finite values
+            scales = dict.fromkeys(rows, 0.0)
         else:
             scales = natural_scales(scene, values, q, qd)
         for name, (x_tb, x_ref) in values.items():
@@ -409,7 +454,7 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
             t_ref[name],
             " and ".join(sorted(bad[name])),
         )
-        for name in QUANTITIES
+        for name in rows
     ]
 
 

@@ -32,8 +32,16 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "rt70"
 
 #: Modules below both sides that any layer may import (``rt70.loads``: the plain
-#: Wrench value both sides turn into a generalised force).
-SHARED = ("rt70.errors", "rt70.arrays", "rt70.rotations", "rt70.loads", "rt70.constraints")
+#: Wrench value both sides turn into a generalised force; ``rt70.wind``: the wind's
+#: Wrench on a body at a pose each side computes).
+SHARED = (
+    "rt70.errors",
+    "rt70.arrays",
+    "rt70.rotations",
+    "rt70.loads",
+    "rt70.constraints",
+    "rt70.wind",
+)
 
 #: layer (module prefix) → module prefixes it may import from rt70.
 RULES = {
@@ -41,7 +49,7 @@ RULES = {
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
     # not rt70.constraints: the reference side maps mimic joints on its own, so the
     # cross-check also checks the textbook's constraint matrix G
-    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED[:4]),
+    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED[:4], "rt70.wind"),
     "rt70.resources": ("rt70.urdf.description", *SHARED),
     "rt70.rotations": (),
     "rt70.errors": (),
@@ -50,6 +58,7 @@ RULES = {
     # a second formulation of the drives, independent of both rigid-body sides
     "rt70.bondgraph": ("rt70.bondgraph", *SHARED),
     "rt70.loads": ("rt70.arrays", "rt70.errors"),
+    "rt70.wind": ("rt70.errors", "rt70.loads"),
 }
 
 
@@ -213,6 +222,7 @@ RT70_MODULES = (
     "rt70.scenes.rt70_state",
     "rt70.scenes.rt70_drives",
     "rt70.scenes.rt70_optics",
+    "rt70.scenes.rt70_wind",
 )
 
 #: Generic analyses and simulation: they take what they need of a scene as arguments.
@@ -223,6 +233,8 @@ GENERIC = (
     "rt70.outputs",
     "rt70.optics",
     "rt70.loads",
+    "rt70.wind",
+    "rt70.wind_load",
     "rt70.constraints",
     "rt70.bondgraph",
     "rt70.drives",

@@ -67,3 +67,13 @@ def test_installed_package_is_not_the_source_tree(installed, tmp_path):
     module, scenes = proc.stdout.split()
     assert not module.startswith(str(ROOT)) and not scenes.startswith(str(ROOT))
     assert scenes.endswith("scene_files")
+
+
+def test_installed_package_ships_the_wind_tables(installed, tmp_path):
+    """The built-in coefficient tables are package data (rt70/wind_tables/*.csv)."""
+    code = (
+        "from rt70.wind import builtin_table as b\n"
+        "print(b('dish').axial[0], b('cylinder').normal[18], b('dish').source)\n"
+    )
+    proc = _run([str(installed / "python"), "-c", code], tmp_path)
+    assert proc.stdout.split()[:2] == ["1.42", "1.2"]

@@ -6,5 +6,8 @@
 - :mod:`rt70.linear.modal` — eigenfrequencies, mode shapes, damping, principal coordinates;
 - :mod:`rt70.linear.responses` — state space, frequency and step responses;
 - :mod:`rt70.linear.checks` — the input checks both share;
-- :mod:`rt70.linear.linearize` — equilibrium and M, K, D of a nonlinear URDF scene.
+- :mod:`rt70.linear.linearize` — equilibrium and M, K, D of a nonlinear URDF scene;
+- :mod:`rt70.linear.covariance` — stationary covariances under white noise (Lyapunov),
+  shaping filters in series, the variance split over modes, the statistical error of a
+  record's mean square.
 """

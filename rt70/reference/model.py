@@ -73,6 +73,8 @@ class ReferenceModel:
         Attachment frames and gains of every bushing and strut.
     spring_v, spring_k, spring_d : numpy.ndarray
         Velocity index, stiffness and damping of every joint spring.
+    winds, air_density : tuple of rt70.urdf.Wind, float
+        The scene's exposed bodies and air density (:mod:`rt70.reference.wind`).
     """
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
@@ -105,6 +107,8 @@ class ReferenceModel:
         )
         self.spring_k = np.array([s.stiffness for s in desc.joint_springs], dtype=float)
         self.spring_d = np.array([s.damping for s in desc.joint_springs], dtype=float)
+        self.winds = desc.winds  # exposed bodies (rt70.reference.wind)
+        self.air_density = desc.air_density
         self._built = True
 
     def __setattr__(self, name: str, value: object) -> None:

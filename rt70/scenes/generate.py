@@ -19,7 +19,7 @@ from pathlib import Path
 
 from rt70.atomic import atomic_write_text
 from rt70.geartrains import parallel_drive
-from rt70.scenes import mechanisms, rt70_data, rt70_drives
+from rt70.scenes import mechanisms, rt70_data, rt70_drives, rt70_wind
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.pairs import pair_joint_names
 from rt70.scenes.urdf_writer import ROOT_LINK, ZERO3, check_name, fmt, fmt_vec
@@ -69,7 +69,8 @@ def rt70_servo_scene() -> str:
     horizontal is 2.66 times the book's nominal drive torque (errata item 12). This
     scene is the listing with the counterweight's offset mirrored to ``[0, 0, −16]`` m
     (:data:`rt70_data.SERVO_BODIES`), the control object of issue 10, with its two
-    drives (``<rt70:drive>``, :func:`_servo_drives`).
+    drives (``<rt70:drive>``, :func:`_servo_drives`) and its four exposed bodies
+    (``<rt70:wind>``, :func:`_servo_winds`).
     """
     return _rt70_text(
         "rt70_servo",
@@ -77,8 +78,34 @@ def rt70_servo_scene() -> str:
         "with the counterweight below the elevation axis (errata item 12 in "
         "docs/rt70-errata.md) and the azimuth and elevation drives",
         rt70_data.SERVO_BODIES,
-        drives=_servo_drives,
+        drives=_servo_drives_and_winds,
     )
+
+
+def _servo_drives_and_winds(w: uw.Writer) -> None:
+    """The servo scene's drives, then its wind elements."""
+    _servo_drives(w)
+    _servo_winds(w)
+
+
+def _servo_winds(w: uw.Writer) -> None:
+    """The RT-70's exposed bodies and the air (docs/wind.md, :mod:`rt70_wind`)."""
+    w.comment(
+        "Wind (section 4.1.6; docs/wind.md): exposed bodies, derived shapes; ISA sea-level "
+        "air (the Suffa plateau, ~2.3 km: ~0.97 kg/m3)"
+    )
+    w.empty("rt70:air", ("density", fmt(1.225)))
+    for e in rt70_wind.wind_elements():
+        w.empty(
+            "rt70:wind",
+            ("name", e["name"]),
+            ("link", e["link"]),
+            ("shape", e["shape"]),
+            ("area", fmt(e["area"])),
+            ("length", fmt(e["length"])),
+            ("xyz", fmt_vec(e["xyz"])),
+            ("axis", fmt_vec(e["axis"])),
+        )
 
 
 def lumped_drive(axis: rt70_drives.AxisDrive) -> dict[str, float]:

@@ -33,7 +33,8 @@ import numpy as np
 
 from rt70.constraints import mimic_map
 from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
-from rt70.urdf.description import Joint, RobotDescription
+from rt70.urdf.description import Joint, RobotDescription, Wind
+from rt70.wind import DEFAULT_AIR_DENSITY
 
 PAIR_KINDS = ("euler6", "revolute", "prismatic", "planar")
 _NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "planar": 3}
@@ -102,6 +103,8 @@ class Model:
     G, q_offset : numpy.ndarray or None
         Mimic constraints ``q_full = G q + q_offset``; None when there are none
         (``q_full = q``).
+    winds, air_density : tuple of rt70.urdf.Wind, float
+        The scene's exposed bodies and air density (:mod:`rt70.textbook.wind`).
     """
 
     name: str
@@ -126,6 +129,8 @@ class Model:
     spring_damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
     G: np.ndarray | None = None
     q_offset: np.ndarray | None = None
+    winds: tuple[Wind, ...] = ()
+    air_density: float = DEFAULT_AIR_DENSITY
 
     @property
     def nb(self) -> int:
@@ -201,7 +206,7 @@ def _child_joints(desc: RobotDescription) -> dict[str, list[Joint]]:
 def build_model(desc: RobotDescription) -> Model:
     """Build the textbook :class:`Model` from a validated URDF description."""
     referenced = {b.frame1.link for b in desc.bushings} | {b.frame2.link for b in desc.bushings}
-    referenced |= {p.link for p in desc.optical_points}
+    referenced |= {p.link for p in desc.optical_points} | {w.link for w in desc.winds}
     parent, kind, axis, r_c, c_c = [], [], [], [], []
     thetas, ndof, body_names, coord_names = [], [], [], []
     link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = {
@@ -294,6 +299,8 @@ def build_model(desc: RobotDescription) -> Model:
         spring_damping=np.array([s.damping for s in desc.joint_springs], dtype=float),
         G=G,
         q_offset=q_offset,
+        winds=desc.winds,
+        air_density=desc.air_density,
     )
 
 

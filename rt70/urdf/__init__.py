@@ -20,6 +20,7 @@ from rt70.urdf.description import (
     Mimic,
     OpticalPoint,
     RobotDescription,
+    Wind,
 )
 from rt70.urdf.reader import RT70_NS, read_urdf, read_urdf_string
 
@@ -37,6 +38,7 @@ __all__ = [
     "Mimic",
     "OpticalPoint",
     "RobotDescription",
+    "Wind",
     "coordinate_names",
     "read_urdf",
     "read_urdf_string",

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rt70.wind import DEFAULT_AIR_DENSITY, CoefficientTable
+
 #: Joint types of the URDF standard.
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
@@ -196,6 +198,41 @@ class Drive:
     sector: DriveSector | None = None
 
 
+@dataclass(frozen=True, eq=False)
+class Wind:
+    """An exposed body the wind acts on (``<rt70:wind>``, formalism §4.4, (4.132)–(4.136)).
+
+    Attributes
+    ----------
+    name : str
+        The element's name (unique in the scene).
+    link : str
+        The URDF link the load acts on.
+    xyz : numpy.ndarray
+        Reference point in the link frame, m: where the force acts and the moment is
+        taken about, shape (3,).
+    axis : numpy.ndarray
+        Unit symmetry axis of the body in the link frame (a dish: its boresight, out of
+        the concave face), shape (3,).
+    area, length : float
+        Reference area S_ref, m², and reference length l_ref, m.
+    shape : str
+        The built-in table's name (``dish``, ``cylinder``) or the ``coefficients`` file
+        as written in the URDF.
+    table : rt70.wind.CoefficientTable
+        The coefficients C_A, C_N, C_M against θ (:mod:`rt70.wind`).
+    """
+
+    name: str
+    link: str
+    xyz: np.ndarray
+    axis: np.ndarray
+    area: float
+    length: float
+    shape: str
+    table: CoefficientTable
+
+
 @dataclass(frozen=True)
 class RobotDescription:
     """Everything rt70 reads from one URDF scene.
@@ -224,6 +261,10 @@ class RobotDescription:
         Inertias repaired on request (``balance_inertia``), in document order.
     drives : list of Drive
         Motor drives of the axes (``<rt70:drive>``), in document order.
+    winds : tuple of Wind
+        Exposed bodies the wind acts on (``<rt70:wind>``), in document order.
+    air_density : float
+        Air density ρ of ``<rt70:air>``, kg/m³ (default: ISA sea level, 1.225).
     """
 
     name: str
@@ -237,6 +278,8 @@ class RobotDescription:
     optical_points: list[OpticalPoint] = field(default_factory=list)
     inertia_repairs: list[InertiaRepair] = field(default_factory=list)
     drives: list[Drive] = field(default_factory=list)
+    winds: tuple[Wind, ...] = ()
+    air_density: float = DEFAULT_AIR_DENSITY
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

@@ -6,6 +6,7 @@ starts with the source file, so the command line can print it as one readable li
 
 from __future__ import annotations
 
+import dataclasses
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -46,6 +47,7 @@ from rt70.urdf.text import (
     refuse_xacro,
     warn,
 )
+from rt70.urdf.wind import read_air, read_wind
 
 #: Joint types rt70 models on both sides (the others are rejected with a clear error).
 SUPPORTED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -58,7 +60,16 @@ ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
 #: any term of the equations of motion multiplies, so no evaluation can overflow.
 MAX_MAGNITUDE = 1e30
 
-_EXTENSIONS = ("gravity", "joint_spring", "bushing", "strut_package", "optical_point", "drive")
+_EXTENSIONS = (
+    "gravity",
+    "joint_spring",
+    "bushing",
+    "strut_package",
+    "optical_point",
+    "drive",
+    "wind",
+    "air",
+)
 _ZERO3 = np.zeros(3)
 
 
@@ -193,8 +204,7 @@ class _Reader:
             gravity=np.array([0.0, 0.0, -9.81]),
             inertia_repairs=repairs,
         )
-        self.extensions(root, desc)
-        return desc
+        return self.extensions(root, desc)
 
     def link(self, elem: ET.Element) -> Link:
         name = self.name_of(elem)
@@ -403,9 +413,11 @@ class _Reader:
         return roots[0]
 
     # --- rt70 extension elements ---------------------------------------------------
-    def extensions(self, root: ET.Element, desc: RobotDescription) -> None:
+    def extensions(self, root: ET.Element, desc: RobotDescription) -> RobotDescription:
         ns = "{" + RT70_NS + "}"
         gravity_seen = False
+        winds: list = []
+        air: list[float] = []
         joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
         for elem in root:
             if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
@@ -426,10 +438,21 @@ class _Reader:
                 desc.bushings.extend(self.strut_package(elem, desc))
             elif kind == "drive":
                 desc.drives.append(read_drive(self, elem, desc, joints))
+            elif kind == "wind":
+                winds.append(read_wind(self, elem, desc, winds))
+            elif kind == "air":
+                if air:
+                    raise self.fail(ExtensionError, "more than one <rt70:air>")
+                air.append(read_air(self, elem))
             else:
                 name = self.name_of(elem)
                 link = self.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
                 desc.optical_points.append(OpticalPoint(name, link, self.numbers(elem, "xyz", 3)))
+        if not (winds or air):
+            return desc
+        return dataclasses.replace(
+            desc, winds=tuple(winds), air_density=air[0] if air else desc.air_density
+        )
 
     def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
         link = elem.get(attr)

@@ -1,0 +1,47 @@
+"""Wind generalised forces on the reference side (formalism §4.4, (4.132)–(4.136)).
+
+The same quantities as :mod:`rt70.textbook.wind`, from Pinocchio's own kinematics: each
+exposed body's link pose is its placement ``oMi · placement`` (``pin.forwardKinematics``,
+:func:`rt70.reference.drives.link_pose`); the shared :func:`rt70.wind.wind_wrench` gives
+the wind's Wrench, and ``Q = Jᵀ f`` with the point's ``LOCAL_WORLD_ALIGNED`` Jacobian in
+book coordinates (:func:`rt70.reference.points.generalized_force`). Independent of the
+textbook side.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rt70.loads import Wrench
+from rt70.reference.drives import link_pose
+from rt70.reference.model import ReferenceData, ReferenceModel
+from rt70.reference.points import generalized_force
+from rt70.wind import WindCondition, wind_wrench
+
+
+def wind_wrenches(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, condition: WindCondition
+) -> dict[str, Wrench]:
+    """The wind's Wrench on every exposed body at q, by element name (ground axes)."""
+    return {
+        w.name: wind_wrench(w, link_pose(model, data, q, w.link), condition, model.air_density)
+        for w in model.winds
+    }
+
+
+def wind_forces(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, condition: WindCondition
+) -> dict[str, np.ndarray]:
+    """Generalised force (nv,) of each exposed body at q, by element name: ``Jᵀ f_i``."""
+    wrenches = wind_wrenches(model, data, q, condition)
+    return {name: generalized_force(model, data, q, w) for name, w in wrenches.items()}
+
+
+def wind_force(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, condition: WindCondition
+) -> np.ndarray:
+    """Generalised wind force (nv,) at q: ``Q_w = Jᵀ f`` summed over the exposed bodies."""
+    Q = np.zeros(model.nv)
+    for value in wind_forces(model, data, q, condition).values():
+        Q += value
+    return Q

@@ -1,0 +1,68 @@
+"""Wind generalised forces on the textbook side (formalism §4.4, (4.132)–(4.136)).
+
+For every ``<rt70:wind>`` of the model (:attr:`rt70.textbook.model.Model.winds`) the
+link's pose comes from the book's forward pass (4.5)–(4.7); the shared
+:func:`rt70.wind.wind_wrench` gives the wind's force at the reference point and its free
+moment in ground axes; the generalised force is ``Q_w = S W`` (4.129)–(4.131), i.e.
+``J_vᵀ F + J_ωᵀ M`` with the point's Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63) turned to
+ground axes, all from one structure matrix S. The reference side computes the same from
+Pinocchio (:mod:`rt70.reference.wind`); ``rt70 validate`` compares them (row ``wind``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rt70.arrays import check_vector
+from rt70.loads import Wrench
+from rt70.textbook.data import Data
+from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure
+from rt70.textbook.model import Model
+from rt70.textbook.points import link_point
+from rt70.wind import WindCondition, wind_wrench
+
+
+def _force(model: Model, data: Data, wrench: Wrench) -> np.ndarray:
+    """``Q = J_vᵀ F + J_ωᵀ M`` of a wrench from the S already in ``data`` (4.129)–(4.131)."""
+    body, r = link_point(model, wrench.link, wrench.xyz)
+    if body < 0:  # the ground does not move
+        return np.zeros(model.nv)
+    R = frame_pose(data, body, np.zeros(3), np.eye(3))[0]
+    J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
+    return (R @ J[:3]).T @ np.asarray(wrench.force) + (R @ J[3:]).T @ np.asarray(wrench.torque)
+
+
+def wind_wrenches(
+    model: Model, data: Data, q: np.ndarray, condition: WindCondition
+) -> dict[str, Wrench]:
+    """The wind's Wrench on every exposed body at q, by element name (ground axes).
+
+    Runs the forward pass and fills S in ``data`` (:func:`update_structure`).
+    """
+    update_structure(model, data, check_vector("q", q, model.nv))
+    out = {}
+    for w in model.winds:
+        link_point(model, w.link, w.xyz)  # refuses a link without a frame
+        body, r_link, c_link = model.link_frames[w.link]
+        pose = frame_pose(data, body, r_link, c_link)
+        out[w.name] = wind_wrench(w, pose, condition, model.air_density)
+    return out
+
+
+def wind_forces(
+    model: Model, data: Data, q: np.ndarray, condition: WindCondition
+) -> dict[str, np.ndarray]:
+    """Generalised force (nv,) of each exposed body at q, by element name: ``S W_i``."""
+    wrenches = wind_wrenches(model, data, q, condition)
+    return {name: _force(model, data, w) for name, w in wrenches.items()}
+
+
+def wind_force(model: Model, data: Data, q: np.ndarray, condition: WindCondition) -> np.ndarray:
+    """Generalised wind force (nv,) at q: ``Q_w = S W`` summed over the exposed bodies.
+
+    Zero for a model without ``<rt70:wind>`` elements.
+    """
+    Q = np.zeros(model.nv)
+    for value in wind_forces(model, data, q, condition).values():
+        Q += value
+    return Q

@@ -1,0 +1,98 @@
+"""Read and check ``<rt70:wind>`` and ``<rt70:air>`` (docs/urdf-extensions.md, docs/wind.md).
+
+One job: turn the XML of an exposed body — its link, reference point, symmetry axis,
+reference area and length, and coefficient table — into a
+:class:`~rt70.urdf.description.Wind`, or the scene's air density, or refuse it with an
+:class:`~rt70.errors.ExtensionError` naming the file and the element. The coefficient
+table is read and checked here (:class:`rt70.wind.CoefficientTable`): a built-in
+``shape`` or a ``coefficients`` CSV file, relative to the URDF file's directory.
+Called by :mod:`rt70.urdf.reader`.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rt70.errors import ExtensionError
+from rt70.urdf.description import RobotDescription, Wind
+from rt70.wind import BUILTIN_TABLES, CoefficientTable, WindError, builtin_table
+
+if TYPE_CHECKING:  # the reader passes itself; no import cycle at run time
+    from rt70.urdf.reader import _Reader
+
+
+def read_wind(reader: _Reader, elem: ET.Element, desc: RobotDescription, seen: list[Wind]) -> Wind:
+    """The :class:`Wind` of one ``<rt70:wind>`` element.
+
+    Raises
+    ------
+    ExtensionError
+        If the name is missing or repeated, the link does not exist, the axis is zero,
+        the area or length is not positive, not exactly one of ``shape`` and
+        ``coefficients`` is given, the shape is not built in, or the coefficient file
+        is missing or malformed (:meth:`rt70.wind.CoefficientTable.from_text`).
+    NonFiniteError, MagnitudeError
+        If a number is NaN, infinite or too large (as anywhere in the file).
+    """
+    name = reader.name_of(elem)
+    where = f"<rt70:wind name='{name}'>"
+    if any(w.name == name for w in seen):
+        raise reader.fail(ExtensionError, f"two <rt70:wind> elements named '{name}'")
+    link = reader.link_ref(elem, "link", desc, where)
+    owner = f"wind '{name}'"
+    xyz = reader.numbers(elem, "xyz", 3, np.zeros(3), owner)
+    axis = reader.numbers(elem, "axis", 3, owner=owner)
+    norm = float(np.linalg.norm(axis))
+    if norm < 1e-12:
+        raise reader.fail(ExtensionError, f"{where}: zero-length axis")
+    values = {}
+    for key in ("area", "length"):
+        value = reader.number(elem, key, owner=owner)
+        if value <= 0.0:
+            raise reader.fail(ExtensionError, f"{where}: {key}={value:g} must be positive")
+        values[key] = value
+    shape, table = _table(reader, elem, where)
+    return Wind(name, link, xyz, axis / norm, values["area"], values["length"], shape, table)
+
+
+def _table(reader: _Reader, elem: ET.Element, where: str) -> tuple[str, CoefficientTable]:
+    """The element's coefficient table: a built-in ``shape`` or a ``coefficients`` file."""
+    shape, file = elem.get("shape"), elem.get("coefficients")
+    if (shape is None) == (file is None):
+        raise reader.fail(
+            ExtensionError,
+            f"{where}: give exactly one of shape= (built in: {', '.join(BUILTIN_TABLES)}) "
+            "and coefficients=FILE.csv",
+        )
+    try:
+        if shape is not None:
+            if shape not in BUILTIN_TABLES:
+                raise WindError(
+                    f"unknown shape '{shape}' (built in: {', '.join(BUILTIN_TABLES)}; "
+                    "or coefficients=FILE.csv)"
+                )
+            return shape, builtin_table(shape)
+        path = Path(file)
+        if not path.is_absolute():
+            path = Path(reader.source).parent / path
+        return file, CoefficientTable.from_csv(path)
+    except WindError as exc:
+        raise reader.fail(ExtensionError, f"{where}: {exc}") from None
+
+
+def read_air(reader: _Reader, elem: ET.Element) -> float:
+    """The air density of ``<rt70:air density="...">``, kg/m³ (positive).
+
+    Raises
+    ------
+    ExtensionError
+        If the density is missing or not positive.
+    """
+    density = reader.number(elem, "density", owner="air")
+    if density <= 0.0:
+        raise reader.fail(ExtensionError, f"<rt70:air density='{density:g}'>: must be positive")
+    return density
