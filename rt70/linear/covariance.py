@@ -309,7 +309,9 @@ def _pairs(eigenvalues: np.ndarray) -> list[list[int]]:
     return groups
 
 
-def mode_contributions(sys: Any, output: str | int, W: float | np.ndarray = 1.0) -> list[ModeShare]:
+def mode_contributions(
+    sys: Any, output: str | int | Sequence[str | int], W: float | np.ndarray = 1.0
+) -> list[ModeShare]:
     """One output's stationary variance split over the modes of A.
 
     With ``A = V Λ V⁻¹`` and modal coordinates ``z = V⁻¹ x``, the modal covariance is
@@ -324,8 +326,9 @@ def mode_contributions(sys: Any, output: str | int, W: float | np.ndarray = 1.0)
     sys : control.StateSpace, rt70 StateSpace or tuple
         A stable, strictly proper system (e.g. a plant cascaded with its disturbance
         filter, :func:`cascade_with_filter`), diagonalisable.
-    output : str or int
-        The output (name or index).
+    output : str or int, or a sequence of them
+        The output (name or index); several outputs (the components of a vector) split
+        the sum of their variances, ``E|y|²``.
     W : float or ndarray
         Intensity of the white noise on the inputs.
 
@@ -333,7 +336,8 @@ def mode_contributions(sys: Any, output: str | int, W: float | np.ndarray = 1.0)
     -------
     list of ModeShare
         One per mode (real eigenvalue or complex pair), by increasing frequency; the
-        variances sum to ``output_covariance(sys, W)[i, i]`` up to rounding.
+        variances sum to ``output_covariance(sys, W)[i, i]`` (or the trace over the
+        outputs) up to rounding.
 
     Raises
     ------
@@ -343,7 +347,8 @@ def mode_contributions(sys: Any, output: str | int, W: float | np.ndarray = 1.0)
     """
     s = _system(sys)
     _no_feedthrough(s)
-    row, _ = _output_row(s, output)
+    outputs = [output] if isinstance(output, str | int | np.integer) else list(output)
+    rows = [_output_row(s, o)[0] for o in outputs]
     P = _covariance(s, W)
     eigenvalues, V = scipy.linalg.eig(s.A)
     condition = np.linalg.cond(V)
@@ -354,11 +359,14 @@ def mode_contributions(sys: Any, output: str | int, W: float | np.ndarray = 1.0)
         )
     Vinv = np.linalg.inv(V)
     Pz = Vinv @ P @ Vinv.conj().T
-    c = s.C[row] @ V
-    terms = np.real(c * (Pz @ c.conj()))
+    terms = np.zeros(len(eigenvalues))
+    for row in rows:
+        c = s.C[row] @ V
+        terms += np.real(c * (Pz @ c.conj()))
     total = float(np.sum(terms))
-    if total <= 0.0:
-        raise Rt70Error(f"output '{s.outputs[row]}' has zero variance: nothing to split")
+    if not rows or total <= 0.0:
+        names = ", ".join(s.outputs[r] for r in rows) or "none"
+        raise Rt70Error(f"output(s) {names} have zero variance: nothing to split")
     shares = []
     for group in _pairs(eigenvalues):
         lam = eigenvalues[group[0]]
@@ -378,7 +386,7 @@ def mode_contributions(sys: Any, output: str | int, W: float | np.ndarray = 1.0)
 
 def sample_variance_error(
     sys: Any,
-    output: str | int,
+    output: str | int | Sequence[str | int],
     T: float,
     dt: float | None = None,
     W: float | np.ndarray = 1.0,
@@ -397,12 +405,18 @@ def sample_variance_error(
     ``Φ X_d Φᵀ − X_d + (P cᵀ)(P cᵀ)ᵀ = 0``, ``Φ = e^{A dt}`` (the discrete Lyapunov
     equation); it tends to the continuous formula as dt → 0.
 
+    For several outputs (a vector y, e.g. the components of a pointing error) ŝ² is the
+    mean of ``|y|² = Σ_i y_i²``: Isserlis' theorem gives
+    ``Var ŝ² ≈ (4/T) Σ_ij ∫₀^∞ R_ij(τ)² dτ = (4/T) tr(C X Cᵀ)`` with
+    ``A X + X Aᵀ + G Gᵀ = 0``, ``G = P Cᵀ`` (C the outputs' rows); sampled,
+    ``(2/N)(2 tr(C X_d Cᵀ) − ‖C P Cᵀ‖²_F)``. One output is the case above.
+
     Parameters
     ----------
     sys : control.StateSpace, rt70 StateSpace or tuple
         A stable, strictly proper system driven by white noise.
-    output : str or int
-        The output (name or index).
+    output : str or int, or a sequence of them
+        The output (name or index), or the components of a vector output.
     T : float
         Length of the record (for samples, ``T = N·dt``).
     dt : float, optional
@@ -417,18 +431,22 @@ def sample_variance_error(
     """
     s = _system(sys)
     _no_feedthrough(s)
-    row, _ = _output_row(s, output)
+    outputs = [output] if isinstance(output, str | int | np.integer) else list(output)
+    if not outputs:
+        raise Rt70Error("no output named for the sample-variance error")
+    rows = [_output_row(s, o)[0] for o in outputs]
     if not (np.isfinite(T) and T > 0):
         raise Rt70Error(f"record length T must be positive and finite, got {T}")
     P = _covariance(s, W)
-    c = s.C[row]
-    g = (P @ c).reshape(-1, 1)
+    C = s.C[rows]
+    G = P @ C.T
     if dt is None:
-        X = scipy.linalg.solve_continuous_lyapunov(s.A, -g @ g.T)
-        return float(np.sqrt(max(4.0 * (c @ X @ c) / T, 0.0)))
+        X = scipy.linalg.solve_continuous_lyapunov(s.A, -G @ G.T)
+        return float(np.sqrt(max(4.0 * np.trace(C @ X @ C.T) / T, 0.0)))
     if not (np.isfinite(dt) and 0 < dt <= T):
         raise Rt70Error(f"sampling interval dt must be in (0, T], got {dt}")
     Phi = scipy.linalg.expm(s.A * dt)
-    X = scipy.linalg.solve_discrete_lyapunov(Phi, g @ g.T)
-    r0 = float(c @ P @ c)
-    return float(np.sqrt(max(2.0 * dt / T * (2.0 * (c @ X @ c) - r0**2), 0.0)))
+    X = scipy.linalg.solve_discrete_lyapunov(Phi, G @ G.T)
+    r0 = C @ P @ C.T
+    value = 2.0 * dt / T * (2.0 * np.trace(C @ X @ C.T) - float(np.sum(r0 * r0)))
+    return float(np.sqrt(max(value, 0.0)))

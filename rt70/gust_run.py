@@ -1,0 +1,204 @@
+"""A gust record run through the nonlinear model and the linear closed loop, and compared.
+
+One job: the check of the pointing budget's gust numbers (:mod:`rt70.pointing`) in the
+time domain. One realisation of the Davenport gusts (:func:`rt70.gusts.realise`,
+reproducible by its seed) drives
+
+- the **nonlinear** model: the scene's structure (Pinocchio), both drives with their
+  servo cascades (:class:`rt70.scene_servo.SceneServoFactory`, anti-windup and clamps
+  included) and the wind load exact in the speed, ``½ρ(v̄ + v′)²…``
+  (:class:`rt70.wind_load.WindLoad`), started at rest in the windy equilibrium;
+- the **linear** closed loop of the budget (:func:`rt70.pointing.gust_system`), by
+  python-control's ``forced_response`` on the same samples (both interpolate linearly
+  between them).
+
+Three rms values of each budget output's magnitude then compare: the nonlinear record's,
+the linear record's (same gusts: they differ only by the model's nonlinearity, the
+v′² term of the load and the solver's tolerance), and the Lyapunov value of the
+budget (the ensemble rms, which a finite record estimates with a statistical error —
+:func:`rt70.linear.covariance.sample_variance_error` gives it from the linear model).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.outputs import evaluate
+from rt70.pointing import (
+    BUDGET_OUTPUTS,
+    PointingCase,
+    WindyScene,
+    budget_outputs,
+    check_case,
+    gust_system,
+    wind_equilibria,
+)
+from rt70.scene import Scene
+
+#: Integration method and tolerance of the nonlinear run (as the servo scenarios:
+#: :data:`rt70.scenarios.METHOD`; rtol 1e-6 puts atol at 1e-9 rad, 2e-4″).
+METHOD = "LSODA"
+RTOL = 1e-6
+#: Gust sampling interval, s: Nyquist 5 Hz, above the modes the gusts excite (the
+#: lowest locked-rotor modes lie at 0.4–2.4 Hz); each sample is a kink of the linearly
+#: interpolated gust the solver must step through.
+DT = 0.1
+
+
+@dataclass
+class GustRun:
+    """Records and rms values of one run (module docstring).
+
+    ``nonlinear[name]`` and ``linear[name]`` are (n, 3) records of an output's change
+    from the windy equilibrium; ``linear_exact_load[name]`` the linear loop's, fed the
+    load's exact speed law ``v′ + v′²/2v̄`` (so that what is left against the nonlinear
+    record is the structure's and the servo's nonlinearity); ``rms_*[name]`` the rms
+    of its magnitude; ``rms_error[name]`` the standard deviation of a record's rms
+    about the ensemble rms ``rms_lyapunov``.
+    """
+
+    case: PointingCase
+    duration: float
+    seed: int
+    t: np.ndarray
+    gust: np.ndarray
+    nonlinear: dict[str, np.ndarray]
+    linear: dict[str, np.ndarray]
+    linear_exact_load: dict[str, np.ndarray]
+    rms_nonlinear: dict[str, float]
+    rms_linear: dict[str, float]
+    rms_linear_exact_load: dict[str, float]
+    rms_lyapunov: dict[str, float]
+    rms_error: dict[str, float]
+    seconds: float
+    steps: int
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready values (no records)."""
+        return {
+            "duration_s": self.duration,
+            "seed": self.seed,
+            "gust_rms_m_s": float(np.sqrt(np.mean(self.gust**2))),
+            "rms_nonlinear": self.rms_nonlinear,
+            "rms_linear_same_gusts": self.rms_linear,
+            "rms_linear_exact_load_law": self.rms_linear_exact_load,
+            "max_difference_nonlinear_vs_linear_exact_load": {
+                k: float(np.abs(self.nonlinear[k] - self.linear_exact_load[k]).max())
+                for k in self.nonlinear
+            },
+            "rms_lyapunov": self.rms_lyapunov,
+            "rms_statistical_error": self.rms_error,
+            "nonlinear_seconds": self.seconds,
+            "nonlinear_rhs_evaluations": self.steps,
+        }
+
+
+def _rms(y: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.sum(y * y, axis=1))))
+
+
+def gust_run(
+    scene: Scene,
+    case: PointingCase,
+    duration: float,
+    seed: int = 0,
+    dt: float = DT,
+    rtol: float = RTOL,
+    progress: bool = False,
+) -> GustRun:
+    """Run one gust record through both models (module docstring).
+
+    Raises
+    ------
+    Rt70Error
+        A bad case, a record shorter than two samples, or the integration failing.
+    """
+    from rt70.gusts import GustFilter, realise
+    from rt70.linear.covariance import output_covariance, sample_variance_error
+    from rt70.scene_servo import SceneServoFactory
+    from rt70.simulate import simulate
+    from rt70.wind_load import WindLoad
+
+    check_case(case)
+    if not (np.isfinite(duration) and duration >= 2 * dt):
+        raise Rt70Error(f"gust run: duration must be at least {2 * dt:g} s, got {duration:g}")
+    windy = WindyScene(scene, case.speed, case.direction)
+    state = wind_equilibria(scene, case, windy)
+    outputs = budget_outputs(scene, case)
+    series = realise(GustFilter(case.speed), duration, dt, seed)
+    t = series.t
+    # the nonlinear model, at rest in the windy equilibrium held by its drives
+    factory = SceneServoFactory()
+    couplings = factory.couplings(scene)
+    names = scene.coordinate_names
+    q0 = state.q_wind
+    torques = {names[c.index]: float(k) for c, k in zip(couplings, state.torque_wind, strict=True)}
+    held = {names[c.index]: float(q0[c.index]) for c in couplings}
+    refs = {c: (lambda _t, v=v: v) for c, v in held.items()}
+    components = [*factory(scene, q0, torques, refs), WindLoad(scene, windy.condition, series)]
+    start = time.perf_counter()
+    result = simulate(
+        scene,
+        (0.0, float(t[-1])),
+        (q0, np.zeros(scene.textbook.nv)),
+        method=METHOD,
+        rtol=rtol,
+        t_eval=t,
+        outputs=outputs,
+        components=components,
+        progress=progress,
+    )
+    seconds = time.perf_counter() - start
+    if not result.success:
+        raise Rt70Error(f"{scene.name}: gust run: {result.message}")
+    steady = evaluate(scene, q0, outputs, "reference")
+    nonlinear = {o.name: result.outputs[o.name] - steady[o.name] for o in outputs}
+    # the linear closed loop on the same samples
+    augmented, loop = gust_system(scene, case, windy, state)
+    rows = {o.name: [f"{o.name}:{c}" for c in "xyz"] for o in outputs}
+    labels = [r for o in outputs for r in rows[o.name]]
+
+    def linear_response(u: np.ndarray) -> dict[str, np.ndarray]:
+        response = control.forced_response(loop[labels, "gust"], T=t, U=u)
+        y = np.atleast_2d(response.outputs).T
+        return {o.name: y[:, 3 * k : 3 * k + 3] for k, o in enumerate(outputs)}
+
+    v = np.asarray(series.v)
+    linear = linear_response(v)
+    # the same linear loop fed the load's exact speed law: (v̄+v′)² − v̄² = 2v̄(v′ + v′²/2v̄)
+    exact_load = linear_response(v + v * v / (2.0 * case.speed))
+    cov = output_covariance(augmented)
+    all_labels = list(augmented.output_labels)
+    lyap, error = {}, {}
+    for o in outputs:
+        idx = [all_labels.index(r) for r in rows[o.name]]
+        ms = float(np.trace(cov[np.ix_(idx, idx)]))
+        lyap[o.name] = float(np.sqrt(ms))
+        # std of a record's rms: std(ŝ²) / (2 s) for a small relative error
+        std_ms = sample_variance_error(augmented, rows[o.name], float(t[-1]), dt=dt)
+        error[o.name] = std_ms / (2.0 * np.sqrt(ms))
+    return GustRun(
+        case,
+        float(t[-1]),
+        seed,
+        t,
+        np.asarray(series.v),
+        nonlinear,
+        linear,
+        exact_load,
+        {k: _rms(y) for k, y in nonlinear.items()},
+        {k: _rms(y) for k, y in linear.items()},
+        {k: _rms(y) for k, y in exact_load.items()},
+        lyap,
+        error,
+        seconds,
+        int(getattr(result, "nfev", -1)),
+    )
+
+
+__all__ = ["BUDGET_OUTPUTS", "GustRun", "gust_run"]

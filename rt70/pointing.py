@@ -1,0 +1,347 @@
+"""The wind pointing budget: steady and gust errors of the mirror system with the servos closed.
+
+One job: for one case (a pointing, a mean wind speed and direction) the answer an
+antenna engineer asks of the model — how far the wind moves the beam, and which modes
+do it. Three outputs of the mirror system (book 4.1.8, :mod:`rt70.optics`):
+
+- ``main_mirror_error``: the main-mirror axis against the source (4.156), arc seconds;
+- ``counterreflector_error``: the counterreflector's axis against the main mirror's
+  (4.165), arc seconds;
+- ``focal_offset``: the counterreflector's focus from the main mirror's (4.152), mm.
+
+Each is a 3-vector; the budget gives its magnitude (for the two angles the radial
+error, the component along the axis being second order).
+
+**Steady wind.** The servos' integrators hold the encoders at the pointing, so the
+steady state is the static equilibrium held by the drives
+(:func:`rt70.scene_servo.scene_equilibrium`) with the wind's generalised force added
+(:mod:`rt70.textbook.wind` / :mod:`rt70.reference.wind`, (4.132)–(4.136)). The steady
+error is the outputs' change from the calm equilibrium: the gravity sag at the same
+pointing is the pointing model's business, not the wind's.
+
+**Gusts.** About the windy equilibrium the closed loop is linear
+(:func:`rt70.linear.scene_loop.closed_loop`: the structure, both drives and their PI
+cascades); the gust v′ along the mean wind enters as the column ``∂Q_w/∂v = 2 Q_w/v̄``
+(the load is quadratic in the speed) and the wind's aerodynamic stiffness
+``−∂Q_w/∂q`` is added to K. Driven by the Davenport gust filter
+(:mod:`rt70.gusts`), the output covariance is one Lyapunov equation
+(:mod:`rt70.linear.covariance`); its split over the modes of the closed loop names the
+modes that contribute most.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.linear import linearize as lin
+from rt70.outputs import Output, evaluate
+from rt70.scene import Scene
+
+#: The budget's outputs (names of :func:`rt70.optics.mirror_outputs`), their units.
+BUDGET_OUTPUTS = {
+    "main_mirror_error": "arcsec",
+    "counterreflector_error": "arcsec",
+    "focal_offset": "mm",
+}
+#: How many modes the budget names.
+TOP_MODES = 3
+
+
+@dataclass(frozen=True)
+class PointingCase:
+    """One case of the budget.
+
+    Attributes
+    ----------
+    elevation_deg, azimuth_deg : float
+        The pointing (``rt70 simulate`` conventions).
+    speed : float
+        Mean wind speed, m/s (> 0).
+    direction_deg : float or None
+        Azimuth the wind blows from, degrees (:class:`rt70.wind.WindCondition`); None:
+        the pointing's azimuth, a front wind into the dish.
+    """
+
+    elevation_deg: float = 45.0
+    azimuth_deg: float = 0.0
+    speed: float = 10.0
+    direction_deg: float | None = None
+
+    @property
+    def direction(self) -> float:
+        """The wind's direction, degrees."""
+        return self.azimuth_deg if self.direction_deg is None else self.direction_deg
+
+
+@dataclass(frozen=True)
+class ModeShare:
+    """One closed-loop mode's share of an output's gust variance."""
+
+    frequency_hz: float
+    damping: float
+    share: float
+    label: str
+
+
+@dataclass
+class PointingBudget:
+    """Steady and gust errors of one case (module docstring).
+
+    ``steady[name]`` and ``gust_rms[name]`` are magnitudes in the output's unit;
+    ``steady_vector`` the steady change of each output's components; ``modes`` the
+    :data:`TOP_MODES` modes with the largest share of the main mirror's gust variance;
+    ``wind_torque`` the change of each drive's holding torque, N·m on its angle.
+    """
+
+    case: PointingCase
+    steady: dict[str, float]
+    steady_vector: dict[str, np.ndarray]
+    gust_rms: dict[str, float]
+    modes: list[ModeShare]
+    wind_torque: dict[str, float]
+    seconds: float
+    extra: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready values."""
+        c = self.case
+        return {
+            "elevation_deg": c.elevation_deg,
+            "azimuth_deg": c.azimuth_deg,
+            "wind_speed": c.speed,
+            "wind_direction_deg": c.direction,
+            "units": dict(BUDGET_OUTPUTS),
+            "steady": self.steady,
+            "steady_vector": {k: v.tolist() for k, v in self.steady_vector.items()},
+            "gust_rms": self.gust_rms,
+            "modes": [m.__dict__ for m in self.modes],
+            "wind_torque_Nm": self.wind_torque,
+            "seconds": self.seconds,
+            **self.extra,
+        }
+
+
+def budget_outputs(scene: Scene, case: PointingCase) -> list[Output]:
+    """The mirror-system outputs of :data:`BUDGET_OUTPUTS` for the case's source."""
+    from rt70.scenes.rt70_optics import rt70_mirror_outputs
+
+    found = {o.name: o for o in rt70_mirror_outputs(scene, case.elevation_deg, case.azimuth_deg)}
+    return [found[n] for n in BUDGET_OUTPUTS]
+
+
+def _held(case: PointingCase) -> dict[str, float]:
+    from rt70.scenes.rt70_state import rt70_pointing
+
+    return rt70_pointing(case.elevation_deg, case.azimuth_deg)
+
+
+def check_case(case: PointingCase) -> None:
+    """Refuse a case with a non-finite value or a speed that is not positive."""
+    values = [case.elevation_deg, case.azimuth_deg, case.speed, case.direction]
+    if not np.isfinite(values).all():
+        raise Rt70Error(f"pointing case must be finite, got {case}")
+    if case.speed <= 0.0:
+        raise Rt70Error(f"wind speed must be positive, got {case.speed:g} m/s")
+
+
+class WindyScene:
+    """A scene's wind at one condition on one side: the force, its stiffness, its gust column."""
+
+    def __init__(self, scene: Scene, speed: float, direction_deg: float) -> None:
+        from rt70.reference import wind as ref_wind
+        from rt70.wind import WindCondition
+
+        if not scene.description.winds:
+            raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load")
+        self.scene = scene
+        self.speed = speed
+        self.condition = WindCondition(speed, direction_deg)
+        model, data = scene.reference, scene.reference_data
+        self._force = lambda q: ref_wind.wind_force(model, data, q, self.condition)
+
+    def force(self, q: np.ndarray) -> np.ndarray:
+        """The wind's generalised force at q (reference side), N or N·m."""
+        return self._force(np.asarray(q, dtype=float))
+
+    def stiffness(self, q: np.ndarray, h: float = lin.FD_STEP) -> np.ndarray:
+        """``−∂Q_w/∂q`` by central differences: the aerodynamic stiffness (not symmetric)."""
+        q = np.asarray(q, dtype=float)
+        K = np.empty((q.size, q.size))
+        for i in range(q.size):
+            e = np.zeros(q.size)
+            e[i] = h
+            K[:, i] = -(self.force(q + e) - self.force(q - e)) / (2.0 * h)
+        return K
+
+    def gust_column(self, q: np.ndarray) -> np.ndarray:
+        """``∂Q_w/∂v`` along the mean wind: ``2 Q_w / v̄`` (the load is quadratic in v)."""
+        return 2.0 * self.force(q) / self.speed
+
+
+@dataclass
+class WindState:
+    """The calm and the windy drive-held equilibria of a case."""
+
+    q_calm: np.ndarray
+    q_wind: np.ndarray
+    torque_calm: np.ndarray
+    torque_wind: np.ndarray
+    drives: list[str]
+    residual: float
+
+
+def wind_equilibria(scene: Scene, case: PointingCase, windy: WindyScene) -> WindState:
+    """The drive-held equilibria without and with the case's steady wind."""
+    from rt70.scene_servo import SceneServoFactory, scene_equilibrium
+
+    couplings = SceneServoFactory(side="reference").couplings(scene)
+    held = _held(case)
+    q0, K0, _ = scene_equilibrium(scene, couplings, held)
+    q1, K1, res = scene_equilibrium(scene, couplings, held, load=windy.force)
+    return WindState(q0, q1, K0, K1, [c.drive.name for c in couplings], res)
+
+
+def _magnitude(v: np.ndarray) -> float:
+    return float(np.linalg.norm(v))
+
+
+def steady_errors(
+    scene: Scene, outputs: list[Output], state: WindState
+) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    """The outputs' change from the calm to the windy equilibrium (reference side)."""
+    calm = evaluate(scene, state.q_calm, outputs, "reference")
+    windy = evaluate(scene, state.q_wind, outputs, "reference")
+    vectors = {o.name: np.asarray(windy[o.name] - calm[o.name]) for o in outputs}
+    return {k: _magnitude(v) for k, v in vectors.items()}, vectors
+
+
+def gust_system(scene: Scene, case: PointingCase, windy: WindyScene, state: WindState):
+    """The closed loop driven by the Davenport gust filter: unit white noise in, outputs out.
+
+    Returns the augmented python-control ``StateSpace`` (input ``w``) and the closed
+    loop alone (inputs ``<drive>_reference`` and ``gust``, m/s).
+    """
+    from rt70.gusts import GustFilter
+    from rt70.linear.covariance import cascade_with_filter
+    from rt70.linear.scene_loop import closed_loop
+
+    lm = lin.linearize(scene, state.q_wind)
+    loop = closed_loop(
+        scene,
+        lm,
+        {"gust": windy.gust_column(state.q_wind)},
+        budget_outputs(scene, case),
+        K_extra=windy.stiffness(state.q_wind),
+    )
+    return cascade_with_filter(loop, GustFilter(case.speed).system, "gust"), loop
+
+
+def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
+    """The budget of one case (module docstring)."""
+    from rt70.linear.covariance import state_covariance
+
+    check_case(case)
+    start = time.perf_counter()
+    windy = WindyScene(scene, case.speed, case.direction)
+    state = wind_equilibria(scene, case, windy)
+    outputs = budget_outputs(scene, case)
+    steady, vectors = steady_errors(scene, outputs, state)
+    augmented, _ = gust_system(scene, case, windy, state)
+    P = state_covariance(augmented)
+    cov = augmented.C @ P @ augmented.C.T
+    labels = list(augmented.output_labels)
+    rms = {}
+    for o in outputs:
+        idx = [labels.index(f"{o.name}:{c}") for c in "xyz"]
+        rms[o.name] = float(np.sqrt(np.trace(cov[np.ix_(idx, idx)])))
+    state_rms = np.sqrt(np.clip(np.diag(P), 0.0, None))
+    modes, quasi_static = _mode_shares(
+        augmented, [f"main_mirror_error:{c}" for c in "xyz"], state_rms
+    )
+    torque = {
+        d: float(k1 - k0)
+        for d, k0, k1 in zip(state.drives, state.torque_calm, state.torque_wind, strict=True)
+    }
+    return PointingBudget(
+        case, steady, vectors, rms, modes, torque, time.perf_counter() - start,
+        extra={"equilibrium_residual": state.residual, "quasi_static_share": quasi_static},
+    )  # fmt: skip
+
+
+def _mode_shares(augmented, outputs: list[str], rms: np.ndarray) -> tuple[list[ModeShare], float]:
+    """The loop's :data:`TOP_MODES` largest shares of ``E|y|²``, and the gust filter's share.
+
+    The gust filter's own poles carry the quasi-static response to the wind. The
+    shares are those of :func:`rt70.linear.covariance.mode_contributions` over the
+    outputs' components; each mode is named by :func:`mode_label`.
+    """
+    from rt70.linear.covariance import mode_contributions
+
+    shares = mode_contributions(augmented, outputs)
+    labelled = [(m, mode_label(augmented, m, rms)) for m in shares]
+    quasi_static = sum(m.share for m, label in labelled if label == QUASI_STATIC)
+    loop = sorted((e for e in labelled if e[1] != QUASI_STATIC), key=lambda e: -e[0].share)
+    top = [ModeShare(m.frequency_hz, m.damping, m.share, label) for m, label in loop[:TOP_MODES]]
+    return top, float(quasi_static)
+
+
+#: The label of the gust filter's poles (:func:`mode_label`).
+QUASI_STATIC = "gust (quasi-static wind)"
+
+
+def mode_label(augmented, mode, rms: np.ndarray) -> str:
+    """Name a closed-loop mode by the state it moves most, relative to that state's rms.
+
+    The eigenvector's entries are divided by each state's stationary rms under the gust,
+    so states of any unit compare; a structural coordinate (``q`` or ``q_dot``) names
+    the mode by its coordinate, the gust filter's states as ``gust (quasi-static
+    wind)``, a drive's or a controller's as ``<drive> servo``.
+    """
+    names = [n.removeprefix("plant.").removeprefix("structure_") for n in augmented.state_labels]
+    v = np.abs(np.asarray(mode.eigenvector)) / np.where(rms > 0.0, rms, np.inf)
+    name = names[int(np.argmax(v))]
+    if name.startswith("filter."):
+        return QUASI_STATIC
+    for drive in ("azimuth", "elevation"):
+        if name.startswith(drive):
+            return f"{drive} servo"
+    return name.removesuffix("_dot")
+
+
+#: What the budget's outputs are called in a table.
+TITLES = {
+    "main_mirror_error": "main-mirror axis vs source",
+    "counterreflector_error": "counterreflector vs main-mirror axis",
+    "focal_offset": "focus offset (CR focus vs main focus)",
+}
+
+
+def format_budget(scene_name: str, b: PointingBudget) -> str:
+    """The budget of one case as a short table (what ``rt70 pointing`` prints)."""
+    c = b.case
+    lines = [
+        f"{scene_name}: wind {c.speed:g} m/s from azimuth {c.direction:g}°, pointing "
+        f"elevation {c.elevation_deg:g}°, azimuth {c.azimuth_deg:g}° — servos closed "
+        f"({b.seconds:.2f} s)",
+        f"  {'output':<40} {'steady':>10} {'gust rms':>10}  unit",
+    ]
+    for name, unit in BUDGET_OUTPUTS.items():
+        lines.append(
+            f"  {TITLES[name]:<40} {b.steady[name]:>10.4g} {b.gust_rms[name]:>10.4g}  {unit}"
+        )
+    torques = ", ".join(f"{d} {t / 1e6:+.3g} MN·m" for d, t in b.wind_torque.items())
+    lines.append(f"  steady wind torque on the drives: {torques}")
+    share = b.extra.get("quasi_static_share", float("nan"))
+    lines.append(
+        f"  gust error of the main-mirror axis: {100 * share:.1f} % quasi-static (the wind's "
+        "own slow variation); the loop modes that contribute most:"
+    )
+    for m in b.modes:
+        lines.append(
+            f"    {m.frequency_hz:8.4g} Hz  ζ {m.damping:6.3f}  {100 * m.share:6.1f} %  {m.label}"
+        )
+    return "\n".join(lines)
