@@ -212,6 +212,15 @@ def _pointing_budget(args: argparse.Namespace) -> int:
     if args.duration is not None and args.duration < 1.0:
         raise Rt70Error(f"--duration {args.duration:g}: a gust record needs at least 1 s")
     scene = load_scene(args.scene)
+    requested = scene.name
+    if scene.name == LISTING and not scene.description.drives:
+        print(
+            f"rt70: note: {LISTING} is the listing as printed, which its drives cannot hold "
+            f"(docs/rt70-errata.md, item 12); the budget is that of {SERVO_SCENE}, the "
+            "control object (counterweight below the elevation axis, drives, wind elements)",
+            file=sys.stderr,
+        )
+        scene = load_scene(SERVO_SCENE)
     _pointing(args, scene, "pointing budget")  # the RT-70 axes are there
     check_scene_drives(scene)
     if not scene.description.winds:
@@ -223,7 +232,7 @@ def _pointing_budget(args: argparse.Namespace) -> int:
 
         run = gust_run(scene, case, args.duration, seed=args.seed, progress=args.progress)
     if args.json:
-        out = {"scene": scene.name, **budget.to_dict()}
+        out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
         if run is not None:
             out["gust_run"] = run.to_dict()
         print(json.dumps(out, indent=2))
@@ -242,6 +251,11 @@ def _pointing_budget(args: argparse.Namespace) -> int:
             )
     return 0
 
+
+#: The listing as printed, and the scene that is its control object (docs/rt70-errata.md
+#: item 12): what ``rt70 pointing rt70`` runs.
+LISTING = "rt70"
+SERVO_SCENE = "rt70_servo"
 
 #: Above this elevation (degrees) the pointing corrections are not given (zenith keyhole).
 ZENITH_KEYHOLE_DEG = 89.0

@@ -245,3 +245,36 @@ def test_rt70_state_space_is_accepted():
     np.testing.assert_array_equal(ours.A, theirs.A)
     modes = cov.mode_contributions(ss, "tip")
     assert len(modes) == 2 and sum(m.share for m in modes) == pytest.approx(1.0, abs=1e-12)
+
+
+def _two_channels(a=3.0, b=0.7):
+    """Two independent first-order channels y1 = 1/(s+a) w1, y2 = 1/(s+b) w2."""
+    return control.ss(
+        np.diag([-a, -b]), np.eye(2), np.eye(2), 0, inputs=["w1", "w2"], outputs=["y1", "y2"]
+    )
+
+
+def test_vector_output_sample_variance_error():
+    """|y|² of independent channels: the variances of their mean squares add."""
+    sys, T = _two_channels(), 50.0
+    one = [cov.sample_variance_error(sys, y, T) for y in ("y1", "y2")]
+    both = cov.sample_variance_error(sys, ["y1", "y2"], T)
+    assert both == pytest.approx(np.hypot(*one), rel=1e-12)
+    sampled = [cov.sample_variance_error(sys, y, T, dt=0.01) for y in ("y1", "y2")]
+    assert cov.sample_variance_error(sys, ["y1", "y2"], T, dt=0.01) == pytest.approx(
+        np.hypot(*sampled), rel=1e-12
+    )
+    # one channel named twice: |y|² = 2 y1², its standard deviation doubles
+    assert cov.sample_variance_error(sys, ["y1", "y1"], T) == pytest.approx(2 * one[0], rel=1e-12)
+
+
+def test_vector_output_mode_contributions_add():
+    """The split of E|y|² is the sum of the components' splits, mode by mode."""
+    sys = _transformed(oscillators([0.5, 5.0], [0.02, 0.05], gains=[1.0, 3.0]))
+    sys = control.ss(sys.A, sys.B, np.vstack([sys.C, 2.0 * sys.C[::-1] + 0.1]), 0,
+                     outputs=["y", "z"])  # fmt: skip
+    y, z, yz = (cov.mode_contributions(sys, o) for o in ("y", "z", ["y", "z"]))
+    for a, b, c in zip(y, z, yz, strict=True):
+        assert c.variance == pytest.approx(a.variance + b.variance, rel=1e-10)
+    total = np.trace(cov.output_covariance(sys))
+    assert sum(m.variance for m in yz) == pytest.approx(total, rel=1e-12)
