@@ -7,7 +7,9 @@ fresh ``LocalCluster`` of single-threaded worker processes (BLAS pinned to one t
 the start-up, the sweep's wall time (workers importing rt70 and building the scene
 included: they start empty), the CPU seconds the workers spent on it (a measure of the
 work that the other users of a shared machine do not change much) and the total, the
-load average, and the ratio of the sweep times. Every
+load average, and the ratio of the sweep times — and, as the wall-time ratio depends on
+whether another job holds a core, the ratio of one worker's CPU time to the busier of
+two workers' (the speed-up free cores would give: how evenly the work splits). Every
 run's numbers are checked bit-identical to the first. Before that, in this process
 (BLAS pinned): the per-point cost of the static equilibrium from a cold start (q = 0,
 what the sweep does) and from the previous elevation's (a warm start), and of the
@@ -61,14 +63,15 @@ def on_cluster(sweep: sw.Sweep, workers: int) -> tuple[dict[str, float], dict]:
     start = time.perf_counter()
     with local_cluster(workers) as cluster, Client(cluster) as client:
         assert workers_of(client) == workers
-        cpu0 = sum(client.run(time.process_time).values())
+        cpu0 = client.run(time.process_time)
         started = time.perf_counter()
         result = sw.run(sweep, on_dask(client), workers=workers)
         swept = time.perf_counter()
-        cpu = sum(client.run(time.process_time).values()) - cpu0
+        cpu1 = client.run(time.process_time)
     done = time.perf_counter()
+    each = sorted(cpu1[w] - cpu0[w] for w in cpu0)  # CPU seconds each worker spent on it
     times = {"startup": started - start, "sweep": swept - started, "total": done - start}
-    times["workers_cpu"] = cpu  # CPU seconds the workers spent on the sweep
+    times["workers_cpu"], times["workers_cpu_each"] = sum(each), each
     times["load_average_1min"] = os.getloadavg()[0]  # after the run: others' work too
     return times, result.arrays
 
@@ -107,9 +110,15 @@ def main() -> None:
             )
         run["speedup"] = run["workers_1"]["sweep"] / run["workers_2"]["sweep"]
         run["speedup_total"] = run["workers_1"]["total"] / run["workers_2"]["total"]
+        # what free cores would give: one worker's CPU time over the busiest of two's
+        run["speedup_cpu"] = run["workers_1"]["workers_cpu"] / max(
+            run["workers_2"]["workers_cpu_each"]
+        )
         print(
             f"run {r + 1}: 2 workers vs 1: {run['speedup']:.2f}× on the sweep, "
-            f"{run['speedup_total']:.2f}× start-up included"
+            f"{run['speedup_total']:.2f}× start-up included; work split: the busier of "
+            f"2 workers {max(run['workers_2']['workers_cpu_each']):.2f} CPU s, "
+            f"{run['speedup_cpu']:.2f}× less than 1 worker's"
         )
         record["runs"].append(run)
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
