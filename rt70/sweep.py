@@ -358,8 +358,8 @@ class PartialResults:
         SweepError
             If the directory exists and its key is not this sweep's (or is unreadable).
         """
-        if not self.directory.exists():
-            return
+        if not self.directory.exists() or not any(self.directory.iterdir()):
+            return  # nothing there (or a directory left empty by a stop before its key)
         try:
             key = json.loads((self.directory / "key.json").read_text(encoding="utf-8"))["key"]
         except (OSError, ValueError, KeyError, TypeError):
@@ -375,9 +375,9 @@ class PartialResults:
         """Create the directory, or check its key (:meth:`check`) and load its chunks."""
         self.check()
         key_file = self.directory / "key.json"
-        if self.directory.exists():
+        if key_file.is_file():
             return self._load()
-        self.directory.mkdir(parents=True)
+        self.directory.mkdir(parents=True, exist_ok=True)
         record = {"key": self.sweep.key, "scene": self.sweep.source.name}
         atomic_write(key_file, lambda tmp: tmp.write_text(json.dumps(record), encoding="utf-8"))
         return {}

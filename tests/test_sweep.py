@@ -216,6 +216,15 @@ def test_resume_computes_only_the_missing_chunks(tmp_path):
     np.testing.assert_array_equal(resumed.arrays["frequencies"], fresh.arrays["frequencies"])
 
 
+def test_an_empty_partial_directory_is_a_fresh_start(tmp_path):
+    """A stop between creating FILE.partial/ and writing its key leaves it empty."""
+    out = tmp_path / "s.npz"
+    (tmp_path / "s.npz.partial").mkdir()
+    sweep = sw.plan(SCENE, sw.make_grid({"elevation": (45.0,)}), ["first_frequency"], 1)
+    assert sw.run(sweep, sw.serial, out).metadata["chunks"]["computed"] == 1
+    assert out.exists() and not (tmp_path / "s.npz.partial").exists()
+
+
 def test_cli_refuses_a_foreign_partial_directory(tmp_path, capsys):
     out = tmp_path / "s.npz"
     (tmp_path / "s.npz.partial").mkdir()
