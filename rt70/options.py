@@ -136,7 +136,7 @@ def check_outputs(args: argparse.Namespace) -> None:
     """Refuse output paths the command could not write, before it starts.
 
     ``simulate --out FILE`` (and the ``.png`` beside it unless ``--no-plot``),
-    ``bench --out DIRECTORY`` and ``plant --out FILE.npz``.
+    ``bench --out DIRECTORY``, ``plant --out FILE.npz`` and ``sweep --out FILE.npz``.
 
     Raises
     ------
@@ -157,6 +157,11 @@ def check_outputs(args: argparse.Namespace) -> None:
         check_writable_directory(out.parent)
     elif args.command == "bench":
         check_writable_directory(Path(args.out))
+    elif args.command == "sweep":
+        out = Path(args.out)
+        if out.suffix != ".npz" or out.is_dir():
+            raise OutputError(f"{out}: --out must be a .npz file")
+        check_writable_directory(out.parent)
     elif args.command == "plant" and args.out is not None:
         out = Path(args.out)
         if out.suffix != ".npz" or out.is_dir():
