@@ -239,6 +239,60 @@ register_quantity(
 )
 
 
+def _pointing(scene: Scene, point: SweepPoint) -> dict[str, Any]:
+    """The wind pointing budget at the point (:func:`rt70.pointing.pointing_budget`).
+
+    The point's wind speed (> 0) and direction; its pointing. The budget solves its own
+    drive-held equilibria (with and without the wind), not the point's coordinate-held
+    one.
+    """
+    from rt70.pointing import PointingCase, pointing_budget
+
+    if not point.wind > 0.0:
+        raise Rt70Error("the pointing budget needs a wind speed above 0 (--wind)")
+    case = PointingCase(point.elevation, point.azimuth, point.wind, point.direction)
+    b = pointing_budget(scene, case)
+    out: dict[str, Any] = {}
+    for name, (steady, gust) in POINTING_FIELDS.items():
+        out[steady], out[gust] = b.steady[name], b.gust_rms[name]
+    out["quasi_static_share"] = b.extra["quasi_static_share"]
+    return out
+
+
+def _check_pointing(scene: Scene) -> None:
+    from rt70.scene_servo import check_scene_drives
+
+    _check_mirror(scene)
+    check_scene_drives(scene)
+    if not scene.description.winds:
+        raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no pointing budget")
+
+
+#: The budget's outputs (:data:`rt70.pointing.BUDGET_OUTPUTS`) and their two fields.
+POINTING_FIELDS = {
+    "main_mirror_error": ("pointing_steady", "pointing_gust"),
+    "counterreflector_error": ("counterreflector_steady", "counterreflector_gust"),
+    "focal_offset": ("focus_steady", "focus_gust"),
+}
+register_quantity(
+    Quantity(
+        "pointing",
+        (
+            Field("pointing_steady", (), "arcsec", "steady main-mirror axis error vs source"),
+            Field("pointing_gust", (), "arcsec", "gust rms of the main-mirror axis error"),
+            Field("counterreflector_steady", (), "arcsec", "steady CR vs main-mirror axis"),
+            Field("counterreflector_gust", (), "arcsec", "gust rms of CR vs main-mirror axis"),
+            Field("focus_steady", (), "mm", "steady CR focus vs main focus"),
+            Field("focus_gust", (), "mm", "gust rms of the focus offset"),
+            Field("quasi_static_share", (), "1", "share of the gust variance that is quasi-static"),
+        ),
+        _pointing,
+        check=_check_pointing,
+        description="the wind pointing budget with the servos closed (docs/pointing.md)",
+    )
+)
+
+
 # --- scene parameters ----------------------------------------------------------------
 
 

@@ -88,3 +88,18 @@ def test_pointing_command_refuses_bad_input(argv, capsys):
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("rt70:")
+
+
+def test_sweep_quantity_is_the_budget(budgets):
+    """``rt70 sweep --quantity pointing`` stores the budget's numbers; no wind is a NaN."""
+    from rt70 import sweep as sw
+
+    grid = sw.make_grid({"elevation": (45.0,), "wind": (0.0, 10.0)})
+    result = sw.run(sw.plan("rt70_servo", grid, ["pointing"]), sw.serial)
+    a, b = result.arrays, budgets[10.0]
+    assert a["pointing_steady"][0, 0, 1, 0] == b.steady["main_mirror_error"]
+    assert a["pointing_gust"][0, 0, 1, 0] == b.gust_rms["main_mirror_error"]
+    assert a["focus_gust"][0, 0, 1, 0] == b.gust_rms["focal_offset"]
+    assert np.isnan(a["pointing_steady"][0, 0, 0, 0])
+    assert [e["quantity"] for e in result.errors] == ["pointing"]
+    assert "wind speed above 0" in result.errors[0]["error"]

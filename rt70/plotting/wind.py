@@ -93,3 +93,74 @@ def mode_shares_figure(shares: Sequence[tuple[str, float, float]], title: str = 
     ax.set_title(title or "which modes make the gust pointing error", fontsize=10)
     ax.grid(True, axis="y", alpha=0.3)
     return fig
+
+
+def gust_check_figure(runs: Sequence[tuple[dict, Mapping[str, np.ndarray]]]) -> Figure:
+    """Nonlinear gust records against the linear loop, and the rms against Lyapunov.
+
+    ``runs``: ``(info, records)`` per wind speed as validation/gust_check.py writes
+    them (the JSON's values and the NPZ's arrays ``t``, ``nonlinear_<output>``,
+    ``linear_<output>``, ``linear_exact_load_<output>``). Top: a window of the main
+    mirror's error (its largest component) in each model; bottom: the record's rms in
+    each model against the Lyapunov (ensemble) rms with ±2 standard errors of a record
+    of that length.
+    """
+    name = "main_mirror_error"
+    fig = Figure(figsize=(11, 4 + 2.6 * len(runs)), constrained_layout=True)
+    axes = fig.subplots(len(runs) + 1, 1)
+    for ax, (info, rec) in zip(axes[:-1], runs, strict=False):
+        t = rec["t"]
+        window = t <= min(t[-1], 200.0)
+        nl = rec[f"nonlinear_{name}"]
+        k = int(np.argmax(np.abs(nl).max(axis=0)))
+        comp = "xyz"[k]
+        ax.plot(t[window], nl[window, k], color="k", lw=1.4, label="nonlinear model")
+        ax.plot(
+            t[window], rec[f"linear_{name}"][window, k], color="C0", lw=0.9,
+            label="linear loop, gust 2v̄v′",
+        )  # fmt: skip
+        ax.plot(
+            t[window], rec[f"linear_exact_load_{name}"][window, k], "--", color="C3", lw=0.9,
+            label="linear loop, exact load law v′ + v′²/2v̄",
+        )  # fmt: skip
+        ax.set_ylabel(f"{name}:{comp}, ″")
+        ax.set_title(
+            f"{info['wind_speed']:g} m/s front wind, elevation {info['elevation_deg']:g}°: "
+            f"first {t[window][-1]:.0f} s of the {info['duration_s']:.0f} s record "
+            f"(seed {info['seed']})",
+            fontsize=9,
+        )
+        ax.legend(fontsize=7, loc="upper right")
+        ax.grid(True, alpha=0.3)
+    axes[-2].set_xlabel("time, s")
+    ax = axes[-1]
+    width = 0.2
+    for i, (info, _) in enumerate(runs):
+        x = i
+        values = (
+            info["rms_nonlinear"][name],
+            info["rms_linear_same_gusts"][name],
+            info["rms_linear_exact_load_law"][name],
+        )
+        for j, (val, label, color) in enumerate(
+            zip(values, ("nonlinear", "linear, same gusts", "linear, exact load law"),
+                ("k", "C0", "C3"), strict=True)
+        ):  # fmt: skip
+            ax.bar(x + (j - 1.5) * width, val, width, color=color, label=label if i == 0 else None)
+        lyap, err = info["rms_lyapunov"][name], info["rms_statistical_error"][name]
+        ax.bar(
+            x + 1.5 * width,
+            lyap,
+            width,
+            color="C2",
+            label="Lyapunov (ensemble)" if i == 0 else None,
+        )
+        ax.errorbar(x + 1.5 * width, lyap, yerr=2 * err, color="k", capsize=4, lw=1)
+    ax.set_xticks(range(len(runs)), [f"{info['wind_speed']:g} m/s" for info, _ in runs])
+    ax.set_ylabel(f"rms of |{name}|, ″")
+    ax.set_title(
+        "record rms against the ensemble rms ± 2 standard errors of the record", fontsize=9
+    )
+    ax.legend(fontsize=7)
+    ax.grid(True, axis="y", alpha=0.3)
+    return fig
