@@ -37,6 +37,7 @@ from rt70.pointing import (
     check_case,
     gust_system,
     wind_equilibria,
+    windy_linearization,
 )
 from rt70.scene import Scene
 
@@ -159,7 +160,7 @@ def gust_run(
     steady = evaluate(scene, q0, outputs, "reference")
     nonlinear = {o.name: result.outputs[o.name] - steady[o.name] for o in outputs}
     # the linear closed loop on the same samples
-    augmented, loop = gust_system(scene, case, windy, state)
+    augmented, loop = gust_system(scene, case, windy_linearization(scene, windy, state))
     rows = {o.name: [f"{o.name}:{c}" for c in "xyz"] for o in outputs}
     labels = [r for o in outputs for r in rows[o.name]]
 

@@ -219,7 +219,37 @@ def steady_errors(
     return {k: _magnitude(v) for k, v in vectors.items()}, vectors
 
 
-def gust_system(scene: Scene, case: PointingCase, windy: WindyScene, state: WindState):
+@dataclass
+class WindyLinearization:
+    """The linear model about the windy equilibrium, the wind's stiffness and gust column."""
+
+    lm: lin.Linearization
+    K_wind: np.ndarray
+    gust_column: np.ndarray
+
+
+def windy_linearization(scene: Scene, windy: WindyScene, state: WindState) -> WindyLinearization:
+    """Linearise about the windy equilibrium, with the wind's stiffness and gust input."""
+    q = state.q_wind
+    return WindyLinearization(lin.linearize(scene, q), windy.stiffness(q), windy.gust_column(q))
+
+
+def windy_first_frequency(scene: Scene, w: WindyLinearization) -> float:
+    """The first locked-rotor frequency in the wind, Hz: ``K + K_w`` with the motors held.
+
+    The wind's aerodynamic stiffness is not symmetric: the frequencies are
+    ``√λ / 2π`` of the eigenvalues λ of ``M⁻¹(K + K_w)`` (real parts; the imaginary ones
+    are rounding-sized for the RT-70).
+    """
+    locked = lin.locked_rotor(scene, w.lm)
+    lam = np.linalg.eigvals(np.linalg.solve(locked.M, locked.K + w.K_wind))
+    lam = np.sort(lam.real)
+    if lam[0] <= 0.0:
+        raise Rt70Error(f"{scene.name}: the wind leaves a mode without stiffness")
+    return float(np.sqrt(lam[0]) / (2.0 * np.pi))
+
+
+def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
     """The closed loop driven by the Davenport gust filter: unit white noise in, outputs out.
 
     Returns the augmented python-control ``StateSpace`` (input ``w``) and the closed
@@ -229,13 +259,8 @@ def gust_system(scene: Scene, case: PointingCase, windy: WindyScene, state: Wind
     from rt70.linear.covariance import cascade_with_filter
     from rt70.linear.scene_loop import closed_loop
 
-    lm = lin.linearize(scene, state.q_wind)
     loop = closed_loop(
-        scene,
-        lm,
-        {"gust": windy.gust_column(state.q_wind)},
-        budget_outputs(scene, case),
-        K_extra=windy.stiffness(state.q_wind),
+        scene, w.lm, {"gust": w.gust_column}, budget_outputs(scene, case), K_extra=w.K_wind
     )
     return cascade_with_filter(loop, GustFilter(case.speed).system, "gust"), loop
 
@@ -250,7 +275,8 @@ def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
     state = wind_equilibria(scene, case, windy)
     outputs = budget_outputs(scene, case)
     steady, vectors = steady_errors(scene, outputs, state)
-    augmented, _ = gust_system(scene, case, windy, state)
+    linear = windy_linearization(scene, windy, state)
+    augmented, _ = gust_system(scene, case, linear)
     P = state_covariance(augmented)
     cov = augmented.C @ P @ augmented.C.T
     labels = list(augmented.output_labels)
@@ -268,7 +294,11 @@ def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
     }
     return PointingBudget(
         case, steady, vectors, rms, modes, torque, time.perf_counter() - start,
-        extra={"equilibrium_residual": state.residual, "quasi_static_share": quasi_static},
+        extra={
+            "equilibrium_residual": state.residual,
+            "quasi_static_share": quasi_static,
+            "first_frequency_hz": windy_first_frequency(scene, linear),
+        },
     )  # fmt: skip
 
 

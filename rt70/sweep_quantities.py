@@ -256,6 +256,7 @@ def _pointing(scene: Scene, point: SweepPoint) -> dict[str, Any]:
     for name, (steady, gust) in POINTING_FIELDS.items():
         out[steady], out[gust] = b.steady[name], b.gust_rms[name]
     out["quasi_static_share"] = b.extra["quasi_static_share"]
+    out["first_frequency_wind"] = b.extra["first_frequency_hz"]
     return out
 
 
@@ -285,6 +286,7 @@ register_quantity(
             Field("focus_steady", (), "mm", "steady CR focus vs main focus"),
             Field("focus_gust", (), "mm", "gust rms of the focus offset"),
             Field("quasi_static_share", (), "1", "share of the gust variance that is quasi-static"),
+            Field("first_frequency_wind", (), "Hz", "first locked-rotor frequency with K + K_wind"),
         ),
         _pointing,
         check=_check_pointing,
