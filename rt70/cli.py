@@ -21,7 +21,7 @@ import signal
 import sys
 import warnings
 
-from rt70 import cli_sweep, options
+from rt70 import cli_pointing, cli_sweep, options
 from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
@@ -196,66 +196,6 @@ def _modes(args: argparse.Namespace) -> int:
             )
     return 0
 
-
-def _pointing_budget(args: argparse.Namespace) -> int:
-    from rt70.pointing import PointingCase, check_case, format_budget, pointing_budget
-    from rt70.scene import load_scene
-    from rt70.scene_servo import check_scene_drives
-
-    case = PointingCase(
-        45.0 if args.elevation is None else args.elevation,
-        0.0 if args.azimuth is None else args.azimuth,
-        args.wind,
-        args.direction,
-    )
-    check_case(case)
-    if args.duration is not None and args.duration < 1.0:
-        raise Rt70Error(f"--duration {args.duration:g}: a gust record needs at least 1 s")
-    scene = load_scene(args.scene)
-    requested = scene.name
-    if scene.name == LISTING and not scene.description.drives:
-        print(
-            f"rt70: note: {LISTING} is the listing as printed, which its drives cannot hold "
-            f"(docs/rt70-errata.md, item 12); the budget is that of {SERVO_SCENE}, the "
-            "control object (counterweight below the elevation axis, drives, wind elements)",
-            file=sys.stderr,
-        )
-        scene = load_scene(SERVO_SCENE)
-    _pointing(args, scene, "pointing budget")  # the RT-70 axes are there
-    check_scene_drives(scene)
-    if not scene.description.winds:
-        raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (see docs/wind.md)")
-    budget = pointing_budget(scene, case)
-    run = None
-    if args.duration is not None:
-        from rt70.gust_run import gust_run
-
-        run = gust_run(scene, case, args.duration, seed=args.seed, progress=args.progress)
-    if args.json:
-        out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
-        if run is not None:
-            out["gust_run"] = run.to_dict()
-        print(json.dumps(out, indent=2))
-        return 0
-    print(format_budget(scene.name, budget))
-    if run is not None:
-        print(
-            f"  {run.duration:g} s of gusts (seed {run.seed}), rms of the record against the "
-            f"ensemble (Lyapunov) rms ± its statistical error ({run.seconds:.0f} s nonlinear):"
-        )
-        for name in run.rms_lyapunov:
-            print(
-                f"    {name:<24} nonlinear {run.rms_nonlinear[name]:.4g}, linear same gusts "
-                f"{run.rms_linear[name]:.4g}, Lyapunov {run.rms_lyapunov[name]:.4g} "
-                f"± {run.rms_error[name]:.2g}"
-            )
-    return 0
-
-
-#: The listing as printed, and the scene that is its control object (docs/rt70-errata.md
-#: item 12): what ``rt70 pointing rt70`` runs.
-LISTING = "rt70"
-SERVO_SCENE = "rt70_servo"
 
 #: Above this elevation (degrees) the pointing corrections are not given (zenith keyhole).
 ZENITH_KEYHOLE_DEG = 89.0
@@ -631,41 +571,7 @@ def build_parser() -> argparse.ArgumentParser:
         "truncation by Hankel singular values (default)",
     )
     pla.set_defaults(func=_plant)
-    poi = sub.add_parser(
-        "pointing",
-        help="wind pointing budget: steady and gust errors with the servos closed",
-        description="The pointing error a steady wind and its Davenport gusts cause at one "
-        "pointing, with both drives' servos closed (rt70_servo): the main-mirror axis "
-        "against the source, the counterreflector against the main mirror (arc seconds) "
-        "and the focus offset (mm); the steady value and the gust rms (Lyapunov), and the "
-        "three closed-loop modes that contribute most. --duration also runs that many "
-        "seconds of gusts through the nonlinear model and compares (docs/wind.md).",
-    )
-    poi.add_argument("scene", metavar="SCENE", help="scene name or URDF path (rt70_servo)")
-    _add_pointing_arguments(poi, default="45")
-    poi.add_argument(
-        "--wind",
-        type=options.positive_float,
-        required=True,
-        metavar="SPEED",
-        help="mean wind speed at the antenna, m/s",
-    )
-    poi.add_argument(
-        "--direction",
-        type=options.finite_float,
-        help="azimuth the wind blows from, degrees (default: the pointing's azimuth, a "
-        "front wind into the dish)",
-    )
-    poi.add_argument(
-        "--duration",
-        type=options.positive_float,
-        metavar="T",
-        help="also run T seconds of gusts through the nonlinear model and compare",
-    )
-    poi.add_argument("--seed", type=options.seed, default=0, help="gust record seed (default 0)")
-    poi.add_argument("--progress", action="store_true", help="progress bar of the gust run")
-    poi.add_argument("--json", action="store_true", help="print JSON")
-    poi.set_defaults(func=_pointing_budget)
+    cli_pointing.add_parser(sub, _add_pointing_arguments)
     sim = sub.add_parser(
         "simulate",
         help="integrate the equations of motion with an energy audit",

@@ -258,9 +258,15 @@ def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
     from rt70.gusts import GustFilter
     from rt70.linear.covariance import cascade_with_filter
     from rt70.linear.scene_loop import closed_loop
+    from rt70.scene_servo import scene_servos
 
     loop = closed_loop(
-        scene, w.lm, {"gust": w.gust_column}, budget_outputs(scene, case), K_extra=w.K_wind
+        scene,
+        w.lm,
+        {"gust": w.gust_column},
+        budget_outputs(scene, case),
+        scene_servos(scene),
+        K_extra=w.K_wind,
     )
     return cascade_with_filter(loop, GustFilter(case.speed).system, "gust"), loop
 
@@ -286,7 +292,7 @@ def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
         rms[o.name] = float(np.sqrt(np.trace(cov[np.ix_(idx, idx)])))
     state_rms = np.sqrt(np.clip(np.diag(P), 0.0, None))
     modes, quasi_static = _mode_shares(
-        augmented, [f"main_mirror_error:{c}" for c in "xyz"], state_rms
+        augmented, [f"main_mirror_error:{c}" for c in "xyz"], state_rms, linear.lm
     )
     torque = {
         d: float(k1 - k0)
@@ -302,44 +308,61 @@ def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
     )  # fmt: skip
 
 
-def _mode_shares(augmented, outputs: list[str], rms: np.ndarray) -> tuple[list[ModeShare], float]:
+def _mode_shares(
+    augmented, outputs: list[str], rms: np.ndarray, lm: lin.Linearization
+) -> tuple[list[ModeShare], float]:
     """The loop's :data:`TOP_MODES` largest shares of ``E|y|²``, and the gust filter's share.
 
-    The gust filter's own poles carry the quasi-static response to the wind. The
-    shares are those of :func:`rt70.linear.covariance.mode_contributions` over the
-    outputs' components; each mode is named by :func:`mode_label`.
+    The augmented system is the gust filter in series with the loop, so its A is block
+    triangular and its eigenvalues are the filter's and the loop's: a mode whose
+    eigenvalue is one of the filter's is the quasi-static response to the wind (the
+    structure following the slow gusts). The shares are those of
+    :func:`rt70.linear.covariance.mode_contributions` over the outputs' components; each
+    loop mode is named by :func:`mode_label`.
     """
     from rt70.linear.covariance import mode_contributions
 
-    shares = mode_contributions(augmented, outputs)
-    labelled = [(m, mode_label(augmented, m, rms)) for m in shares]
-    quasi_static = sum(m.share for m, label in labelled if label == QUASI_STATIC)
-    loop = sorted((e for e in labelled if e[1] != QUASI_STATIC), key=lambda e: -e[0].share)
-    top = [ModeShare(m.frequency_hz, m.damping, m.share, label) for m, label in loop[:TOP_MODES]]
+    labels = list(augmented.state_labels)
+    filt = [i for i, n in enumerate(labels) if n.startswith("filter.")]
+    poles = np.linalg.eigvals(augmented.A[np.ix_(filt, filt)])
+    quasi_static, loop = 0.0, []
+    for m in mode_contributions(augmented, outputs):
+        if np.min(np.abs(poles - m.eigenvalue)) <= 1e-9 * abs(m.eigenvalue):
+            quasi_static += m.share
+        else:
+            loop.append(m)
+    loop.sort(key=lambda m: -m.share)
+    top = [
+        ModeShare(
+            m.frequency_hz, m.damping, m.share, mode_label(augmented, m, rms, lm.M, lm.coordinates)
+        )
+        for m in loop[:TOP_MODES]
+    ]
     return top, float(quasi_static)
 
 
-#: The label of the gust filter's poles (:func:`mode_label`).
-QUASI_STATIC = "gust (quasi-static wind)"
+def mode_label(augmented, mode, rms: np.ndarray, M: np.ndarray, coordinates: list[str]) -> str:
+    """Name a loop mode: a servo's, or the coordinate that carries its kinetic energy.
 
-
-def mode_label(augmented, mode, rms: np.ndarray) -> str:
-    """Name a closed-loop mode by the state it moves most, relative to that state's rms.
-
-    The eigenvector's entries are divided by each state's stationary rms under the gust,
-    so states of any unit compare; a structural coordinate (``q`` or ``q_dot``) names
-    the mode by its coordinate, the gust filter's states as ``gust (quasi-static
-    wind)``, a drive's or a controller's as ``<drive> servo``.
+    Which block the mode belongs to is decided on the eigenvector's entries divided by
+    each state's stationary rms under the gust (so states of any unit compare; the gust
+    filter's states left out): a drive's or a controller's state makes it
+    ``<drive> servo``; a structural one names it by the coordinate with the largest
+    share of the mode's kinetic energy ``Re(v̇ᵢ* (M v̇)ᵢ)`` (the heavy body that moves,
+    not the light one that moves most).
     """
-    names = [n.removeprefix("plant.").removeprefix("structure_") for n in augmented.state_labels]
-    v = np.abs(np.asarray(mode.eigenvector)) / np.where(rms > 0.0, rms, np.inf)
-    name = names[int(np.argmax(v))]
-    if name.startswith("filter."):
-        return QUASI_STATIC
+    labels = [n.removeprefix("plant.") for n in augmented.state_labels]
+    loop = np.array([not n.startswith("filter.") for n in labels])
+    vector = np.asarray(mode.eigenvector)
+    v = np.abs(vector) / np.where(rms > 0.0, rms, np.inf)
+    v[~loop] = 0.0
+    name = labels[int(np.argmax(v))]
     for drive in ("azimuth", "elevation"):
         if name.startswith(drive):
             return f"{drive} servo"
-    return name.removesuffix("_dot")
+    rate = np.array([vector[labels.index(f"structure_{c}_dot")] for c in coordinates])
+    energy = np.real(np.conj(rate) * (M @ rate))
+    return coordinates[int(np.argmax(energy))]
 
 
 #: What the budget's outputs are called in a table.

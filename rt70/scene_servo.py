@@ -161,6 +161,25 @@ def scene_equilibrium(
     )
 
 
+def scene_servos(
+    scene: Scene, tuning: dict[str, tuple[float, float]] | None = None
+) -> dict[str, tuple[DriveParameters, CascadeGains]]:
+    """Each scene drive's parameters and cascade gains, as :class:`SceneServoFactory` uses.
+
+    For the linear closed loop (:func:`rt70.linear.scene_loop.closed_loop`); ``tuning``
+    as the factory's.
+    """
+    tuning = {**AXIS_TUNING, **(tuning or {})}
+    out = {}
+    for d in scene.description.drives:
+        if d.joint not in AXES:
+            raise Rt70Error(f"{scene.name}: drive '{d.name}' turns '{d.joint}', not an RT-70 axis")
+        axis = AXES[d.joint]
+        p = drive_parameters(d, axis.reference_inertia)
+        out[d.name] = (p, scene_axis_gains(p, axis, *tuning[axis.name]))
+    return out
+
+
 class SceneServoFactory:
     """Drive factory of the scene's ``<rt70:drive>`` elements (module docstring).
 

@@ -9,7 +9,7 @@ from rt70.linear.scene_loop import closed_loop
 from rt70.loads import Wrench
 from rt70.outputs import evaluate
 from rt70.scene import load_scene
-from rt70.scene_servo import SceneServoFactory, scene_equilibrium
+from rt70.scene_servo import SceneServoFactory, scene_equilibrium, scene_servos
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.simulate import simulate
@@ -46,7 +46,7 @@ def case():
     q0, torques = factory.start(scene, held)
     outs = [o for o in rt70_mirror_outputs(scene, ELEVATION, 0.0) if o.name == "main_mirror_error"]
     b = points.generalized_force(scene.textbook, scene.textbook_data, q0, PUSH)
-    loop = closed_loop(scene, lin.linearize(scene, q0), {"push": b}, outs)
+    loop = closed_loop(scene, lin.linearize(scene, q0), {"push": b}, outs, scene_servos(scene))
     return scene, factory, held, q0, torques, outs, loop
 
 

@@ -30,15 +30,14 @@ from collections.abc import Mapping, Sequence
 import control
 import numpy as np
 
+from rt70.bondgraph.parameters import DriveParameters
 from rt70.couplings import SceneCoupling
-from rt70.drives import drive_parameters
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.linear.loops import drive_block, pi_block
 from rt70.outputs import Output, column_labels, output_matrix
-from rt70.scenarios import AXIS_TUNING
 from rt70.scene import Scene
-from rt70.scene_servo import AXES, scene_axis_gains
+from rt70.servo import CascadeGains
 
 
 def _renamed(sys: control.StateSpace, prefix: str, name: str) -> control.StateSpace:
@@ -132,14 +131,20 @@ def closed_loop(
     lm: lin.Linearization,
     disturbances: Mapping[str, np.ndarray],
     outputs: Sequence[Output],
+    servos: Mapping[str, tuple[DriveParameters, CascadeGains]],
     K_extra: np.ndarray | None = None,
-    tuning: Mapping[str, tuple[float, float]] | None = None,
 ) -> control.StateSpace:
     """The scene's drives with their PI cascades closed around the structure.
 
-    Each ``<rt70:drive>`` gets the cascade :class:`rt70.scene_servo.SceneServoFactory`
-    gives it (:func:`rt70.scene_servo.scene_axis_gains` with ``tuning``, default
-    :data:`rt70.scenarios.AXIS_TUNING`), without its clamps (a linear analysis).
+    Parameters
+    ----------
+    scene, lm, disturbances, outputs, K_extra
+        As :func:`structure_system`.
+    servos : mapping drive name → (DriveParameters, CascadeGains)
+        Every ``<rt70:drive>`` of the scene: its parameters and its cascade's gains
+        (for the RT-70 :func:`rt70.scene_servo.scene_servos`, the gains
+        :class:`rt70.scene_servo.SceneServoFactory` simulates with). The clamps are left
+        out (a linear analysis).
 
     Returns
     -------
@@ -151,20 +156,21 @@ def closed_loop(
     Raises
     ------
     Rt70Error
-        If the scene has no drive on an RT-70 axis.
+        If a drive of the scene has no servo, or a servo names no drive of the scene.
     """
     drives = scene.description.drives
-    if not drives or any(d.joint not in AXES for d in drives):
-        raise Rt70Error(f"{scene.name}: the closed loop needs <rt70:drive> on the RT-70 axes")
-    tuning = {**AXIS_TUNING, **(tuning or {})}
+    names = {d.name for d in drives}
+    if not drives or names != set(servos):
+        raise Rt70Error(
+            f"{scene.name}: servos for {', '.join(sorted(servos)) or 'no drive'}, the scene's "
+            f"drives are {', '.join(sorted(names)) or 'none'}"
+        )
     couplings = [SceneCoupling(scene, d, "textbook") for d in drives]
     blocks = [structure_system(scene, lm, couplings, disturbances, outputs, K_extra)]
     extra_out = []
     for c in couplings:
         d = c.drive.name
-        axis = AXES[c.drive.joint]
-        p = drive_parameters(c.drive, axis.reference_inertia)
-        g = scene_axis_gains(p, axis, *tuning[axis.name])
+        p, g = servos[d]
         drive = _renamed(drive_block(p), f"{d}_", d)
         # the drive's own names: voltage, axis_angle, axis_rate → reducer_torque, …
         blocks += [
