@@ -101,8 +101,12 @@ def on_dask(client: Client) -> Executor:
         if not chunks:
             return
         client.register_plugin(PinBlasThreads(), name="rt70-pin-blas")
+        # hash=False: keys of this run only. Content-hashed keys are shared with an earlier
+        # run on the same client, whose futures release them as it ends, and the new
+        # run's tasks then lose their inputs ("lost dependencies": measured on two sweeps
+        # with the same scene in one client, validation/pointing_budget.py)
         source, grid, quantities = client.scatter(
-            [sweep.source, sweep.grid, sweep.quantities], broadcast=True
+            [sweep.source, sweep.grid, sweep.quantities], broadcast=True, hash=False
         )
         futures = [
             client.submit(compute_chunk, source, grid, c, quantities, pure=False) for c in chunks
