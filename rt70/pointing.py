@@ -182,6 +182,29 @@ class WindyScene:
         return 2.0 * self.force(q) / self.speed
 
 
+def wind_inputs(scene: Scene, q0: np.ndarray, speed: float, direction_deg: float) -> list:
+    """The linear plant's wind inputs at q0: one gust channel per exposed body, and all.
+
+    ``wind:<element>`` is the generalised force of a unit gust (1 m/s along the mean
+    wind of ``speed`` from ``direction_deg``) on that ``<rt70:wind>`` body alone,
+    ``∂Q_w,e/∂v = 2 Q_w,e / v̄``; ``wind`` the same on every body at once (coherent
+    gusts, the budget's input). For :func:`rt70.linear.plant.plant`: its
+    disturbance-to-pointing transfer functions.
+    """
+    from rt70.linear.plant import ForceInput
+    from rt70.reference import wind as ref_wind
+    from rt70.wind import WindCondition
+
+    if not speed > 0.0:
+        raise Rt70Error(f"wind speed must be positive, got {speed:g} m/s")
+    condition = WindCondition(speed, direction_deg)
+    q0 = np.asarray(q0, dtype=float)
+    parts = ref_wind.wind_forces(scene.reference, scene.reference_data, q0, condition)
+    inputs = [ForceInput(f"wind:{name}", 2.0 * Q / speed) for name, Q in parts.items()]
+    total = 2.0 * ref_wind.wind_force(scene.reference, scene.reference_data, q0, condition) / speed
+    return [*inputs, ForceInput("wind", total)]
+
+
 @dataclass
 class WindState:
     """The calm and the windy drive-held equilibria of a case."""

@@ -5,10 +5,11 @@ One call, :func:`plant`, linearises a scene about a static equilibrium
 ``y = C x`` with ``x = [q; q̇]`` (:func:`rt70.linear.responses.state_space`):
 
 - inputs are generalised forces: a torque or force on a named coordinate
-  (:class:`CoordinateInput`, what a drive applies to its axis), or a load
+  (:class:`CoordinateInput`, what a drive applies to its axis), a load
   (:class:`LoadInput`, a :class:`rt70.loads.Wrench` per unit input — a force on the
-  counterweight, wind on the dish), whose column is the load's generalised force
-  ``S·U`` (4.129)–(4.131) on the textbook side;
+  counterweight), whose column is the load's generalised force ``S·U`` (4.129)–(4.131)
+  on the textbook side, or any column (:class:`ForceInput`: a wind gust's ``∂Q_w/∂v``
+  on each exposed body, :func:`rt70.pointing.wind_inputs`);
 - outputs are coordinates (:class:`CoordinateOutput`, an axis angle) or any
   :class:`rt70.outputs.Output` (the optical points, the mirror system's quantities),
   linearised on the textbook side by :func:`rt70.outputs.output_matrix` (the exact point
@@ -55,6 +56,18 @@ class LoadInput:
     wrench: Wrench
 
 
+@dataclass(frozen=True, eq=False)
+class ForceInput:
+    """A generalised-force column per unit input (rows: all the scene's coordinates).
+
+    For loads that are not one fixed wrench: a wind gust's ``∂Q_w/∂v`` on the exposed
+    bodies (:func:`rt70.pointing.wind_inputs`), computed by the caller at q0.
+    """
+
+    name: str
+    column: np.ndarray
+
+
 @dataclass(frozen=True)
 class CoordinateOutput:
     """One coordinate as an output (m or rad), e.g. an axis angle."""
@@ -63,7 +76,7 @@ class CoordinateOutput:
     coordinate: str
 
 
-PlantInput = CoordinateInput | LoadInput
+PlantInput = CoordinateInput | LoadInput | ForceInput
 PlantOutput = CoordinateOutput | Output
 
 
@@ -78,7 +91,15 @@ def _input_column(lm: lin.Linearization, scene: Scene, u: PlantInput) -> np.ndar
         column = np.zeros(len(lm.coordinates))
         column[lm.coordinates.index(u.coordinate)] = 1.0
         return column
-    Q = points.generalized_force(scene.textbook, scene.textbook_data, lm.q0, u.wrench)
+    if isinstance(u, ForceInput):
+        Q = np.asarray(u.column, dtype=float)
+        if Q.shape != (scene.textbook.nv,) or not np.isfinite(Q).all():
+            raise Rt70Error(
+                f"{scene.name}: input '{u.name}': a column of {scene.textbook.nv} finite "
+                f"generalised forces expected, got shape {Q.shape}"
+            )
+    else:
+        Q = points.generalized_force(scene.textbook, scene.textbook_data, lm.q0, u.wrench)
     return Q[lin.coordinate_indices(scene, lm.coordinates)]
 
 
@@ -112,7 +133,7 @@ def plant(
         The scene.
     q0 : ndarray
         A static equilibrium (:func:`rt70.linear.linearize.equilibrium`).
-    inputs : sequence of CoordinateInput or LoadInput
+    inputs : sequence of CoordinateInput, LoadInput or ForceInput
         The inputs, in order (their names label B's columns).
     outputs : sequence of CoordinateOutput or rt70.outputs.Output
         The outputs, in order; an Output with several components gives one row each
