@@ -37,6 +37,8 @@ ELEVATIONS = (15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
 MAP_ELEVATIONS = tuple(float(e) for e in range(0, 91, 10))
 MAP_DIRECTIONS = tuple(float(d) for d in range(0, 360, 30))
 MAP_SPEED = 10.0
+#: The cases whose mode shares are drawn: (elevation, wind direction, what it is).
+MODE_CASES = ((45.0, 0.0, "front wind"), (90.0, 0.0, "horizontal wind"), (30.0, 90.0, "side wind"))
 
 
 def _save(fig, name: str) -> None:
@@ -96,12 +98,15 @@ def main() -> None:
         ),
         "pointing_maps.png",
     )
-    case = pointing_budget(scene, PointingCase(45.0, 0.0, 10.0))
-    shares = [("quasi-static (gust filter)", 0.0, case.extra["quasi_static_share"])]
-    shares += [(md.label, md.frequency_hz, md.share) for md in case.modes]
+    cases = []
+    for e, d, what in MODE_CASES:
+        b = pointing_budget(scene, PointingCase(e, 0.0, 10.0, d))
+        shares = [("quasi-static", None, b.extra["quasi_static_share"])]
+        shares += [(md.label, md.frequency_hz, md.share) for md in b.modes]
+        cases.append((f"{what}, elevation {e:g}°", shares))
     _save(
         mode_shares_figure(
-            shares, title="10 m/s front wind at 45°: shares of the main-mirror axis's gust variance"
+            cases, title="10 m/s: shares of the main-mirror axis's gust variance (servos closed)"
         ),
         "pointing_modes.png",
     )

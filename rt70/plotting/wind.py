@@ -28,17 +28,27 @@ def error_vs_speed_figure(
     ``steady[E]``, ``gust[E]``: values at ``speeds`` for elevation E (degrees).
     ``target``: a horizontal line (e.g. a tenth of the beam width).
     """
+    from matplotlib.ticker import FixedLocator, NullFormatter, ScalarFormatter
+
     v = np.asarray(speeds, dtype=float)
-    fig = Figure(figsize=(8, 5.5), constrained_layout=True)
+    fig = Figure(figsize=(8.5, 6), constrained_layout=True)
     ax = fig.subplots()
+    markers = "osD^vP*X"
     for k, elevation in enumerate(sorted(steady)):
-        c = f"C{k}"
-        ax.loglog(v, steady[elevation], "-o", color=c, ms=4, label=f"steady, E = {elevation:g}°")
-        ax.loglog(v, gust[elevation], "--s", color=c, ms=3, label=f"gust rms, E = {elevation:g}°")
-    # the v² law through the largest steady value at the middle speed
-    mid = len(v) // 2
-    top = max(float(np.asarray(steady[e])[mid]) for e in steady)
-    ax.loglog(v, top * (v / v[mid]) ** 2, ":", color="0.4", lw=1.0, label="∝ v² (reference)")
+        c, m = f"C{k}", markers[k % len(markers)]
+        ax.loglog(
+            v, steady[elevation], "-", marker=m, color=c, ms=5, label=f"steady, E = {elevation:g}°"
+        )
+        ax.loglog(
+            v, gust[elevation], "--", marker=m, color=c, ms=4, mfc="none",
+            label=f"gust rms, E = {elevation:g}°",
+        )  # fmt: skip
+    # the v² law, drawn below the lowest curve so it hides none
+    low = min(float(np.min(np.asarray(gust[e]))) for e in gust)
+    ax.loglog(v, 0.4 * low * (v / v[0]) ** 2, ":", color="0.3", lw=1.5, label="∝ v² (slope 2)")
+    ax.xaxis.set_major_locator(FixedLocator(v))
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.xaxis.set_minor_formatter(NullFormatter())
     if target is not None:
         ax.axhline(target, color="k", lw=0.8, ls="-.", label=f"{target:g}″ target")
     ax.set_xlabel("mean wind speed, m/s")
@@ -79,19 +89,27 @@ def maps_figure(
     return fig
 
 
-def mode_shares_figure(shares: Sequence[tuple[str, float, float]], title: str = "") -> Figure:
-    """Bar chart of the modes' shares of the gust variance: ``(label, frequency Hz, share)``."""
-    fig = Figure(figsize=(8, 4.5), constrained_layout=True)
-    ax = fig.subplots()
-    labels = [f"{name}\n{f:.3g} Hz" for name, f, _ in shares]
-    values = [100.0 * s for _, _, s in shares]
-    ax.bar(range(len(values)), values, color=["C0" if v >= 0 else "C3" for v in values])
-    ax.set_xticks(range(len(values)), labels, fontsize=7)
-    ax.set_ylabel("share of the gust variance, %")
-    ax.set_xlabel("closed-loop mode (dominant state, frequency)")
-    ax.axhline(0.0, color="k", lw=0.6)
-    ax.set_title(title or "which modes make the gust pointing error", fontsize=10)
-    ax.grid(True, axis="y", alpha=0.3)
+def mode_shares_figure(
+    cases: Sequence[tuple[str, Sequence[tuple[str, float, float]]]], title: str = ""
+) -> Figure:
+    """Bar charts of the modes' shares of the gust variance, one panel per case.
+
+    ``cases``: ``(case title, [(label, frequency Hz or None, share), …])``; a frequency
+    of None prints no frequency (the quasi-static part). Each bar carries its share.
+    """
+    fig = Figure(figsize=(4.2 * len(cases), 4.8), constrained_layout=True)
+    axes = np.atleast_1d(fig.subplots(1, len(cases), sharey=True))
+    for ax, (name, shares) in zip(axes, cases, strict=True):
+        labels = [label if f is None else f"{label}\n{f:.3g} Hz" for label, f, _ in shares]
+        values = [100.0 * s for _, _, s in shares]
+        bars = ax.bar(range(len(values)), values, color=["C0" if v >= 0 else "C3" for v in values])
+        ax.bar_label(bars, labels=[f"{v:.1f} %" for v in values], fontsize=7)
+        ax.set_xticks(range(len(values)), labels, fontsize=7, rotation=20)
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_title(name, fontsize=9)
+        ax.grid(True, axis="y", alpha=0.3)
+    axes[0].set_ylabel("share of the gust variance, %")
+    fig.suptitle(title or "which modes make the gust pointing error", fontsize=10)
     return fig
 
 

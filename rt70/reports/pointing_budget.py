@@ -41,13 +41,14 @@ def format_table(budgets: Sequence[PointingBudget]) -> str:
     head = ["elevation, °", "wind, m/s"]
     for name, unit in BUDGET_OUTPUTS.items():
         head += [f"{TITLES[name]}: steady, {unit}", f"gust rms, {unit}"]
-    head += ["first mode (share)"]
+    head += ["quasi-static share", "loop mode with the largest share"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for b in budgets:
         row = [f"{b.case.elevation_deg:g}", f"{b.case.speed:g}"]
         for name in BUDGET_OUTPUTS:
             row += [f"{b.steady[name]:.3g}", f"{b.gust_rms[name]:.3g}"]
         m = b.modes[0] if b.modes else None
-        row += [f"{m.label} {m.frequency_hz:.3g} Hz ({100 * m.share:.0f} %)" if m else "—"]
+        row += [f"{100 * b.extra['quasi_static_share']:.1f} %"]
+        row += [f"{m.label} {m.frequency_hz:.3g} Hz ({100 * m.share:.1f} %)" if m else "—"]
         lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)
