@@ -30,7 +30,7 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
         "against the source, the counterreflector against the main mirror (arc seconds) "
         "and the focus offset (mm); the steady value and the gust rms (Lyapunov), and the "
         "three closed-loop modes that contribute most. --duration also runs that many "
-        "seconds of gusts through the nonlinear model and compares (docs/wind.md).",
+        "seconds of gusts through the nonlinear model and compares (docs/pointing.md).",
     )
     poi.add_argument("scene", metavar="SCENE", help="scene name or URDF path (rt70_servo)")
     add_pointing_arguments(poi, default="45")
