@@ -8,8 +8,9 @@ validation/results/gust_check_<speed>.json (rms values, statistical error, run t
 .npz (the records). ``--figure`` draws validation/results/gust_check.png from the files
 already written.
 
-Run: ``python validation/gust_check.py --speed 5 --duration 1200`` (about 50 minutes of
-one core per speed on this machine; the runs of issue 11: 5 and 15 m/s).
+Run: ``python validation/gust_check.py --speed 5 --duration 600`` (the runs of issue 11:
+5 and 15 m/s, 600 s each; their nonlinear simulations took 1234 s and 1698 s of one
+core), then ``--figure``.
 """
 
 import argparse
@@ -50,7 +51,8 @@ def figure() -> Path:
     from rt70.plotting.wind import gust_check_figure
 
     runs = []
-    for path in sorted(OUT.glob("gust_check_*.json")):
+    paths = OUT.glob("gust_check_*.json")
+    for path in sorted(paths, key=lambda p: float(p.stem.removeprefix("gust_check_"))):
         info = json.loads(path.read_text())
         records = dict(np.load(path.with_suffix(".npz")))
         runs.append((info, records))
@@ -65,7 +67,7 @@ def figure() -> Path:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--speed", type=float, help="mean wind speed, m/s")
-    p.add_argument("--duration", type=float, default=1200.0, help="record length, s")
+    p.add_argument("--duration", type=float, default=600.0, help="record length, s")
     p.add_argument("--figure", action="store_true", help="draw the figure from the results")
     args = p.parse_args()
     if args.figure:

@@ -154,31 +154,36 @@ def gust_check_figure(runs: Sequence[tuple[dict, Mapping[str, np.ndarray]]]) -> 
     ax = axes[-1]
     width = 0.2
     for i, (info, _) in enumerate(runs):
-        x = i
+        lyap, err = info["rms_lyapunov"][name], info["rms_statistical_error"][name]
         values = (
             info["rms_nonlinear"][name],
             info["rms_linear_same_gusts"][name],
             info["rms_linear_exact_load_law"][name],
+            lyap,
+        )
+        labels = (
+            "nonlinear",
+            "linear, same gusts",
+            "linear, exact load law",
+            "Lyapunov (ensemble)",
         )
         for j, (val, label, color) in enumerate(
-            zip(values, ("nonlinear", "linear, same gusts", "linear, exact load law"),
-                ("k", "C0", "C3"), strict=True)
-        ):  # fmt: skip
-            ax.bar(x + (j - 1.5) * width, val, width, color=color, label=label if i == 0 else None)
-        lyap, err = info["rms_lyapunov"][name], info["rms_statistical_error"][name]
-        ax.bar(
-            x + 1.5 * width,
-            lyap,
-            width,
-            color="C2",
-            label="Lyapunov (ensemble)" if i == 0 else None,
-        )
-        ax.errorbar(x + 1.5 * width, lyap, yerr=2 * err, color="k", capsize=4, lw=1)
+            zip(values, labels, ("k", "C0", "C3", "C2"), strict=True)
+        ):
+            bar = ax.bar(
+                i + (j - 1.5) * width, val / lyap, width, color=color,
+                label=label if i == 0 else None,
+            )  # fmt: skip
+            ax.bar_label(bar, labels=[f"{val:.3g}″"], fontsize=7)
+        ax.errorbar(i + 1.5 * width, 1.0, yerr=2 * err / lyap, color="k", capsize=4, lw=1)
     ax.set_xticks(range(len(runs)), [f"{info['wind_speed']:g} m/s" for info, _ in runs])
-    ax.set_ylabel(f"rms of |{name}|, ″")
+    ax.set_ylabel(f"rms of |{name}| / Lyapunov rms")
+    ax.set_ylim(0.0, 1.35)
     ax.set_title(
-        "record rms against the ensemble rms ± 2 standard errors of the record", fontsize=9
+        "record rms (value on the bar) against the ensemble rms ± 2 standard errors of a "
+        "record this long",
+        fontsize=9,
     )
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, ncol=4, loc="lower center")
     ax.grid(True, axis="y", alpha=0.3)
     return fig
