@@ -60,21 +60,17 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
     return poi
 
 
-def _require_axes(scene) -> None:
-    from rt70.scenes import rt70_state
-
-    names = scene.textbook.coordinate_names
-    axes = (rt70_state.AZIMUTH_COORDINATE, rt70_state.ELEVATION_COORDINATE)
-    missing = [a for a in axes if a not in names]
-    if missing:
-        raise Rt70Error(f"{scene.name}: no RT-70 pointing axis {', '.join(missing)}: no budget")
-
-
 def run(args: argparse.Namespace) -> int:
     """Check the options and the scene, compute the budget (and the gust record), print."""
-    from rt70.pointing import PointingCase, check_case, format_budget, pointing_budget
+    from rt70.pointing import (
+        PointingCase,
+        budget_model,
+        check_case,
+        check_scene,
+        format_budget,
+        pointing_budget,
+    )
     from rt70.scene import load_scene
-    from rt70.scene_servo import check_scene_drives
 
     case = PointingCase(
         45.0 if args.elevation is None else args.elevation,
@@ -95,16 +91,16 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         scene = load_scene(SERVO_SCENE)
-    _require_axes(scene)
-    check_scene_drives(scene)
-    if not scene.description.winds:
-        raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (see docs/wind.md)")
-    budget = pointing_budget(scene, case)
+    check_scene(scene)
+    model = budget_model(scene, case)
+    budget = pointing_budget(scene, case, model)
     run = None
-    if args.duration is not None:
+    if args.duration is not None:  # the same equilibria, loop and covariance
         from rt70.gust_run import gust_run
 
-        run = gust_run(scene, case, args.duration, seed=args.seed, progress=args.progress)
+        run = gust_run(
+            scene, case, args.duration, seed=args.seed, progress=args.progress, model=model
+        )
     if args.json:
         out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
         if run is not None:

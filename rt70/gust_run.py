@@ -29,16 +29,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.outputs import evaluate
-from rt70.pointing import (
-    BUDGET_OUTPUTS,
-    PointingCase,
-    WindyScene,
-    budget_outputs,
-    check_case,
-    gust_system,
-    wind_equilibria,
-    windy_linearization,
-)
+from rt70.pointing import BUDGET_OUTPUTS, BudgetModel, PointingCase, budget_model, check_case
 from rt70.scene import Scene
 
 #: Integration method and tolerance of the nonlinear run (as the servo scenarios:
@@ -111,8 +102,13 @@ def gust_run(
     dt: float = DT,
     rtol: float = RTOL,
     progress: bool = False,
+    model: BudgetModel | None = None,
 ) -> GustRun:
     """Run one gust record through both models (module docstring).
+
+    ``model``: the case's :class:`rt70.pointing.BudgetModel` if the budget was computed
+    already (``rt70 pointing --duration``): its equilibria, loop and covariance are used
+    as they are.
 
     Raises
     ------
@@ -120,7 +116,7 @@ def gust_run(
         A bad case, a record shorter than two samples, or the integration failing.
     """
     from rt70.gusts import GustFilter, realise
-    from rt70.linear.covariance import output_covariance, sample_variance_error
+    from rt70.linear.covariance import sample_variance_error
     from rt70.scene_servo import SceneServoFactory
     from rt70.simulate import simulate
     from rt70.wind_load import WindLoad
@@ -128,20 +124,27 @@ def gust_run(
     check_case(case)
     if not (np.isfinite(duration) and duration >= 2 * dt):
         raise Rt70Error(f"gust run: duration must be at least {2 * dt:g} s, got {duration:g}")
-    windy = WindyScene(scene, case.speed, case.direction)
-    state = wind_equilibria(scene, case, windy)
-    outputs = budget_outputs(scene, case)
+    if model is None:
+        model = budget_model(scene, case)
+    elif model.case != case:
+        raise Rt70Error(f"the budget model is of {model.case}, not of {case}")
+    outputs = model.outputs
     series = realise(GustFilter(case.speed), duration, dt, seed)
     t = series.t
     # the nonlinear model, at rest in the windy equilibrium held by its drives
     factory = SceneServoFactory()
     couplings = factory.couplings(scene)
     names = scene.coordinate_names
-    q0 = state.q_wind
-    torques = {names[c.index]: float(k) for c, k in zip(couplings, state.torque_wind, strict=True)}
+    q0 = model.state.q_wind
+    torques = {
+        names[c.index]: float(k) for c, k in zip(couplings, model.state.torque_wind, strict=True)
+    }
     held = {names[c.index]: float(q0[c.index]) for c in couplings}
     refs = {c: (lambda _t, v=v: v) for c, v in held.items()}
-    components = [*factory(scene, q0, torques, refs), WindLoad(scene, windy.condition, series)]
+    components = [
+        *factory(scene, q0, torques, refs),
+        WindLoad(scene, model.windy.condition, series),
+    ]
     start = time.perf_counter()
     result = simulate(
         scene,
@@ -160,12 +163,10 @@ def gust_run(
     steady = evaluate(scene, q0, outputs, "reference")
     nonlinear = {o.name: result.outputs[o.name] - steady[o.name] for o in outputs}
     # the linear closed loop on the same samples
-    augmented, loop = gust_system(scene, case, windy_linearization(scene, windy, state))
-    rows = {o.name: [f"{o.name}:{c}" for c in "xyz"] for o in outputs}
-    labels = [r for o in outputs for r in rows[o.name]]
+    labels = [r for o in outputs for r in model.rows(o)]
 
     def linear_response(u: np.ndarray) -> dict[str, np.ndarray]:
-        response = control.forced_response(loop[labels, "gust"], T=t, U=u)
+        response = control.forced_response(model.loop[labels, "gust"], T=t, U=u)
         y = np.atleast_2d(response.outputs).T
         return {o.name: y[:, 3 * k : 3 * k + 3] for k, o in enumerate(outputs)}
 
@@ -173,22 +174,19 @@ def gust_run(
     linear = linear_response(v)
     # the same linear loop fed the load's exact speed law: (v̄+v′)² − v̄² = 2v̄(v′ + v′²/2v̄)
     exact_load = linear_response(v + v * v / (2.0 * case.speed))
-    cov = output_covariance(augmented)
-    all_labels = list(augmented.output_labels)
-    lyap, error = {}, {}
-    for o in outputs:
-        idx = [all_labels.index(r) for r in rows[o.name]]
-        ms = float(np.trace(cov[np.ix_(idx, idx)]))
-        lyap[o.name] = float(np.sqrt(ms))
-        # std of a record's rms: std(ŝ²) / (2 s) for a small relative error
-        std_ms = sample_variance_error(augmented, rows[o.name], float(t[-1]), dt=dt)
-        error[o.name] = std_ms / (2.0 * np.sqrt(ms))
+    lyap = model.gust_rms()
+    # std of a record's rms: std(ŝ²) / (2 s) for a small relative error
+    error = {
+        o.name: sample_variance_error(model.augmented, model.rows(o), float(t[-1]), dt=dt)
+        / (2.0 * lyap[o.name])
+        for o in outputs
+    }
     return GustRun(
         case,
         float(t[-1]),
         seed,
         t,
-        np.asarray(series.v),
+        v,
         nonlinear,
         linear,
         exact_load,

@@ -38,7 +38,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
-from rt70.outputs import Output, evaluate
+from rt70.outputs import Output, column_labels, evaluate
 from rt70.scene import Scene
 
 #: The budget's outputs (names of :func:`rt70.optics.mirror_outputs`), their units.
@@ -148,6 +148,25 @@ def check_case(case: PointingCase) -> None:
         raise Rt70Error(f"wind speed must be positive, got {case.speed:g} m/s")
 
 
+def check_scene(scene: Scene) -> None:
+    """Refuse a scene that cannot give a budget, before any work.
+
+    It needs the RT-70 pointing axes, the mirror system's optical points, a
+    ``<rt70:drive>`` on each axis and at least one ``<rt70:wind>`` element.
+    """
+    from rt70.scene_servo import check_scene_drives
+    from rt70.scenes.rt70_optics import rt70_mirror_system
+    from rt70.scenes.rt70_state import missing_axes
+
+    missing = missing_axes(scene.coordinate_names)
+    if missing:
+        raise Rt70Error(f"{scene.name}: no RT-70 pointing axis {', '.join(missing)}: no budget")
+    rt70_mirror_system(scene)  # raises naming the missing optical points
+    check_scene_drives(scene)
+    if not scene.description.winds:
+        raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (see docs/wind.md)")
+
+
 class WindyScene:
     """A scene's wind at one condition on one side: the force, its stiffness, its gust column."""
 
@@ -169,13 +188,7 @@ class WindyScene:
 
     def stiffness(self, q: np.ndarray, h: float = lin.FD_STEP) -> np.ndarray:
         """``−∂Q_w/∂q`` by central differences: the aerodynamic stiffness (not symmetric)."""
-        q = np.asarray(q, dtype=float)
-        K = np.empty((q.size, q.size))
-        for i in range(q.size):
-            e = np.zeros(q.size)
-            e[i] = h
-            K[:, i] = -(self.force(q + e) - self.force(q - e)) / (2.0 * h)
-        return K
+        return lin.negative_jacobian(self.force, q, h)
 
     def gust_column(self, q: np.ndarray) -> np.ndarray:
         """``∂Q_w/∂v`` along the mean wind: ``2 Q_w / v̄`` (the load is quadratic in v)."""
@@ -193,16 +206,14 @@ def wind_inputs(scene: Scene, q0: np.ndarray, speed: float, direction_deg: float
     """
     from rt70.linear.plant import ForceInput
     from rt70.reference import wind as ref_wind
-    from rt70.wind import WindCondition
 
     if not speed > 0.0:
         raise Rt70Error(f"wind speed must be positive, got {speed:g} m/s")
-    condition = WindCondition(speed, direction_deg)
+    windy = WindyScene(scene, speed, direction_deg)
     q0 = np.asarray(q0, dtype=float)
-    parts = ref_wind.wind_forces(scene.reference, scene.reference_data, q0, condition)
+    parts = ref_wind.wind_forces(scene.reference, scene.reference_data, q0, windy.condition)
     inputs = [ForceInput(f"wind:{name}", 2.0 * Q / speed) for name, Q in parts.items()]
-    total = 2.0 * ref_wind.wind_force(scene.reference, scene.reference_data, q0, condition) / speed
-    return [*inputs, ForceInput("wind", total)]
+    return [*inputs, ForceInput("wind", windy.gust_column(q0))]
 
 
 @dataclass
@@ -294,35 +305,84 @@ def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
     return cascade_with_filter(loop, GustFilter(case.speed).system, "gust"), loop
 
 
-def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
-    """The budget of one case (module docstring)."""
+@dataclass
+class BudgetModel:
+    """Everything a case's budget is computed from, kept for the gust run to reuse.
+
+    The wind at the case, its calm and windy drive-held equilibria, the budget's outputs,
+    the linear model about the windy one, the closed loop (``loop``, inputs
+    ``<drive>_reference`` and ``gust``) and the loop driven by the gust filter
+    (``augmented``, input ``w``) with its state covariance ``P``; ``seconds`` to build.
+    """
+
+    case: PointingCase
+    windy: WindyScene
+    state: WindState
+    outputs: list[Output]
+    linear: WindyLinearization
+    loop: object
+    augmented: object
+    P: np.ndarray
+    seconds: float
+
+    def rows(self, output: Output) -> list[str]:
+        """The loop's output names of one budget output's components (``name:x`` …)."""
+        return column_labels(output.name, output.size)
+
+    def gust_rms(self) -> dict[str, float]:
+        """The ensemble (Lyapunov) rms of each output's magnitude."""
+        labels = list(self.augmented.output_labels)
+        cov = self.augmented.C @ self.P @ self.augmented.C.T
+        out = {}
+        for o in self.outputs:
+            idx = [labels.index(r) for r in self.rows(o)]
+            out[o.name] = float(np.sqrt(np.trace(cov[np.ix_(idx, idx)])))
+        return out
+
+
+def budget_model(scene: Scene, case: PointingCase) -> BudgetModel:
+    """Build the :class:`BudgetModel` of a case (module docstring)."""
     from rt70.linear.covariance import state_covariance
 
     check_case(case)
     start = time.perf_counter()
     windy = WindyScene(scene, case.speed, case.direction)
     state = wind_equilibria(scene, case, windy)
-    outputs = budget_outputs(scene, case)
-    steady, vectors = steady_errors(scene, outputs, state)
     linear = windy_linearization(scene, windy, state)
-    augmented, _ = gust_system(scene, case, linear)
+    augmented, loop = gust_system(scene, case, linear)
     P = state_covariance(augmented)
-    cov = augmented.C @ P @ augmented.C.T
-    labels = list(augmented.output_labels)
-    rms = {}
-    for o in outputs:
-        idx = [labels.index(f"{o.name}:{c}") for c in "xyz"]
-        rms[o.name] = float(np.sqrt(np.trace(cov[np.ix_(idx, idx)])))
-    state_rms = np.sqrt(np.clip(np.diag(P), 0.0, None))
+    outputs = budget_outputs(scene, case)
+    return BudgetModel(
+        case, windy, state, outputs, linear, loop, augmented, P, time.perf_counter() - start
+    )
+
+
+def pointing_budget(
+    scene: Scene, case: PointingCase, model: BudgetModel | None = None
+) -> PointingBudget:
+    """The budget of one case (module docstring); ``model`` of this case if already built.
+
+    Its ``seconds`` count the model's building too, wherever it was built.
+    """
+    if model is None:
+        model = budget_model(scene, case)
+    elif model.case != case:
+        raise Rt70Error(f"the budget model is of {model.case}, not of {case}")
+    start = time.perf_counter()
+    state, linear, augmented = model.state, model.linear, model.augmented
+    steady, vectors = steady_errors(scene, model.outputs, state)
+    state_rms = np.sqrt(np.clip(np.diag(model.P), 0.0, None))
+    main = next(o for o in model.outputs if o.name == "main_mirror_error")
     modes, quasi_static = _mode_shares(
-        augmented, [f"main_mirror_error:{c}" for c in "xyz"], state_rms, linear.lm
+        augmented, model.rows(main), state_rms, linear.lm, state.drives
     )
     torque = {
         d: float(k1 - k0)
         for d, k0, k1 in zip(state.drives, state.torque_calm, state.torque_wind, strict=True)
     }
     return PointingBudget(
-        case, steady, vectors, rms, modes, torque, time.perf_counter() - start,
+        case, steady, vectors, model.gust_rms(), modes, torque,
+        model.seconds + time.perf_counter() - start,
         extra={
             "equilibrium_residual": state.residual,
             "quasi_static_share": quasi_static,
@@ -332,7 +392,7 @@ def pointing_budget(scene: Scene, case: PointingCase) -> PointingBudget:
 
 
 def _mode_shares(
-    augmented, outputs: list[str], rms: np.ndarray, lm: lin.Linearization
+    augmented, outputs: list[str], rms: np.ndarray, lm: lin.Linearization, drives: list[str]
 ) -> tuple[list[ModeShare], float]:
     """The loop's :data:`TOP_MODES` largest shares of ``E|y|²``, and the gust filter's share.
 
@@ -357,19 +417,30 @@ def _mode_shares(
     loop.sort(key=lambda m: -m.share)
     top = [
         ModeShare(
-            m.frequency_hz, m.damping, m.share, mode_label(augmented, m, rms, lm.M, lm.coordinates)
+            m.frequency_hz,
+            m.damping,
+            m.share,
+            mode_label(augmented, m, rms, lm.M, lm.coordinates, drives),
         )
         for m in loop[:TOP_MODES]
     ]
     return top, float(quasi_static)
 
 
-def mode_label(augmented, mode, rms: np.ndarray, M: np.ndarray, coordinates: list[str]) -> str:
+def mode_label(
+    augmented,
+    mode,
+    rms: np.ndarray,
+    M: np.ndarray,
+    coordinates: list[str],
+    drives: list[str],
+) -> str:
     """Name a loop mode: a servo's, or the coordinate that carries its kinetic energy.
 
     Which block the mode belongs to is decided on the eigenvector's entries divided by
     each state's stationary rms under the gust (so states of any unit compare; the gust
-    filter's states left out): a drive's or a controller's state makes it
+    filter's states left out): a state of one of the ``drives`` (its motor or its
+    cascade, named ``<drive>_…`` by :func:`rt70.linear.scene_loop.closed_loop`) makes it
     ``<drive> servo``; a structural one names it by the coordinate with the largest
     share of the mode's kinetic energy ``Re(v̇ᵢ* (M v̇)ᵢ)`` (the heavy body that moves,
     not the light one that moves most).
@@ -380,8 +451,8 @@ def mode_label(augmented, mode, rms: np.ndarray, M: np.ndarray, coordinates: lis
     v = np.abs(vector) / np.where(rms > 0.0, rms, np.inf)
     v[~loop] = 0.0
     name = labels[int(np.argmax(v))]
-    for drive in ("azimuth", "elevation"):
-        if name.startswith(drive):
+    for drive in drives:
+        if name.startswith(f"{drive}_"):
             return f"{drive} servo"
     rate = np.array([vector[labels.index(f"structure_{c}_dot")] for c in coordinates])
     energy = np.real(np.conj(rate) * (M @ rate))

@@ -44,7 +44,13 @@ from rt70.outputs import Output, evaluate
 from rt70.scene import Scene
 from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE, AxisDrive
 from rt70.scenes.rt70_optics import rt70_mirror_outputs, rt70_mirror_system
-from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
+from rt70.scenes.rt70_state import (
+    AZIMUTH_COORDINATE,
+    ELEVATION_COORDINATE,
+    POINTING_AXES,
+    missing_axes,
+    rt70_pointing,
+)
 from rt70.servo import CascadeGains, ServoDrive, cascade_gains
 from rt70.servo_metrics import (  # noqa: F401  (re-exported: the scenario's numbers)
     BAND_ARCSEC,
@@ -299,13 +305,12 @@ def choose(
         A scenario or pointing asked of a scene without the axes, or one the drives
         cannot hold at that pointing.
     """
-    axes = (AZIMUTH_COORDINATE, ELEVATION_COORDINATE)
     asked = name is not None or elevation_deg is not None or azimuth_deg is not None
-    if not all(axis in scene.coordinate_names for axis in axes):
+    if missing_axes(scene.coordinate_names):
         if asked:
             raise Rt70Error(
                 f"{scene.name}: --scenario/--elevation/--azimuth need the RT-70 pointing axes "
-                f"({', '.join(axes)})"
+                f"({', '.join(POINTING_AXES)})"
             )
         return None, None
     elevation = DEFAULT_ELEVATION if elevation_deg is None else elevation_deg
@@ -417,9 +422,9 @@ def run_scenario(
         Output samples per second of simulated time.
     """
     names = scene.coordinate_names
-    for c in (AZIMUTH_COORDINATE, ELEVATION_COORDINATE):
-        if c not in names:
-            raise Rt70Error(f"{scene.name}: no RT-70 pointing axis '{c}': no servo scenario")
+    missing = missing_axes(names)
+    if missing:
+        raise Rt70Error(f"{scene.name}: no RT-70 pointing axis '{missing[0]}': no servo scenario")
     drives = servo_drives() if drives is None else drives
     ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
     held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)

@@ -319,7 +319,7 @@ def plan(
         A scene that does not load, has no RT-70 pointing axes or cannot give a
         quantity (:attr:`Quantity.check`); an unknown quantity; chunk < 1.
     """
-    from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE
+    from rt70.scenes.rt70_state import missing_axes
 
     if chunk < 1:
         raise SweepError(f"--chunk must be at least 1, got {chunk}")
@@ -330,7 +330,7 @@ def plan(
     source = SceneSource.read(target)
     scene = build_scene(source)
     names = scene.textbook.coordinate_names
-    missing = [a for a in (AZIMUTH_COORDINATE, ELEVATION_COORDINATE) if a not in names]
+    missing = missing_axes(names)
     if missing:
         raise SweepError(f"{source.name}: no RT-70 pointing axis {', '.join(missing)} to sweep")
     chosen = tuple(QUANTITIES[q] for q in quantities)

@@ -261,12 +261,9 @@ def _pointing(scene: Scene, point: SweepPoint) -> dict[str, Any]:
 
 
 def _check_pointing(scene: Scene) -> None:
-    from rt70.scene_servo import check_scene_drives
+    from rt70.pointing import check_scene
 
-    _check_mirror(scene)
-    check_scene_drives(scene)
-    if not scene.description.winds:
-        raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no pointing budget")
+    check_scene(scene)
 
 
 #: The budget's outputs (:data:`rt70.pointing.BUDGET_OUTPUTS`) and their two fields.

@@ -137,3 +137,14 @@ def test_plant_wind_inputs_give_disturbance_to_pointing_transfer_functions(scene
     assert total == pytest.approx(quasi_static, rel=0.01)
     with pytest.raises(Exception, match="positive"):
         wind_inputs(scene, q0, 0.0, 0.0)
+
+
+def test_pointing_command_runs_a_gust_record_on_the_budget_model(capsys):
+    """``--duration``: the record's Lyapunov rms is the budget's gust rms (one model)."""
+    argv = ["pointing", "rt70_servo", "--wind", "10", "--duration", "1", "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    run = out["gust_run"]
+    assert run["duration_s"] == 1.0
+    assert run["rms_lyapunov"] == out["gust_rms"]
+    assert all(np.isfinite(v) and v > 0 for v in run["rms_nonlinear"].values())

@@ -80,13 +80,24 @@ def _check_side(side: str) -> None:
         raise Rt70Error(f"unknown side {side!r} (choose from {', '.join(SIDES)})")
 
 
-def _negative_jacobian(force, q: np.ndarray, h: float) -> np.ndarray:
-    """``−∂force/∂q`` by central differences with step h per coordinate, symmetrised."""
+def negative_jacobian(force, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+    """``−∂force/∂q`` by central differences with step h per coordinate, as it is.
+
+    Not symmetrised: a non-conservative force (the wind's, :mod:`rt70.pointing`) has a
+    non-symmetric stiffness.
+    """
+    q = np.asarray(q, dtype=float)
     K = np.empty((q.size, q.size))
     for i in range(q.size):
         e = np.zeros(q.size)
         e[i] = h
         K[:, i] = -(force(q + e) - force(q - e)) / (2.0 * h)
+    return K
+
+
+def _negative_jacobian(force, q: np.ndarray, h: float) -> np.ndarray:
+    """``−∂force/∂q`` by central differences with step h per coordinate, symmetrised."""
+    K = negative_jacobian(force, q, h)
     return 0.5 * (K + K.T)
 
 

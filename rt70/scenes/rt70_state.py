@@ -29,6 +29,15 @@ AZIMUTH_COORDINATE = "platform_rz"
 ELEVATION_COORDINATE = "base_rx"
 
 
+#: Both pointing axes, azimuth first.
+POINTING_AXES = (AZIMUTH_COORDINATE, ELEVATION_COORDINATE)
+
+
+def missing_axes(coordinates) -> list[str]:
+    """The RT-70 pointing axes (:data:`POINTING_AXES`) not among ``coordinates``."""
+    return [a for a in POINTING_AXES if a not in coordinates]
+
+
 def rt70_pointing(elevation_deg: float, azimuth_deg: float = 0.0) -> dict[str, float]:
     """Held coordinates of the RT-70 drives for a pointing.
 
