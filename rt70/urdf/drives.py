@@ -23,9 +23,6 @@ if TYPE_CHECKING:  # the reader passes itself; no import cycle at run time
 #: Parameters that must be positive (the others, D_m and D_r, may be zero).
 POSITIVE = ("L_a", "R_a", "c_m", "c_e", "J_m", "i_r", "C_r")
 
-#: Joint types a drive can turn (one coordinate).
-DRIVEN_TYPES = ("revolute", "continuous", "prismatic")
-
 #: Largest |axis · direction| of a sector: the tangent must be normal to the axis.
 ORTHOGONALITY = 1e-9
 
@@ -50,16 +47,8 @@ def read_drive(
     where = f"<rt70:drive name='{name}'>"
     if any(d.name == name for d in desc.drives):
         raise reader.fail(ExtensionError, f"two drives named '{name}'")
-    jname = elem.get("joint")
-    if not jname:
-        raise reader.fail(ExtensionError, f"{where} lacks attribute 'joint'")
-    joint = joints.get(jname)
-    if joint is None:
-        raise reader.fail(ExtensionError, f"{where}: joint '{jname}' does not exist")
-    if joint.type not in DRIVEN_TYPES:
-        raise reader.fail(
-            ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"
-        )
+    joint = reader.one_dof_joint(elem, joints, where)
+    jname = joint.name
     if joint.mimic is not None:
         raise reader.fail(
             ExtensionError,

@@ -471,9 +471,14 @@ class _Reader:
             out.append(values)
         return out[0], out[1]
 
-    def joint_spring(self, elem: ET.Element, joints: dict[str, Joint]) -> JointSpring:
-        name = self.name_of(elem)
-        where = f"<rt70:joint_spring name='{name}'>"
+    def one_dof_joint(self, elem: ET.Element, joints: dict[str, Joint], where: str) -> Joint:
+        """The 1-DOF joint an extension element names in its ``joint`` attribute.
+
+        Raises
+        ------
+        ExtensionError
+            If the attribute is missing, names no joint, or a joint that is not 1-DOF.
+        """
         jname = elem.get("joint")
         if not jname:
             raise self.fail(ExtensionError, f"{where} lacks attribute 'joint'")
@@ -484,8 +489,14 @@ class _Reader:
             raise self.fail(
                 ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"
             )
+        return joint
+
+    def joint_spring(self, elem: ET.Element, joints: dict[str, Joint]) -> JointSpring:
+        name = self.name_of(elem)
+        where = f"<rt70:joint_spring name='{name}'>"
+        joint = self.one_dof_joint(elem, joints, where)
         k, d = self.gains(elem, 1, where)
-        return JointSpring(name, jname, float(k[0]), float(d[0]))
+        return JointSpring(name, joint.name, float(k[0]), float(d[0]))
 
     def frame(self, elem: ET.Element, tag: str, desc: RobotDescription, where: str) -> FrameRef:
         sub = elem.find(f"{{{RT70_NS}}}{tag}")
