@@ -32,23 +32,11 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.linear.checks import _matrix, _square
+from rt70.linear.responses import StateSpace
 
 #: Largest condition number of the eigenvector matrix V for which :func:`mode_contributions`
 #: splits a variance over modes (beyond it A is numerically defective and the split is noise).
 MAX_EIGENVECTOR_CONDITION = 1e10
-
-
-@dataclass(frozen=True)
-class _System:
-    """The matrices and labels of a state-space system, however it was given."""
-
-    A: np.ndarray
-    B: np.ndarray
-    C: np.ndarray
-    D: np.ndarray
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-    states: tuple[str, ...]
 
 
 def _labels(sys: Any, names: Sequence[str], count: int, prefix: str) -> tuple[str, ...]:
@@ -59,8 +47,11 @@ def _labels(sys: Any, names: Sequence[str], count: int, prefix: str) -> tuple[st
     return tuple(f"{prefix}[{i}]" for i in range(count))
 
 
-def _system(sys: Any) -> _System:
-    """Read ``sys`` (python-control or rt70 StateSpace, or a tuple of arrays), checked."""
+def _system(sys: Any) -> StateSpace:
+    """Read ``sys`` (python-control or rt70 StateSpace, or a tuple of arrays), checked.
+
+    Returned as rt70's own :class:`rt70.linear.responses.StateSpace` (labels included).
+    """
     if isinstance(sys, tuple):
         if len(sys) not in (3, 4):
             raise Rt70Error(f"a system tuple is (A, B, C) or (A, B, C, D), got {len(sys)} items")
@@ -79,18 +70,18 @@ def _system(sys: Any) -> _System:
         if D is None
         else _matrix("D", D, (C.shape[0], B.shape[1]))
     )
-    return _System(
+    return StateSpace(
         A,
         B,
         C,
         D,
-        _labels(sys, ("input_labels", "input_names"), B.shape[1], "u"),
-        _labels(sys, ("output_labels", "output_names"), C.shape[0], "y"),
-        _labels(sys, ("state_labels", "state_names"), n, "x"),
+        state_names=_labels(sys, ("state_labels", "state_names"), n, "x"),
+        input_names=_labels(sys, ("input_labels", "input_names"), B.shape[1], "u"),
+        output_names=_labels(sys, ("output_labels", "output_names"), C.shape[0], "y"),
     )
 
 
-def _stable(s: _System) -> np.ndarray:
+def _stable(s: StateSpace) -> np.ndarray:
     """The eigenvalues of A, after checking they all have negative real parts."""
     eigenvalues = np.linalg.eigvals(s.A)
     worst = eigenvalues[np.argmax(eigenvalues.real)]
@@ -102,7 +93,7 @@ def _stable(s: _System) -> np.ndarray:
     return eigenvalues
 
 
-def _no_feedthrough(s: _System) -> None:
+def _no_feedthrough(s: StateSpace) -> None:
     if np.any(s.D != 0.0):
         raise Rt70Error(
             "the system has a feedthrough D ≠ 0: white noise passed straight to an output "
@@ -123,7 +114,7 @@ def _intensity(W: float | np.ndarray, m: int) -> np.ndarray:
     return 0.5 * (W + W.T)
 
 
-def _covariance(s: _System, W: float | np.ndarray) -> np.ndarray:
+def _covariance(s: StateSpace, W: float | np.ndarray) -> np.ndarray:
     _stable(s)
     Q = s.B @ _intensity(W, s.B.shape[1]) @ s.B.T
     P = scipy.linalg.solve_continuous_lyapunov(s.A, -Q)
@@ -182,16 +173,16 @@ def output_covariance(sys: Any, W: float | np.ndarray = 1.0) -> np.ndarray:
     return 0.5 * (Y + Y.T)
 
 
-def _output_row(s: _System, output: str | int) -> tuple[int, str]:
+def _output_row(s: StateSpace, output: str | int) -> tuple[int, str]:
     if isinstance(output, str):
-        if output not in s.outputs:
-            raise Rt70Error(f"no output named '{output}' (outputs: {', '.join(s.outputs)})")
-        index = s.outputs.index(output)
+        if output not in s.output_names:
+            raise Rt70Error(f"no output named '{output}' (outputs: {', '.join(s.output_names)})")
+        index = s.output_names.index(output)
     else:
         index = int(output)
-        if not 0 <= index < len(s.outputs):
-            raise Rt70Error(f"output index {output} out of range (0…{len(s.outputs) - 1})")
-    return index, s.outputs[index]
+        if not 0 <= index < len(s.output_names):
+            raise Rt70Error(f"output index {output} out of range (0…{len(s.output_names) - 1})")
+    return index, s.output_names[index]
 
 
 def cascade_with_filter(
@@ -235,17 +226,17 @@ def cascade_with_filter(
     names = [input_name] if isinstance(input_name, str) else [str(n) for n in input_name]
     if not names:
         raise Rt70Error("no plant input named for the filter output")
-    missing = [n for n in names if n not in p.inputs]
+    missing = [n for n in names if n not in p.input_names]
     if missing:
         raise Rt70Error(
             f"the plant has no input {', '.join(repr(n) for n in missing)} "
-            f"(inputs: {', '.join(p.inputs)})"
+            f"(inputs: {', '.join(p.input_names)})"
         )
     g = np.broadcast_to(np.asarray(gain, dtype=float), (len(names),)).reshape(-1, 1)
     if not np.all(np.isfinite(g)):
         raise Rt70Error("the filter-to-plant gain contains NaN or infinite values")
-    Bp = p.B[:, [p.inputs.index(n) for n in names]] @ g  # n_p × 1
-    Dp = p.D[:, [p.inputs.index(n) for n in names]] @ g  # p_p × 1
+    Bp = p.B[:, [p.input_names.index(n) for n in names]] @ g  # n_p × 1
+    Dp = p.D[:, [p.input_names.index(n) for n in names]] @ g  # p_p × 1
     nf, np_ = f.A.shape[0], p.A.shape[0]
     A = np.block([[f.A, np.zeros((nf, np_))], [Bp @ f.C, p.A]])
     B = np.vstack([f.B, Bp @ f.D])
@@ -256,9 +247,9 @@ def cascade_with_filter(
         B,
         C,
         D,
-        states=[f"filter.{s}" for s in f.states] + [f"plant.{s}" for s in p.states],
-        inputs=list(f.inputs),
-        outputs=list(p.outputs),
+        states=[f"filter.{s}" for s in f.state_names] + [f"plant.{s}" for s in p.state_names],
+        inputs=list(f.input_names),
+        outputs=list(p.output_names),
     )
 
 
@@ -365,7 +356,7 @@ def mode_contributions(
         terms += np.real(c * (Pz @ c.conj()))
     total = float(np.sum(terms))
     if not rows or total <= 0.0:
-        names = ", ".join(s.outputs[r] for r in rows) or "none"
+        names = ", ".join(s.output_names[r] for r in rows) or "none"
         raise Rt70Error(f"output(s) {names} have zero variance: nothing to split")
     shares = []
     for group in _pairs(eigenvalues):
