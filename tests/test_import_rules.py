@@ -41,6 +41,7 @@ SHARED = (
     "rt70.loads",
     "rt70.constraints",
     "rt70.wind",
+    "rt70.kkt",
 )
 
 #: layer (module prefix) → module prefixes it may import from rt70.
@@ -59,6 +60,7 @@ RULES = {
     "rt70.bondgraph": ("rt70.bondgraph", *SHARED),
     "rt70.loads": ("rt70.arrays", "rt70.errors"),
     "rt70.wind": ("rt70.errors", "rt70.loads"),
+    "rt70.kkt": ("rt70.errors",),
 }
 
 
@@ -236,6 +238,7 @@ GENERIC = (
     "rt70.wind",
     "rt70.wind_load",
     "rt70.constraints",
+    "rt70.kkt",
     "rt70.bondgraph",
     "rt70.drives",
     "rt70.servo",
