@@ -107,7 +107,7 @@ def _modes(args: argparse.Namespace) -> int:
     import numpy as np
 
     from rt70.linear import linearize as lin
-    from rt70.linear import modal
+    from rt70.linear import modal, mode_table
     from rt70.scene import load_scene
     from rt70.textbook.massless import require_diagonal
 
@@ -125,34 +125,8 @@ def _modes(args: argparse.Namespace) -> int:
     require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
     result = modal.modes(model.M, model.K, model.D)
     damped = modal.damped_modes(model.M, model.K, model.D)
-    rows = []
-    energy = result.shapes * (model.M @ result.shapes)  # kinetic-energy share per coordinate
-    for i in range(len(result.freq_hz)):
-        unstable = bool(result.negative[i])
-        zeta = None if np.isnan(result.zeta[i]) else float(result.zeta[i])
-        kind = "unstable" if unstable else "rigid" if result.rigid[i] else "elastic"
-        if kind == "elastic" and zeta is not None and zeta >= 1.0:
-            kind = "overdamped"  # ζ ≥ 1: it creeps back, it does not ring
-        rows.append(
-            {
-                "mode": i + 1,
-                "freq_hz": None if unstable else float(result.freq_hz[i]),
-                "kind": kind,
-                # an unstable mode diverges as exp(λt), λ = √(−ω²)
-                "divergence_rate": float(np.sqrt(-result.omega2[i])) if unstable else None,
-                "zeta": zeta,
-                "dominant": model.coordinates[int(np.argmax(np.abs(energy[:, i])))],
-                "shape": dict(zip(model.coordinates, result.shapes[:, i].tolist(), strict=True)),
-            }
-        )
-    damped_summary = {
-        "oscillatory": [
-            {"freq_hz": float(f), "zeta": float(z)}
-            for f, z in zip(damped.frequencies_hz, damped.zeta, strict=True)
-        ],
-        "real_eigenvalues": damped.real.tolist(),
-        "proportional": bool(result.proportional),
-    }
+    rows = mode_table.mode_rows(result, result.shapes, model.M, model.coordinates)
+    damped_summary = mode_table.damped_summary(result, damped)
     if args.json:
         out = {
             "scene": scene.name,

@@ -1,0 +1,238 @@
+"""Modes of a URDF scene closed by loop constraints: the wiring of :mod:`rt70.linear.constrained`.
+
+A scene with closed chains (``<rt70:loop>``, docs/loops.md) is its tree plus the
+closure Φ(q) = 0. Each side computes the closure with its own kinematics:
+``loop_residual(model, data, q) → Φ`` and ``loop_jacobian(model, data, q) → B_c`` in
+``rt70/textbook/loops.py`` and ``rt70/reference/loops.py``. This module takes those two
+functions **as arguments** (any pair with that signature: a hand-written closure of an
+existing scene serves as well) and gives what ``rt70 modes`` gives for a tree:
+
+1. the static equilibrium on the manifold (:func:`rt70.linear.constrained.equilibrium`),
+   with the held coordinates (the RT-70's pointing) added as the linear constraints
+   ``q_h = value`` — their multipliers are the torques that hold them, as the drives'
+   are in :func:`rt70.linear.linearize.equilibrium`;
+2. the full-coordinate M, K and D of :mod:`rt70.linear.linearize` at that state
+   (K differenced from ``side``'s static force, M from ``side``, D the textbook's), the
+   locked-rotor stiffness of the scene's drives added as ``rt70 modes`` does, the held
+   coordinates locked instead when ``lock_held``;
+3. the reduced model on the manifold (null space with the multipliers' geometric
+   stiffness, or a coordinate partition) and its modes, shapes in the full coordinates;
+4. the rows of ``rt70 modes --json`` (:mod:`rt70.linear.mode_table`).
+
+docs/constrained-modes.md; tests/test_constrained_scene.py.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.linear import constrained as cm
+from rt70.linear import linearize as lin
+from rt70.linear import modal, mode_table
+from rt70.scene import Scene
+from rt70.textbook import dynamics
+
+#: A side's loop function: ``(model, data, q) → Φ`` or ``→ B_c``.
+LoopFunction = Callable[[Any, Any, np.ndarray], np.ndarray]
+
+#: How the reduced model is formed (:func:`rt70.linear.constrained.linearize` or
+#: :func:`~rt70.linear.constrained.partition_linearize`).
+METHODS = ("null-space", "partition")
+
+
+def _side(scene: Scene, side: str) -> tuple[Any, Any]:
+    if side not in lin.SIDES:
+        raise Rt70Error(f"unknown side {side!r} (choose from {', '.join(lin.SIDES)})")
+    if side == "textbook":
+        return scene.textbook, scene.textbook_data
+    return scene.reference, scene.reference_data
+
+
+def scene_constraints(
+    scene: Scene, loop_residual: LoopFunction, loop_jacobian: LoopFunction, side: str = "textbook"
+) -> cm.Constraints:
+    """The scene's loop closures on ``side`` as :class:`~rt70.linear.constrained.Constraints`."""
+    model, data = _side(scene, side)
+    return cm.Constraints(
+        residual=lambda q: loop_residual(model, data, q),
+        jacobian=lambda q: loop_jacobian(model, data, q),
+    )
+
+
+def _static_force(scene: Scene, side: str) -> cm.Vector:
+    if side == "textbook":
+        return lambda q: lin.static_force(scene, q)
+    return lambda q: lin.reference_static_force(scene, q)
+
+
+def _mass_matrix(scene: Scene, side: str, q: np.ndarray) -> np.ndarray:
+    if side == "textbook":
+        return dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)
+    from rt70.reference import dynamics as ref_dynamics
+
+    return ref_dynamics.mass_matrix(scene.reference, scene.reference_data, q)
+
+
+@dataclass(frozen=True)
+class SceneConstrainedModel:
+    """The linear model of a closed-chain scene about its equilibrium on the manifold.
+
+    Attributes
+    ----------
+    scene : str
+        Scene name.
+    coordinates : list of str
+        The full (tree) coordinates the shapes are given in.
+    equilibrium : rt70.linear.constrained.Equilibrium
+        q*, the multipliers (the loop rows first, then the held coordinates').
+    M, K, D : ndarray, shape (n, n)
+        Full-coordinate mass, stiffness (with the locked rotor's) and damping at q*.
+    reduced : rt70.linear.constrained.ConstrainedLinearization
+        The model on the manifold.
+    loop_rows : int
+        Number of loop-closure rows (the first rows of the multipliers).
+    held : dict
+        Coordinates held at given values while the equilibrium was solved.
+    lock_held : bool
+        The held coordinates are constraints of the linear model too.
+    locked_rotor : bool
+        The scene's drives hold their axes through their reducers (rt70 modes' default).
+    """
+
+    scene: str
+    coordinates: list[str]
+    equilibrium: cm.Equilibrium
+    M: np.ndarray
+    K: np.ndarray
+    D: np.ndarray
+    reduced: cm.ConstrainedLinearization
+    loop_rows: int
+    held: dict = field(default_factory=dict)
+    lock_held: bool = False
+    locked_rotor: bool = False
+
+
+def constrained_linearize(
+    scene: Scene,
+    loop_residual: LoopFunction,
+    loop_jacobian: LoopFunction,
+    held: dict[str, float] | None = None,
+    lock_held: bool = False,
+    side: str = "textbook",
+    method: str = "null-space",
+    q_start: np.ndarray | None = None,
+) -> SceneConstrainedModel:
+    """Equilibrium on the manifold and the reduced linear model of a closed-chain scene.
+
+    Parameters
+    ----------
+    scene : Scene
+        The tree.
+    loop_residual, loop_jacobian : callable
+        ``(model, data, q) → Φ`` and ``→ B_c`` of ``side`` (the loops of the scene).
+    held : dict, optional
+        ``{coordinate: value}`` held during the equilibrium (the RT-70's pointing).
+    lock_held : bool
+        Keep the held coordinates as constraints of the linear model (``--lock-axes``);
+        otherwise they are free, and the scene's drives, if any, hold them through their
+        reducers (:func:`rt70.linear.linearize.locked_rotor`), as ``rt70 modes`` does.
+    side : str
+        ``"textbook"`` or ``"reference"``: whose loop functions, static force and mass
+        matrix (D is the textbook's on both).
+    method : str
+        ``"null-space"`` (with the geometric stiffness) or ``"partition"``.
+    q_start : array_like, optional
+        Start of Newton (default zeros, the held values set).
+
+    Raises
+    ------
+    Rt70Error
+        On an unknown side, method or coordinate, no equilibrium, or no motion left.
+    """
+    if method not in METHODS:
+        raise Rt70Error(f"unknown method {method!r} (choose from {', '.join(METHODS)})")
+    model, _ = _side(scene, side)
+    names = list(scene.textbook.coordinate_names)
+    n = len(names)
+    held = dict(held or {})
+    hold_idx = lin.coordinate_indices(scene, list(held))
+    loops = scene_constraints(scene, loop_residual, loop_jacobian, side)
+    hold = cm.fixed(n, hold_idx, list(held.values()))
+    q = np.zeros(n) if q_start is None else np.array(q_start, dtype=float)
+    q[hold_idx] = list(held.values())
+    force = _static_force(scene, side)
+    K_of = lambda x: lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
+    try:
+        eq = cm.equilibrium(force, cm.combine(loops, hold) if held else loops, q, stiffness=K_of)
+    except Rt70Error as exc:
+        raise Rt70Error(f"{scene.name}: {exc}") from None
+    m_loop = np.atleast_1d(loops.residual(eq.q)).size
+    K0 = K_of(eq.q)
+    full = lin.Linearization(
+        scene=scene.name,
+        q0=eq.q,
+        coordinates=names,
+        M=_mass_matrix(scene, side, eq.q),
+        K=K0,
+        D=lin.damping_matrix(scene, eq.q),
+        K_gravity=np.full((n, n), np.nan),  # not formed: only M, K and D are used
+    )
+    drives = bool(scene.description.drives) and not lock_held
+    if drives:
+        full = lin.locked_rotor(scene, full)
+    constraints, lam = loops, eq.lam[:m_loop]
+    if lock_held and held:
+        constraints, lam = cm.combine(loops, hold), eq.lam
+    try:
+        if method == "null-space":
+            reduced = cm.linearize(constraints, eq.q, lam, full.M, full.K, full.D)
+        else:
+            extra = full.K - K0  # the locked rotor's springs about q*
+            with_rotor = lambda x: force(x) - extra @ (x - eq.q)  # noqa: E731
+            reduced = cm.partition_linearize(with_rotor, constraints, eq.q, full.M, full.D)
+    except Rt70Error as exc:
+        raise Rt70Error(f"{scene.name}: {exc}") from None
+    return SceneConstrainedModel(
+        scene=scene.name,
+        coordinates=names,
+        equilibrium=eq,
+        M=full.M,
+        K=full.K,
+        D=full.D,
+        reduced=reduced,
+        loop_rows=m_loop,
+        held=held,
+        lock_held=lock_held,
+        locked_rotor=drives,
+    )
+
+
+def constrained_modes(model: SceneConstrainedModel) -> dict:
+    """The modes of a closed-chain scene in the form ``rt70 modes --json`` prints.
+
+    The keys of ``rt70 modes --json`` (``scene``, ``held``, ``locked_rotor``, ``modes``,
+    ``damped``) and ``constraints``: the loop rows, their rank at q* (with the held
+    coordinates when locked) and the loop multipliers. The mode shapes are in the full
+    tree coordinates (``N φ``) and the dominant coordinate is chosen by kinetic energy in
+    them; the damped system is the reduced one.
+    """
+    red = model.reduced
+    spectrum = cm.modes(red)
+    damped = modal.damped_modes(red.M_r, red.K_r, red.D_r)
+    return {
+        "scene": model.scene,
+        "held": model.held,
+        "locked_rotor": model.locked_rotor,
+        "constraints": {
+            "loop_rows": model.loop_rows,
+            "rank": red.rank,
+            "multipliers": model.equilibrium.lam[: model.loop_rows].tolist(),
+        },
+        "modes": mode_table.mode_rows(spectrum.modes, spectrum.shapes, model.M, model.coordinates),
+        "damped": mode_table.damped_summary(spectrum.modes, damped),
+    }

@@ -1,0 +1,150 @@
+"""The closed-chain wiring (rt70.linear.constrained_scene) on scenes closed by hand.
+
+The loop functions of ``<rt70:loop>`` are not needed to test the wiring: any
+``(model, data, q) → Φ`` / ``→ B_c`` pair of a side serves. Here:
+
+- no closure at all: the RT-70 servo scene must give exactly what ``rt70 modes`` gives;
+- a linear closure (a coordinate fixed) must give ``linearize``'s locked model;
+- a nonlinear closure of the double pendulum (its tip on a vertical line, a one-DOF
+  closed chain) written with each side's own point kinematics: the two sides and the
+  two reductions (null space, coordinate partition) must agree.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from rt70.cli import main
+from rt70.errors import Rt70Error
+from rt70.linear import constrained_scene as cs
+from rt70.linear import linearize as lin
+from rt70.linear import modal
+from rt70.reference import points as ref_points
+from rt70.scene import load_scene
+from rt70.textbook import points as tb_points
+
+TIP = ("link2", np.array([1.0, 0.0, 0.0]))
+LINE_X = 1.2  # the vertical line x = 1.2 m the tip slides on
+
+
+def _tip_on_line(points):
+    def residual(model, data, q):
+        return np.array([points.point_position(model, data, q, *TIP)[0] - LINE_X])
+
+    def jacobian(model, data, q):
+        return points.point_jacobian(model, data, q, *TIP)[0][:1]
+
+    return residual, jacobian
+
+
+def _no_loop(model, data, q):
+    return np.zeros(0)
+
+
+def _no_loop_jacobian(model, data, q):
+    return np.zeros((0, q.size))
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["rt70_servo"], ["rt70", "--elevation", "30", "--lock-axes"]],
+    ids=["servo-locked-rotor", "rt70-axes-locked"],
+)
+def test_without_loops_it_is_rt70_modes(capsys, argv):
+    """An empty closure: the equilibrium with the axes held, and the spectrum with the
+    drives' locked rotors (rt70_servo) or with the axes locked (rt70 --lock-axes)."""
+    assert main(["modes", *argv, "--json"]) == 0
+    want = json.loads(capsys.readouterr().out)
+    scene = load_scene(argv[0])
+    lock = "--lock-axes" in argv
+    model = cs.constrained_linearize(
+        scene, _no_loop, _no_loop_jacobian, held=want["held"], lock_held=lock
+    )
+    got = cs.constrained_modes(model)
+    assert got["locked_rotor"] == want["locked_rotor"] == (not lock)
+    assert got["constraints"]["loop_rows"] == 0
+    assert got["constraints"]["rank"] == (2 if lock else 0)
+    f_want = np.array([r["freq_hz"] for r in want["modes"]])
+    f_got = np.array([r["freq_hz"] for r in got["modes"]])
+    np.testing.assert_allclose(f_got, f_want, rtol=1e-8)
+    assert [r["dominant"] for r in got["modes"]] == [r["dominant"] for r in want["modes"]]
+    z_want = np.array([r["zeta"] for r in want["modes"]])
+    np.testing.assert_allclose([r["zeta"] for r in got["modes"]], z_want, rtol=1e-7)
+    if lock:  # the locked axes do not move in the full-coordinate shapes
+        assert all(abs(r["shape"][name]) < 1e-14 for r in got["modes"] for name in want["held"])
+
+
+def test_a_fixed_coordinate_is_the_locked_model():
+    scene = load_scene("double_pendulum")
+    model, data = scene.textbook, scene.textbook_data
+
+    def residual(model_, data_, q):
+        return np.array([q[0] - 0.3])
+
+    def jacobian(model_, data_, q):
+        return np.array([[1.0, 0.0]])
+
+    start = np.array([0.2, -1.5])
+    got = cs.constrained_linearize(scene, residual, jacobian, q_start=start)
+    q0 = lin.equilibrium(scene, held={"joint1": 0.3}, q_start=start, tol=1e-13)
+    assert q0[1] == pytest.approx(-np.pi / 2 - 0.3, abs=1e-10)  # link 2 hangs
+    np.testing.assert_allclose(got.equilibrium.q, q0, atol=1e-10)
+    locked = lin.linearize(scene, q0, locked=("joint1",))
+    want = modal.modes(locked.M, locked.K)
+    res = cs.constrained_modes(got)
+    np.testing.assert_allclose([r["freq_hz"] for r in res["modes"]], want.freq_hz, rtol=1e-8)
+    assert res["modes"][0]["shape"]["joint1"] == 0.0
+    np.testing.assert_allclose(res["modes"][0]["shape"]["joint2"], want.shapes[0, 0], rtol=1e-8)
+    # its multiplier is the torque that holds joint1: minus gravity's moment about it
+    Qg = lin.static_force(scene, q0)
+    np.testing.assert_allclose(got.equilibrium.lam, [-Qg[0]], rtol=1e-8)
+    assert model.nv == 2 and data is scene.textbook_data
+
+
+@pytest.fixture(scope="module")
+def tip_models():
+    scene = load_scene("double_pendulum")
+    start = np.array([-0.3, -0.6])
+    out = {}
+    for side, points in (("textbook", tb_points), ("reference", ref_points)):
+        for method in cs.METHODS:
+            out[side, method] = cs.constrained_linearize(
+                scene, *_tip_on_line(points), side=side, method=method, q_start=start
+            )
+    return out
+
+
+def test_tip_on_a_line_both_sides_both_reductions(tip_models):
+    base = tip_models["textbook", "null-space"]
+    q = base.equilibrium.q
+    # on the line, and the gravity not balanced by the line is zero along the manifold
+    assert np.cos(q[0]) + np.cos(q[0] + q[1]) == pytest.approx(LINE_X, abs=1e-12)
+    w = cs.constrained_modes(base)["modes"][0]
+    assert w["kind"] == "elastic"
+    for key, other in tip_models.items():
+        np.testing.assert_allclose(other.equilibrium.q, q, atol=1e-10, err_msg=str(key))
+        row = cs.constrained_modes(other)["modes"][0]
+        assert row["freq_hz"] == pytest.approx(w["freq_hz"], rel=1e-8), key
+        np.testing.assert_allclose(
+            list(row["shape"].values()), list(w["shape"].values()), atol=1e-8
+        )
+
+
+def test_tip_on_a_line_needs_its_geometric_stiffness(tip_models):
+    """The line's reaction (horizontal) times the tip path's curvature is part of K_r."""
+    base = tip_models["textbook", "null-space"]
+    red = base.reduced
+    assert abs(red.K_geometric[0, 0]) > 0.05 * abs(red.K_r[0, 0])
+
+
+def test_bad_side_and_method_are_refused():
+    scene = load_scene("double_pendulum")
+    with pytest.raises(Rt70Error, match="unknown side"):
+        cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, side="pinocchio")
+    with pytest.raises(Rt70Error, match="unknown method"):
+        cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, method="qr")
+    with pytest.raises(Rt70Error, match="double_pendulum: no coordinate"):
+        cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, held={"elevation": 1.0})
