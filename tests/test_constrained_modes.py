@@ -301,10 +301,15 @@ def test_a_free_direction_has_no_equilibrium():
         cm.equilibrium(lambda q: np.zeros(2), con, np.array([0.4, -1.0]))
 
 
-def test_a_wrong_jacobian_shape_is_refused():
+def test_wrong_shapes_are_refused():
     con = cm.Constraints(lambda q: np.zeros(1), lambda q: np.zeros((1, 3)))
     with pytest.raises(Rt70Error, match="3 columns, q has 2"):
         cm.equilibrium(lambda q: np.zeros(2), con, np.zeros(2))
+    con, _, M = particle()
+    with pytest.raises(Rt70Error, match="force has shape"):
+        cm.equilibrium(lambda q: np.zeros(3), con, np.array([0.4, -1.0]))
+    with pytest.raises(Rt70Error, match="M must be 2 × 2"):
+        cm.linearize(con, np.array([0.0, -1.5]), np.ones(1), np.eye(3), np.zeros((2, 2)))
 
 
 # ---------------------------------------------------------------------------- the report

@@ -112,7 +112,7 @@ def tip_models():
     for side, points in (("textbook", tb_points), ("reference", ref_points)):
         for method in cs.METHODS:
             out[side, method] = cs.constrained_linearize(
-                scene, *_tip_on_line(points), side=side, method=method, q_start=start
+                scene, *_tip_on_line(points), side=side, method=method, q_start=start, tol=1e-12
             )
     return out
 
@@ -133,6 +133,48 @@ def test_tip_on_a_line_both_sides_both_reductions(tip_models):
         )
 
 
+def _minimal_tip_on_line(psi1):
+    """Closed form of the scene's closed chain in its link-1 angle ψ1 (unit rods, 1 kg).
+
+    The tip on x = LINE_X: ``cos ψ1 + cos ψ2 = LINE_X``, link 2 pointing down (ψ2 < 0).
+    Returns (V, the centres of mass and angles (p1, p2, ψ1, ψ2) as one vector).
+    """
+    psi2 = -np.arccos(LINE_X - np.cos(psi1))
+    p1 = 0.5 * np.array([np.cos(psi1), np.sin(psi1)])
+    p2 = 2 * p1 + 0.5 * np.array([np.cos(psi2), np.sin(psi2)])
+    return 9.81 * (p1[1] + p2[1]), np.array([*p1, *p2, psi1, psi2])
+
+
+def _closed_form_frequency(psi1: float) -> tuple[float, float]:
+    """(V'(ψ1), f = √(V''/m_r)/2π) by five-point differences of the closed form.
+
+    The stencils' error is O(h⁴ V⁽⁵⁾): the closed form's arccos is singular 0.21 rad from
+    the equilibrium, so V' takes h = 2.5e-4 (truncation ≈ 3e-12, rounding ≈ 1e-11);
+    V'' takes h = 1e-3 (its rounding grows as ε V/h²).
+    """
+
+    def d(f, x, k, h=1e-3):  # five-point first (k=1) and second (k=2) derivatives
+        v = [f(x + j * h) for j in (-2, -1, 0, 1, 2)]
+        if k == 1:
+            return (v[0] - 8 * v[1] + 8 * v[3] - v[4]) / (12 * h)
+        return (-v[0] + 16 * v[1] - 30 * v[2] + 16 * v[3] - v[4]) / (12 * h * h)
+
+    V = lambda x: _minimal_tip_on_line(x)[0]  # noqa: E731
+    rate = d(lambda x: _minimal_tip_on_line(x)[1], psi1, 1)
+    m_r = rate[:2] @ rate[:2] + rate[2:4] @ rate[2:4] + (rate[4] ** 2 + rate[5] ** 2) / 12
+    return d(V, psi1, 1, 2.5e-4), np.sqrt(d(V, psi1, 2) / m_r) / (2 * np.pi)
+
+
+def test_tip_on_a_line_against_its_closed_form(tip_models):
+    """ω² = V''/m_r at the scene's equilibrium, from the closed form (no rt70 code): V' = 0
+    there and the frequency agrees to the differences' error."""
+    q = tip_models["textbook", "null-space"].equilibrium.q
+    slope, f = _closed_form_frequency(q[0])
+    assert abs(slope) < 1e-10  # the scene's equilibrium is V's stationary point
+    for key, model in tip_models.items():
+        assert cs.constrained_modes(model)["modes"][0]["freq_hz"] == pytest.approx(f, rel=1e-8), key
+
+
 def test_tip_on_a_line_needs_its_geometric_stiffness(tip_models):
     """The line's reaction (horizontal) times the tip path's curvature is part of K_r."""
     base = tip_models["textbook", "null-space"]
@@ -148,3 +190,32 @@ def test_bad_side_and_method_are_refused():
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, method="qr")
     with pytest.raises(Rt70Error, match="double_pendulum: no coordinate"):
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, held={"elevation": 1.0})
+
+
+if __name__ == "__main__":  # python tests/test_constrained_scene.py: the numbers in the docs
+    scene = load_scene("double_pendulum")
+    start = np.array([-0.3, -0.6])
+    base = None
+    for side, points in (("textbook", tb_points), ("reference", ref_points)):
+        for method in cs.METHODS:
+            m = cs.constrained_linearize(
+                scene, *_tip_on_line(points), side=side, method=method, q_start=start, tol=1e-12
+            )
+            row = cs.constrained_modes(m)["modes"][0]
+            if base is None:
+                slope, f_closed = _closed_form_frequency(m.equilibrium.q[0])
+                print(f"closed form at q*: V' = {slope:.1e} N·m, f = {f_closed:.12g} Hz")
+                base = (m.equilibrium.q, f_closed)
+            print(
+                f"tip on x = {LINE_X}: {side:<9} {method:<10} q* = {m.equilibrium.q}, "
+                f"λ = {m.equilibrium.lam[0]:.10g} N, f = {row['freq_hz']:.12g} Hz "
+                f"(Δq* {np.abs(m.equilibrium.q - base[0]).max():.1e}, "
+                f"f/f_closed − 1 = {row['freq_hz'] / base[1] - 1:.1e})"
+            )
+            if method == "null-space":
+                red = m.reduced
+                naive = np.sqrt((red.K_r - red.K_geometric)[0, 0] / red.M_r[0, 0]) / (2 * np.pi)
+                print(
+                    f"  K_r = {red.K_r[0, 0]:.6g}, of it G: {red.K_geometric[0, 0]:.6g}; "
+                    f"without G f = {naive:.6g} Hz"
+                )

@@ -267,10 +267,10 @@ def equilibrium(
     """
     q = np.array(q_start, dtype=float)
     K_of = stiffness or (lambda x: force_stiffness(force, x, h))
-    f_scale = max(float(np.max(np.abs(force(q)), initial=0.0)), 1.0)
+    f_scale = max(_max(_force(force, q)), 1.0)
 
     def state(q: np.ndarray):
-        Q = np.asarray(force(q), dtype=float)
+        Q = _force(force, q)
         phi, B = constraints.evaluate(q)
         sub = subspaces(B)
         lam = sub.multipliers(Q)
@@ -306,6 +306,16 @@ def equilibrium(
         f"equilibrium on the constraint manifold not found in {max_iter} Newton steps "
         f"(force left {f_left:.3g}, constraint residual {c_left:.3g})"
     )
+
+
+def _force(force: Vector, q: np.ndarray) -> np.ndarray:
+    """``force(q)`` as a finite float vector of q's length, or a clear error."""
+    Q = np.asarray(force(q), dtype=float)
+    if Q.shape != q.shape:
+        raise Rt70Error(f"the force has shape {Q.shape}, q has {q.shape}")
+    if not np.isfinite(Q).all():
+        raise Rt70Error("the force is NaN or infinite")
+    return Q
 
 
 def _max(x: np.ndarray) -> float:
@@ -521,10 +531,10 @@ def partition_linearize(
         guess[part.independent] = z
         q = solve_dependent(constraints, part, guess)
         J = _partition_jacobian(constraints.evaluate(q)[1], part)
-        return J.T @ np.asarray(force(q), dtype=float)
+        return J.T @ _force(force, q)
 
     K_r = force_stiffness(reduced_force, q0[part.independent], h)
-    lam = subspaces(B).multipliers(np.asarray(force(q0), dtype=float))
+    lam = subspaces(B).multipliers(_force(force, q0))
     return ConstrainedLinearization(
         q0=q0,
         lam=lam,

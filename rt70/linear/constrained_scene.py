@@ -126,6 +126,7 @@ def constrained_linearize(
     side: str = "textbook",
     method: str = "null-space",
     q_start: np.ndarray | None = None,
+    tol: float = 1e-10,
 ) -> SceneConstrainedModel:
     """Equilibrium on the manifold and the reduced linear model of a closed-chain scene.
 
@@ -148,6 +149,8 @@ def constrained_linearize(
         ``"null-space"`` (with the geometric stiffness) or ``"partition"``.
     q_start : array_like, optional
         Start of Newton (default zeros, the held values set).
+    tol : float
+        Relative tolerance of the equilibrium (:func:`rt70.linear.constrained.equilibrium`).
 
     Raises
     ------
@@ -168,7 +171,8 @@ def constrained_linearize(
     force = _static_force(scene, side)
     K_of = lambda x: lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
     try:
-        eq = cm.equilibrium(force, cm.combine(loops, hold) if held else loops, q, stiffness=K_of)
+        both = cm.combine(loops, hold) if held else loops
+        eq = cm.equilibrium(force, both, q, stiffness=K_of, tol=tol)
     except Rt70Error as exc:
         raise Rt70Error(f"{scene.name}: {exc}") from None
     m_loop = np.atleast_1d(loops.residual(eq.q)).size
