@@ -28,6 +28,7 @@ def particle(m: float = 2.0, length: float = 1.5, scale: float = 1.0):
     con = cm.Constraints(
         residual=lambda q: np.array([scale * (q @ q - length**2)]),
         jacobian=lambda q: scale * 2.0 * q.reshape(1, 2),
+        bias=lambda q, qd: np.array([scale * 2.0 * qd @ qd]),
     )
     force = lambda q: np.array([0.0, -m * G])  # noqa: E731
     return con, force, m * np.eye(2)
@@ -198,7 +199,16 @@ def fourbar_full():
         o, _ = _chain(theta)
         return np.column_stack([_cross(o[3], o[k]) for k in range(3)])
 
-    return cm.Constraints(residual, jacobian), force, mass
+    def bias(theta, rate):
+        """Ḃ_c θ̇: the tip's acceleration at θ̈ = 0, −Σ L_i ψ̇_i² (cos ψ_i, sin ψ_i)."""
+        psi = np.cumsum(theta)
+        w = np.cumsum(rate)
+        return -sum(
+            L * wi**2 * np.array([np.cos(p), np.sin(p)])
+            for L, p, wi in zip(LENGTHS, psi, w, strict=True)
+        )
+
+    return cm.Constraints(residual, jacobian, bias), force, mass
 
 
 def _closed_form(phi):
@@ -281,6 +291,23 @@ def test_fourbar_modes_both_ways_against_the_minimal_model(fourbar):
     # without the multipliers' stiffness the frequency is wrong by far more than that
     naive = cm.modes(cm.linearize(con, eq.q, eq.lam, M, K, geometric=False))
     assert abs(naive.modes.omega2[0] / omega2 - 1) > 0.05
+
+
+def test_geometric_stiffness_exact_from_the_bias_and_by_differences(fourbar):
+    """G by polarisation of C = Ḃ_c q̇ (exact) and by differences of B_cᵀλ agree."""
+    con, force, mass, eq, phi, omega2, shape = fourbar
+    differenced = cm.Constraints(con.residual, con.jacobian)
+    G_exact = cm.geometric_stiffness(con, eq.q, eq.lam)
+    G_diff = cm.geometric_stiffness(differenced, eq.q, eq.lam)
+    assert np.abs(G_exact).max() > 1.0  # the loop's reactions are tens of newtons
+    np.testing.assert_allclose(G_diff, G_exact, atol=1e-8 * np.abs(G_exact).max())
+    M, K = mass(eq.q), cm.force_stiffness(force, eq.q)
+    exact = cm.modes(cm.linearize(con, eq.q, eq.lam, M, K))
+    np.testing.assert_allclose(exact.modes.omega2, [omega2], rtol=1e-8)
+    # the bias's check of its shape
+    bad = cm.Constraints(con.residual, con.jacobian, lambda q, qd: np.zeros(3))
+    with pytest.raises(Rt70Error, match="bias has shape"):
+        cm.geometric_stiffness(bad, eq.q, eq.lam)
 
 
 # ------------------------------------------------------------------------------ refusals

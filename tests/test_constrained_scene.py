@@ -182,6 +182,24 @@ def test_tip_on_a_line_needs_its_geometric_stiffness(tip_models):
     assert abs(red.K_geometric[0, 0]) > 0.05 * abs(red.K_r[0, 0])
 
 
+def test_tip_on_a_line_with_its_bias_is_exact(tip_models):
+    """C = Ḃ_c q̇ of the line, written by hand: ẍ_tip at q̈ = 0 is −Σ cos ψ_i ψ̇_i²."""
+
+    def bias(model, data, q, qd):
+        psi, w = np.cumsum(q), np.cumsum(qd)
+        return np.array([-(np.cos(psi) @ w**2)])
+
+    scene = load_scene("double_pendulum")
+    exact = cs.constrained_linearize(
+        scene, *_tip_on_line(tb_points), q_start=np.array([-0.3, -0.6]), tol=1e-12, loop_bias=bias
+    )
+    base = tip_models["textbook", "null-space"]
+    G, G_diff = exact.reduced.K_geometric, base.reduced.K_geometric
+    np.testing.assert_allclose(G, G_diff, rtol=1e-8)
+    f = cs.constrained_modes(exact)["modes"][0]["freq_hz"]
+    assert f == pytest.approx(cs.constrained_modes(base)["modes"][0]["freq_hz"], rel=1e-9)
+
+
 def test_bad_side_and_method_are_refused():
     scene = load_scene("double_pendulum")
     with pytest.raises(Rt70Error, match="unknown side"):

@@ -65,7 +65,7 @@ STEP_TOL = 1e-13
 
 @dataclass(frozen=True)
 class Constraints:
-    """Holonomic constraints Φ(q) = 0 as two callables of q.
+    """Holonomic constraints Φ(q) = 0 as callables of q.
 
     Attributes
     ----------
@@ -73,10 +73,16 @@ class Constraints:
         ``Φ(q)``, shape (m,).
     jacobian : callable
         ``B_c(q) = ∂Φ/∂q``, shape (m, n) (``B_c q̇ = Φ̇``).
+    bias : callable, optional
+        ``C(q, q̇) = Ḃ_c q̇`` (``B_c q̈ + C = 0``, source 004 (14)), shape (m,). For
+        holonomic Φ its row i is the quadratic form ``q̇ᵀ ∇²Φ_i q̇``, so it gives the
+        geometric stiffness exactly (:func:`geometric_stiffness`); without it G is
+        differenced from the Jacobian.
     """
 
     residual: Vector
     jacobian: Vector
+    bias: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
     def evaluate(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(Φ(q), B_c(q))`` as float arrays of shapes (m,) and (m, n), checked."""
@@ -99,7 +105,11 @@ def combine(*parts: Constraints) -> Constraints:
     def jacobian(q: np.ndarray) -> np.ndarray:
         return np.vstack([np.atleast_2d(p.jacobian(q)) for p in parts])
 
-    return Constraints(residual, jacobian)
+    def bias(q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        return np.concatenate([np.atleast_1d(p.bias(q, qd)) for p in parts])
+
+    exact = all(p.bias is not None for p in parts)
+    return Constraints(residual, jacobian, bias if exact else None)
 
 
 def fixed(n: int, indices: Sequence[int], values: Sequence[float]) -> Constraints:
@@ -111,7 +121,7 @@ def fixed(n: int, indices: Sequence[int], values: Sequence[float]) -> Constraint
     idx = np.asarray(indices, dtype=int)
     val = np.asarray(values, dtype=float)
     E = np.eye(n)[idx]
-    return Constraints(lambda q: np.asarray(q)[idx] - val, lambda q: E)
+    return Constraints(lambda q: np.asarray(q)[idx] - val, lambda q: E, lambda q, qd: 0.0 * val)
 
 
 # ------------------------------------------------------------------------ linear algebra
@@ -176,16 +186,35 @@ def force_stiffness(force: Vector, q: np.ndarray, h: float = FD_STEP) -> np.ndar
 def geometric_stiffness(
     constraints: Constraints, q: np.ndarray, lam: np.ndarray, h: float = FD_STEP
 ) -> np.ndarray:
-    """``G = −∂(B_c(q)ᵀ λ)/∂q = −Σ λ_i ∇²Φ_i`` at fixed λ, by central differences.
+    """``G = −∂(B_c(q)ᵀ λ)/∂q = −Σ λ_i ∇²Φ_i`` at fixed λ.
 
     The stiffness the reactions add when the constraint surface is curved: with the
     reactions ``+B_cᵀ λ`` on the right-hand side, ``K + G`` is the stiffness along the
-    manifold. Differenced from the Jacobian (its rows' gradients, ∇²Φ_i, are symmetric:
-    the result is symmetrised).
+    manifold. With the constraints' ``bias`` it is exact, by polarisation of the
+    quadratic form ``λᵀ C(q, u) = uᵀ (Σ λ_i ∇²Φ_i) u``:
+    ``G_jj = −λᵀ C(e_j)``, ``G_jk = −½ λᵀ (C(e_j + e_k) − C(e_j) − C(e_k))``
+    (n(n+1)/2 calls). Without it, central differences of ``B_cᵀ λ`` with step h per
+    coordinate (2n calls), symmetrised (the ∇²Φ_i are symmetric).
     """
     q = np.asarray(q, dtype=float)
     lam = np.asarray(lam, dtype=float)
-    return force_stiffness(lambda x: constraints.evaluate(x)[1].T @ lam, q, h)
+    if constraints.bias is None:
+        return force_stiffness(lambda x: constraints.evaluate(x)[1].T @ lam, q, h)
+    n = q.size
+    eye = np.eye(n)
+
+    def form(u: np.ndarray) -> float:
+        C = np.atleast_1d(np.asarray(constraints.bias(q, u), dtype=float))
+        if C.shape != lam.shape:
+            raise Rt70Error(f"constraint bias has shape {C.shape}, the multipliers {lam.shape}")
+        return float(lam @ C)
+
+    diag = np.array([form(eye[j]) for j in range(n)])
+    H = np.diag(diag)
+    for j in range(n):
+        for k in range(j + 1, n):
+            H[j, k] = H[k, j] = 0.5 * (form(eye[j] + eye[k]) - diag[j] - diag[k])
+    return -H
 
 
 # ---------------------------------------------------------------------------- equilibrium

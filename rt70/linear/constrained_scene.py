@@ -39,6 +39,8 @@ from rt70.textbook import dynamics
 
 #: A side's loop function: ``(model, data, q) → Φ`` or ``→ B_c``.
 LoopFunction = Callable[[Any, Any, np.ndarray], np.ndarray]
+#: A side's loop bias: ``(model, data, q, q̇) → C`` with ``B_c q̈ + C = 0``.
+BiasFunction = Callable[[Any, Any, np.ndarray, np.ndarray], np.ndarray]
 
 #: How the reduced model is formed (:func:`rt70.linear.constrained.linearize` or
 #: :func:`~rt70.linear.constrained.partition_linearize`).
@@ -54,13 +56,23 @@ def _side(scene: Scene, side: str) -> tuple[Any, Any]:
 
 
 def scene_constraints(
-    scene: Scene, loop_residual: LoopFunction, loop_jacobian: LoopFunction, side: str = "textbook"
+    scene: Scene,
+    loop_residual: LoopFunction,
+    loop_jacobian: LoopFunction,
+    side: str = "textbook",
+    loop_bias: BiasFunction | None = None,
 ) -> cm.Constraints:
-    """The scene's loop closures on ``side`` as :class:`~rt70.linear.constrained.Constraints`."""
+    """The scene's loop closures on ``side`` as :class:`~rt70.linear.constrained.Constraints`.
+
+    With ``loop_bias`` (``(model, data, q, q̇) → C``, ``B_c q̈ + C = 0``) the geometric
+    stiffness is formed exactly from it; without, by differences of the Jacobian.
+    """
     model, data = _side(scene, side)
+    bias = None if loop_bias is None else (lambda q, qd: loop_bias(model, data, q, qd))
     return cm.Constraints(
         residual=lambda q: loop_residual(model, data, q),
         jacobian=lambda q: loop_jacobian(model, data, q),
+        bias=bias,
     )
 
 
@@ -127,6 +139,7 @@ def constrained_linearize(
     method: str = "null-space",
     q_start: np.ndarray | None = None,
     tol: float = 1e-10,
+    loop_bias: BiasFunction | None = None,
 ) -> SceneConstrainedModel:
     """Equilibrium on the manifold and the reduced linear model of a closed-chain scene.
 
@@ -151,6 +164,9 @@ def constrained_linearize(
         Start of Newton (default zeros, the held values set).
     tol : float
         Relative tolerance of the equilibrium (:func:`rt70.linear.constrained.equilibrium`).
+    loop_bias : callable, optional
+        ``(model, data, q, q̇) → C`` of ``side``: the geometric stiffness exactly, in
+        n(n+1)/2 calls, instead of 2n differenced Jacobians.
 
     Raises
     ------
@@ -159,12 +175,11 @@ def constrained_linearize(
     """
     if method not in METHODS:
         raise Rt70Error(f"unknown method {method!r} (choose from {', '.join(METHODS)})")
-    model, _ = _side(scene, side)
     names = list(scene.textbook.coordinate_names)
     n = len(names)
     held = dict(held or {})
     hold_idx = lin.coordinate_indices(scene, list(held))
-    loops = scene_constraints(scene, loop_residual, loop_jacobian, side)
+    loops = scene_constraints(scene, loop_residual, loop_jacobian, side, loop_bias)
     hold = cm.fixed(n, hold_idx, list(held.values()))
     q = np.zeros(n) if q_start is None else np.array(q_start, dtype=float)
     q[hold_idx] = list(held.values())
