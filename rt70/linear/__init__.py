@@ -7,6 +7,10 @@
 - :mod:`rt70.linear.responses` — state space, frequency and step responses;
 - :mod:`rt70.linear.checks` — the input checks both share;
 - :mod:`rt70.linear.linearize` — equilibrium and M, K, D of a nonlinear URDF scene;
+- :mod:`rt70.linear.constrained` — equilibrium, linearisation (with the multipliers'
+  geometric stiffness) and modes on a constraint manifold Φ(q) = 0; wired to a scene's
+  closed chains by :mod:`rt70.linear.constrained_scene`, its rows by
+  :mod:`rt70.linear.mode_table` (docs/constrained-modes.md);
 - :mod:`rt70.linear.covariance` — stationary covariances under white noise (Lyapunov),
   shaping filters in series, the variance split over modes, the statistical error of a
   record's mean square.
