@@ -53,7 +53,8 @@ def _no_loop_jacobian(model, data, q):
     [["rt70_servo"], ["rt70", "--elevation", "30", "--lock-axes"]],
     ids=["servo-locked-rotor", "rt70-axes-locked"],
 )
-def test_without_loops_it_is_rt70_modes(capsys, argv):
+@pytest.mark.parametrize("method", cs.METHODS)
+def test_without_loops_it_is_rt70_modes(capsys, argv, method):
     """An empty closure: the equilibrium with the axes held, and the spectrum with the
     drives' locked rotors (rt70_servo) or with the axes locked (rt70 --lock-axes)."""
     assert main(["modes", *argv, "--json"]) == 0
@@ -61,7 +62,7 @@ def test_without_loops_it_is_rt70_modes(capsys, argv):
     scene = load_scene(argv[0])
     lock = "--lock-axes" in argv
     model = cs.constrained_linearize(
-        scene, _no_loop, _no_loop_jacobian, held=want["held"], lock_held=lock
+        scene, _no_loop, _no_loop_jacobian, held=want["held"], lock_held=lock, method=method
     )
     got = cs.constrained_modes(model)
     assert got["locked_rotor"] == want["locked_rotor"] == (not lock)
