@@ -238,3 +238,33 @@ if __name__ == "__main__":  # python tests/test_constrained_scene.py: the number
                     f"  K_r = {red.K_r[0, 0]:.6g}, of it G: {red.K_geometric[0, 0]:.6g}; "
                     f"without G f = {naive:.6g} Hz"
                 )
+    import contextlib
+    import io
+
+    for argv in (["rt70_servo"], ["rt70", "--elevation", "30", "--lock-axes"]):
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text):
+            main(["modes", *argv, "--json"])
+        want = json.loads(text.getvalue())
+        lock = "--lock-axes" in argv
+        for method in cs.METHODS:
+            m = cs.constrained_linearize(
+                load_scene(argv[0]),
+                _no_loop,
+                _no_loop_jacobian,
+                held=want["held"],
+                lock_held=lock,
+                method=method,
+            )
+            got = cs.constrained_modes(m)["modes"]
+            f = np.array(
+                [[r["freq_hz"], w["freq_hz"]] for r, w in zip(got, want["modes"], strict=True)]
+            )
+            z = np.array(
+                [[r["zeta"], w["zeta"]] for r, w in zip(got, want["modes"], strict=True)], float
+            )
+            print(
+                f"rt70 modes {' '.join(argv)}, no loop, {method}: {len(got)} modes, "
+                f"max|f/f_cli − 1| = {np.max(np.abs(f[:, 0] / f[:, 1] - 1)):.1e}, "
+                f"max|ξ/ξ_cli − 1| = {np.nanmax(np.abs(z[:, 0] / z[:, 1] - 1)):.1e}"
+            )
