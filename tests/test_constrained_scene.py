@@ -207,6 +207,8 @@ def test_bad_side_and_method_are_refused():
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, side="pinocchio")
     with pytest.raises(Rt70Error, match="unknown method"):
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, method="qr")
+    with pytest.raises(Rt70Error, match="q_start has shape"):
+        cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, q_start=np.zeros(3))
     with pytest.raises(Rt70Error, match="double_pendulum: no coordinate"):
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, held={"elevation": 1.0})
 

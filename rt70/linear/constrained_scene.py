@@ -182,6 +182,8 @@ def constrained_linearize(
     loops = scene_constraints(scene, loop_residual, loop_jacobian, side, loop_bias)
     hold = cm.fixed(n, hold_idx, list(held.values()))
     q = np.zeros(n) if q_start is None else np.array(q_start, dtype=float)
+    if q.shape != (n,):
+        raise Rt70Error(f"{scene.name}: q_start has shape {q.shape}, the scene has {n} coordinates")
     q[hold_idx] = list(held.values())
     force = _static_force(scene, side)
     K_of = lambda x: lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
