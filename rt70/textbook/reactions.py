@@ -168,10 +168,13 @@ def pair_reactions(
     wrenches = list(wrenches)
     S = update_structure(model, data, q)  # forward pass: poses, L, S
     V = body_velocities(model, data, qd)
-    Vdot = (S.T @ qdd + structure_matrix_rate(model, data, q, qd).T @ qd).reshape(model.nb, 6)
-    momentum = np.einsum("kij,kj->ki", model.Theta, V)
-    W = np.einsum("kij,kj->ki", model.Theta, Vdot)
-    W += np.array([crf(v) @ h for v, h in zip(V, momentum, strict=True)]).reshape(-1, 6)
+    Vdot = S.T @ qdd
+    if qd.any():  # at rest (statics, impulses) Ṡᵀ q̇ and Φ(V) Θ V vanish
+        Vdot += structure_matrix_rate(model, data, q, qd).T @ qd
+    W = np.einsum("kij,kj->ki", model.Theta, Vdot.reshape(model.nb, 6))
+    if qd.any():
+        momentum = np.einsum("kij,kj->ki", model.Theta, V)
+        W += np.array([crf(v) @ h for v, h in zip(V, momentum, strict=True)])
     if gravity:
         W -= gravity_wrenches(model, data)
     W -= load_wrenches(model, data, wrenches)
