@@ -165,14 +165,14 @@ def pair_reactions(
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
     qdd = check_vector("qdd", qdd, model.nv)
-    wrenches = list(wrenches)
     S = update_structure(model, data, q)  # forward pass: poses, L, S
     V = body_velocities(model, data, qd)
+    moving = bool(qd.any())  # at rest (statics, impulses) Ṡᵀ q̇ and Φ(V) Θ V vanish
     Vdot = S.T @ qdd
-    if qd.any():  # at rest (statics, impulses) Ṡᵀ q̇ and Φ(V) Θ V vanish
+    if moving:
         Vdot += structure_matrix_rate(model, data, q, qd).T @ qd
     W = np.einsum("kij,kj->ki", model.Theta, Vdot.reshape(model.nb, 6))
-    if qd.any():
+    if moving:
         momentum = np.einsum("kij,kj->ki", model.Theta, V)
         W += np.array([crf(v) @ h for v, h in zip(V, momentum, strict=True)])
     if gravity:
