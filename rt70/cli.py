@@ -21,7 +21,7 @@ import signal
 import sys
 import warnings
 
-from rt70 import cli_pointing, cli_sweep, options
+from rt70 import cli_pointing, cli_reactions, cli_sweep, options
 from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
@@ -546,6 +546,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     pla.set_defaults(func=_plant)
     cli_pointing.add_parser(sub, _add_pointing_arguments)
+    cli_reactions.add_parser(sub)
     sim = sub.add_parser(
         "simulate",
         help="integrate the equations of motion with an energy audit",

@@ -23,6 +23,7 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.loads import Wrench
 from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
+from rt70.reaction_check import reaction_pair, reaction_scale
 from rt70.scene import Scene, require_coordinates
 from rt70.textbook import drives as tb_drives
 from rt70.textbook import dynamics, forces, points
@@ -45,6 +46,7 @@ QUANTITIES = (
     "points",
     "load_force",
     "drives",
+    "reactions",
 )
 
 #: Compared after :data:`QUANTITIES` for a scene with ``<rt70:wind>`` elements only.
@@ -249,6 +251,8 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: _stacked_drives(tb_drives.drive_force, tm, td, q, compared_drives),
             lambda: _stacked_drives(ref_drives.drive_force, ref, rd, q, compared_drives),
         ),
+        # joint reaction wrenches, source 004 (9)–(13) (rt70.reaction_check)
+        "reactions": reaction_pair(scene, q, qd, wrench),
     }
     if scene.description.winds:  # Q_w = S W and Jᵀ f (4.132)–(4.136), a random wind
         wind = state_wind(q)
@@ -350,6 +354,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
         "load_force": _load_scale(scene, q),
         "drives": norm("drives"),
+        "reactions": reaction_scale(scene, q, qd, state_wrench(scene, q)),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
     }
 

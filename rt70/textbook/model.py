@@ -105,6 +105,9 @@ class Model:
         (``q_full = q``).
     winds, air_density : tuple of rt70.urdf.Wind, float
         The scene's exposed bodies and air density (:mod:`rt70.textbook.wind`).
+    pair_joints : list of tuple of str
+        The URDF joints of each pair: one, or the six of a merged euler6 chain
+        (:mod:`rt70.textbook.reactions` reports the wrench across each).
     """
 
     name: str
@@ -131,6 +134,7 @@ class Model:
     q_offset: np.ndarray | None = None
     winds: tuple[Wind, ...] = ()
     air_density: float = DEFAULT_AIR_DENSITY
+    pair_joints: list[tuple[str, ...]] = field(default_factory=list)
 
     @property
     def nb(self) -> int:
@@ -209,6 +213,7 @@ def build_model(desc: RobotDescription) -> Model:
     referenced |= {p.link for p in desc.optical_points} | {w.link for w in desc.winds}
     parent, kind, axis, r_c, c_c = [], [], [], [], []
     thetas, ndof, body_names, coord_names = [], [], [], []
+    pair_joints: list[tuple[str, ...]] = []
     link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = {
         desc.root: (-1, np.zeros(3), np.eye(3))
     }
@@ -247,6 +252,7 @@ def build_model(desc: RobotDescription) -> Model:
             suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
             names = [joint.name + suffix for suffix in suffixes]
         j = len(kind)
+        pair_joints.append(tuple(c.name for c in chain) if chain else (joint.name,))
         parent.append(body)
         kind.append(jkind)
         axis.append(joint.axis)
@@ -301,6 +307,7 @@ def build_model(desc: RobotDescription) -> Model:
         q_offset=q_offset,
         winds=desc.winds,
         air_density=desc.air_density,
+        pair_joints=pair_joints,
     )
 
 
