@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from rt70.arrays import check_vector
+from rt70.baumgarte import DEFAULT_STABILIZATION, Baumgarte
+from rt70.closed_chains import constrained_start, residual_trajectory
 from rt70.errors import (
     OutputError,
     Rt70Error,
@@ -215,6 +217,7 @@ class SimulationResult:
     drift_flagged: bool = False
     outputs: dict[str, np.ndarray] = field(default_factory=dict)
     states: dict[str, np.ndarray] = field(default_factory=dict)
+    constraint_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def relative_drift(self) -> float:
@@ -294,6 +297,7 @@ def simulate(
     progress: bool = False,
     outputs: Sequence[Output] = (),
     components: Sequence[StateComponent] = (),
+    stabilization: Baumgarte | None = DEFAULT_STABILIZATION,
 ) -> SimulationResult:
     """Integrate the scene's equations of motion over ``t_span``.
 
@@ -328,6 +332,11 @@ def simulate(
         Quantities evaluated on the trajectory by the backend's side (e.g.
         :func:`rt70.outputs.optical_point_outputs`), in ``result.outputs`` by name,
         arrays (n_t, size); checked at the initial state before the run.
+    stabilization : rt70.baumgarte.Baumgarte or None
+        For a scene with ``<rt70:loop>`` closures (:mod:`rt70.closed_chains`): the gains
+        of the perturbation equations (2.2); None integrates ``Φ̈ = 0`` and lets Φ
+        drift. The start is assembled from rest (x0 None) or must be closed; the
+        residual ``max |Φ|`` is in ``result.constraint_residual``.
     """
     from scipy.integrate import solve_ivp
     from tqdm import tqdm
@@ -352,8 +361,9 @@ def simulate(
     n = scene.textbook.nv
     if n == 0:
         raise SimulationError(f"{scene.name}: the model has no degree of freedom: nothing moves")
-    side = BACKENDS[backend](scene)
+    side, *closed = constrained_start(scene, BACKENDS[backend](scene), x0, stabilization)
     q0, qd0 = (np.zeros(n), np.zeros(n)) if x0 is None else x0
+    q0, qd0 = (q0, qd0) if closed[0] is None else closed
     q0 = check_vector("initial state q0", q0, n)
     qd0 = check_vector("initial state qd0", qd0, n)
     output_side = "reference" if backend == "pinocchio" else "textbook"
@@ -478,6 +488,7 @@ def simulate(
         message=str(sol.message),
         coordinates=list(scene.textbook.coordinate_names),
         states=states,
+        constraint_residual=residual_trajectory(side, q),
     )
     passive = inputs is None and not pushed[0]
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
