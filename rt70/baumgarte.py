@@ -80,5 +80,19 @@ def constraint_rhs(
     return stabilization.rhs(C, rate, residual)
 
 
+def consistent_rhs(B_c: np.ndarray, g: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
+    """``g`` projected onto the range of ``B_c`` (least squares; unchanged if it lies in it).
+
+    With dependent rows (a weld closed in 3-D, a planar loop) the rows of Φ and of C
+    that depend on each other on the manifold need not do so off it, and (2.2) would
+    demand contradicting accelerations; the stabilisation then acts in the least-squares
+    sense: ``B_c q̈ = B_c B_c⁺ g``. Exact at Φ = 0 and for independent rows.
+    """
+    if B_c.size == 0:
+        return g
+    x = np.linalg.lstsq(B_c, g, rcond=rtol)[0]
+    return B_c @ x
+
+
 #: The default gains (ω = 20 rad/s, ζ = 1) as one shared value, for argument defaults.
 DEFAULT_STABILIZATION = Baumgarte()

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rt70.arrays import check_vector
-from rt70.baumgarte import Baumgarte, constraint_rhs
+from rt70.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
 from rt70.errors import Rt70Error, SimulationError
 from rt70.kkt import solve_kkt
 from rt70.scene import Scene
@@ -234,7 +234,7 @@ class ConstrainedBackend:
         qdd_free, Qd = self.side.accelerations(q, qd, Q_u)  # A⁻¹ f of the tree
         A = self.side.mass_matrix(q)
         phi, B, C = stacked(self.constraints, q, qd)
-        g = constraint_rhs(C, B @ qd, phi, self.stabilization)
+        g = consistent_rhs(B, constraint_rhs(C, B @ qd, phi, self.stabilization))
         try:
             sol = solve_kkt(A, B, A @ qdd_free, g)
         except Rt70Error as exc:

@@ -4,15 +4,20 @@ Both sides' :mod:`rt70.textbook.loops` and :mod:`rt70.reference.loops` at the sa
 (random, generally not closed) state:
 
 * ``loop_residual`` Φ(q), ``loop_jacobian`` B_c, ``loop_bias`` C = Ḃ_c q̇;
-* ``loop_dynamics`` q̈ and ``loop_reaction`` λ of the constrained equations (14) with
-  the default Baumgarte stabilisation (:class:`rt70.baumgarte.Baumgarte`): the KKT
-  system by the range-space method against ``pin.constraintDynamics``. Off the
-  manifold every term of (2.2) is active, so the stabilisation is compared too.
+* ``loop_dynamics`` q̈ and ``loop_reaction`` the generalised reaction ``B_cᵀ λ`` of the
+  constrained equations (14) with the default Baumgarte stabilisation
+  (:class:`rt70.baumgarte.Baumgarte`): the KKT system by the range-space method against
+  ``pin.constraintDynamics``. Off the manifold every term of (2.2) is active, so the
+  stabilisation is compared too. ``B_cᵀ λ`` rather than λ: with dependent rows (a
+  planar loop closed in 3-D, a weld) λ is not unique — rt70.kkt returns the
+  least-norm one, Pinocchio's proximal iterations head for it from zero but its
+  regularised factorisation leaks rounding/μ into the dependent directions (docs/loops.md);
+  each side's own ``B_c`` times its own λ still checks λ's frame and sign.
 
 Each row is measured against its own max-norm (Pinocchio's value), floored as every
 row of :mod:`rt70.validate`: ``loop_residual`` by the largest distance of a loop frame
 from the ground origin, ``loop_bias`` by that distance times ``‖q̇‖²`` plus ``|C|``,
-``loop_dynamics`` by the unconstrained q̈'s scale, ``loop_reaction`` by ``|λ|``.
+``loop_dynamics`` by the unconstrained q̈'s scale, ``loop_reaction`` by ``|B_cᵀ λ|``.
 """
 
 from __future__ import annotations
@@ -61,8 +66,14 @@ def loop_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[C
             lambda: rl.constrained_forward_dynamics(ref, rd, q, qd, stabilization=gains)[0],
         ),
         "loop_reaction": (
-            lambda: tl.constrained_forward_dynamics(tm, td, q, qd, stabilization=gains)[1],
-            lambda: rl.constrained_forward_dynamics(ref, rd, q, qd, stabilization=gains)[1],
+            lambda: (
+                tl.loop_jacobian(tm, td, q).T
+                @ tl.constrained_forward_dynamics(tm, td, q, qd, stabilization=gains)[1]
+            ),
+            lambda: (
+                rl.loop_jacobian(ref, rd, q).T
+                @ rl.constrained_forward_dynamics(ref, rd, q, qd, stabilization=gains)[1]
+            ),
         ),
     }
 

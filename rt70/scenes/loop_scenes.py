@@ -1,11 +1,14 @@
 """The closed-chain test mechanisms of issue 12 (docs/loops.md): four-bar, crank–slider.
 
-Both are planar in the x-y plane with gravity along −y (a vertical plane), every
-revolute joint about z, links as uniform rods (``I_c = m L²/12`` about y and z, a small
-axial moment about x). Each is a tree plus one ``<rt70:loop type="point">``: three rows,
-of which two are independent (the z row is identically zero in a planar mechanism —
-rt70.kkt and Pinocchio's proximal solver take the dependent row). The scenes are
-written by :mod:`rt70.scenes.generate` like every other scene.
+Both are planar in the x-y plane, every revolute joint about z, links as uniform rods
+(``I_c = m L²/12`` about y and z, a small axial moment about x). The four-bar hangs in a
+vertical plane (gravity along −y); the crank–slider lies on a horizontal table (gravity
+along −z, normal to its plane, carried by the joints and doing no work), so that its
+crank, started at 10 rad/s, keeps turning — in a vertical plane the rod's weight would
+stop it and swing it back. Each is a tree plus one ``<rt70:loop type="point">``: three
+rows, of which two are independent (the z row is identically zero in a planar
+mechanism — rt70.kkt and Pinocchio's proximal solver take the dependent row). The
+scenes are written by :mod:`rt70.scenes.generate` like every other scene.
 """
 
 from __future__ import annotations
@@ -36,7 +39,7 @@ CRANK_SLIDER = {
     "rod": (0.4, 2.0),
     "slider": 0.5,
     "slider_size": 0.05,  # cube edge, m (its inertia only)
-    "gravity": (0.0, -9.81, 0.0),
+    "gravity": (0.0, 0.0, -9.81),  # normal to the plane: carried by the joints, no work
     "crank_speed": 10.0,  # rad/s, the initial crank speed of the spec
 }
 
@@ -100,7 +103,7 @@ def crank_slider_scene() -> str:
         w,
         "crank_slider",
         f"Crank-slider (crank {a} m {ma} kg, rod {b} m {mb} kg, slider {ms} kg) in the x-y "
-        "plane, slider along x, gravity along -y; closed by <rt70:loop>",
+        "plane, slider along x, gravity along -z (normal to the plane); closed by <rt70:loop>",
     )
     uw.joint(w, "crank_joint", "revolute", ROOT_LINK, "crank")
     _rod(w, "crank", a, ma)

@@ -29,7 +29,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from rt70.arrays import check_vector
-from rt70.baumgarte import Baumgarte, constraint_rhs
+from rt70.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
 from rt70.kkt import solve_kkt
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import (
@@ -130,7 +130,8 @@ def constrained_forward_dynamics(
     """``(q̈, λ)`` of the constrained equations (14), solved by :func:`rt70.kkt.solve_kkt`.
 
     ``A q̈ = Q_g + Q_c + Q_d + Q − B q̇ + B_cᵀ λ`` and ``B_c q̈ = g``, g = −C or the
-    perturbation equations (2.2) of :class:`rt70.baumgarte.Baumgarte`.
+    perturbation equations (2.2) of :class:`rt70.baumgarte.Baumgarte`, projected onto
+    the range of B_c when rows are dependent (:func:`rt70.baumgarte.consistent_rhs`).
 
     Parameters
     ----------
@@ -154,6 +155,6 @@ def constrained_forward_dynamics(
     B_c = _jacobian_here(model, data)
     C = _bias_here(model, data, q, qd)
     residual = np.concatenate([_residual(data, loop) for loop in model.loops] or [np.zeros(0)])
-    g = constraint_rhs(C, B_c @ qd, residual, stabilization)
+    g = consistent_rhs(B_c, constraint_rhs(C, B_c @ qd, residual, stabilization))
     sol = solve_kkt(A, B_c, f, g)
     return sol.x, sol.lam
