@@ -387,6 +387,8 @@ def _simulate(args: argparse.Namespace) -> int:
         f"balance drift {result.relative_drift:.2e} of {result.balance_scale:.6g} J"
         + ("  [FLAGGED: more than the tolerance explains]" if result.drift_flagged else "")
     )
+    if result.constraint_residual.size:  # closed chains (rt70.closed_chains)
+        print(f"  constraints: max |Φ| = {result.constraint_residual.max():.2e} m (Baumgarte)")
     if args.out:
         figure = None
         if not args.no_plot:

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.urdf_writer import ROOT_LINK, ZERO3, check_name, fmt_vec
 
@@ -116,3 +118,28 @@ def crank_slider_scene() -> str:
     uw.gravity(w, d["gravity"])
     loop(w, "rod_slider", "rod", "slider", xyz1=(b, 0.0, 0.0))
     return uw.end(w)
+
+
+#: Guesses ``rt70 simulate`` closes (:func:`start_state`): q, q̇ and the kept coordinates.
+STARTS = {
+    "crank_slider": ((0.0, 0.0, 0.5), (CRANK_SLIDER["crank_speed"], 0.0, 0.0), ("crank_joint",)),
+    "four_bar": ((np.pi / 2, -1.0, 1.5), (0.0, 0.0, 0.0), ("crank_joint",)),
+}
+
+
+def start_state(scene) -> tuple[np.ndarray, np.ndarray] | None:
+    """The closed start of a mechanism of this module (crank at 10 rad/s), else None.
+
+    The crank–slider starts at crank angle 0 turning at 10 rad/s, the four-bar at rest
+    with the crank vertical; both closed by :func:`rt70.closed_chains.assemble` keeping
+    the crank.
+    """
+    from rt70.closed_chains import assemble
+
+    guess = STARTS.get(scene.name)
+    if guess is None or not scene.description.loops:
+        return None
+    q, qd, keep = guess
+    if len(q) != scene.textbook.nv:
+        return None
+    return assemble(scene, np.array(q), np.array(qd), keep=keep)
