@@ -112,6 +112,8 @@ def _modes(args: argparse.Namespace) -> int:
     from rt70.textbook.massless import require_diagonal
 
     scene = load_scene(args.scene)
+    if scene.description.loops:  # the tree's modes would ignore them (docs/loops.md)
+        raise Rt70Error(f"{scene.name}: closed chains (<rt70:loop>): rt70 modes takes trees only")
     has_axes, elevation, azimuth, held = _pointing(args, scene, "modes")
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned

@@ -329,3 +329,21 @@ def test_kkt_matrix_is_indefinite_and_plain_cg_breaks_down(crank_slider_start):
     sol = solve_kkt(A, B, f, g)  # the range-space method
     assert np.linalg.norm(A @ sol.x - f - B.T @ sol.lam) <= 1e-12 * np.linalg.norm(f)
     assert np.linalg.norm(B @ sol.x - g) <= 1e-12 * np.linalg.norm(g)
+
+
+def test_modes_refuses_a_scene_with_loops(capsys):
+    """The tree's linearisation would ignore the loops: refused, not a wrong answer."""
+    assert rt70.cli.main(["modes", "four_bar"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        "rt70: error: four_bar: closed chains (<rt70:loop>): rt70 modes takes trees only"
+    ]
+
+
+def test_cli_simulate_crank_slider_reports_the_residual(capsys):
+    args = ["simulate", "crank_slider", "--t-end", "0.5", "--method", "DOP853", "--rtol", "1e-10"]
+    assert rt70.cli.main(args) == 0
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if "constraints: max |Φ|" in x)
+    assert float(line.split("=")[1].split()[0]) <= 1e-10
+    assert "T0 = 0.5 J" in out  # the closed start at 10 rad/s

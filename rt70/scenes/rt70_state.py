@@ -85,7 +85,8 @@ def start_state(scene: Scene) -> tuple[np.ndarray, np.ndarray] | None:
     (numpy.ndarray, numpy.ndarray) or None
         :func:`listing_initial_state` when the scene has the listing's coordinates,
         the assembled start of the four-bar and the crank–slider
-        (:func:`rt70.scenes.loop_scenes.start_state`), else None (:func:`rt70.simulate.simulate` then starts at rest).
+        (:func:`rt70.scenes.loop_scenes.start_state`), else None
+        (:func:`rt70.simulate.simulate` then starts at rest).
     """
     from rt70.scenes.loop_scenes import start_state as loop_start
 
