@@ -188,7 +188,8 @@ class SimulationResult:
     relative to). ``drift_flagged`` is set when a passive run drifts by more than
     ``DRIFT_FACTOR · rtol`` of it. ``states`` holds the trajectory of every extra state
     by name (:mod:`rt70.states`; the energy audit's ``dissipated`` and ``input_work``
-    first).
+    first). ``constraint_residual`` is ``max |Φ|`` per sample for a scene with closed
+    chains (:mod:`rt70.closed_chains`), empty otherwise.
     """
 
     scene: str
@@ -254,6 +255,8 @@ class SimulationResult:
             arrays.update(input_work=self.input_work, balance=self.balance)
             arrays.update({f"state:{k}": v for k, v in self._component_states().items()})
             arrays["coordinates"] = np.array(self.coordinates)
+            if self.constraint_residual.size:  # closed chains: max |Φ| per sample
+                arrays["constraint_residual"] = self.constraint_residual
             arrays.update({f"output:{k}": v for k, v in self.outputs.items()})
             return lambda tmp: np.savez_compressed(tmp, **arrays)
         extra = self._component_states()
@@ -264,6 +267,9 @@ class SimulationResult:
             [self.t, self.q, self.qd, self.kinetic, self.gravity, self.elastic]
             + [self.dissipated, self.input_work, self.balance, *extra.values()]
         )
+        if self.constraint_residual.size:  # closed chains: max |Φ| per sample
+            names.append("constraint_residual")
+            table = np.column_stack([table, self.constraint_residual])
         for name, values in self.outputs.items():  # rt70.outputs, one column per component
             names += column_labels(name, values.shape[1])
             table = np.column_stack([table, values])

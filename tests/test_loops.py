@@ -347,3 +347,14 @@ def test_cli_simulate_crank_slider_reports_the_residual(capsys):
     line = next(x for x in out.splitlines() if "constraints: max |Φ|" in x)
     assert float(line.split("=")[1].split()[0]) <= 1e-10
     assert "T0 = 0.5 J" in out  # the closed start at 10 rad/s
+
+
+def test_saved_result_carries_the_residual(tmp_path):
+    scene = load_scene("crank_slider")
+    result = simulate(scene, (0.0, 0.05), method="DOP853", rtol=1e-8)
+    result.save(tmp_path / "run.npz")
+    result.save(tmp_path / "run.csv")
+    saved = np.load(tmp_path / "run.npz")
+    np.testing.assert_array_equal(saved["constraint_residual"], result.constraint_residual)
+    header = (tmp_path / "run.csv").read_text(encoding="utf-8").splitlines()[0].split(",")
+    assert header[-1] == "constraint_residual"
