@@ -55,6 +55,8 @@ class Constraint:
         ``B_c`` with ``B_c q̇ = Φ̇``.
     bias : callable (q, q̇) -> (m,)
         ``C = Ḃ_c q̇`` (``B_c q̈ + C = Φ̈``).
+    terms : callable (q, q̇) -> (Φ, B_c, C), optional
+        All three at once when a side can share the work (one forward pass).
     """
 
     name: str
@@ -62,6 +64,7 @@ class Constraint:
     residual: object
     jacobian: object
     bias: object
+    terms: object = None
 
 
 def scene_constraints(scene: Scene, side: str = "textbook") -> list[Constraint]:
@@ -94,12 +97,17 @@ def scene_constraints(scene: Scene, side: str = "textbook") -> list[Constraint]:
             lambda q: tl.loop_residual(model, data, q),
             lambda q: tl.loop_jacobian(model, data, q),
             lambda q, qd: tl.loop_bias(model, data, q, qd),
+            (lambda q, qd: tl.loop_terms(model, data, q, qd)) if side == "textbook" else None,
         )
     ]
 
 
 def stacked(constraints: Sequence[Constraint], q, qd=None):
     """``(Φ, B_c, C)`` of all constraints stacked (C None without q̇)."""
+    if qd is not None and all(c.terms is not None for c in constraints):
+        parts = [c.terms(q, qd) for c in constraints]
+        phi, B, C = zip(*parts, strict=True)
+        return np.concatenate(phi), np.vstack(B), np.concatenate(C)
     phi = np.concatenate([c.residual(q) for c in constraints])
     B = np.vstack([c.jacobian(q) for c in constraints])
     C = None if qd is None else np.concatenate([c.bias(q, qd) for c in constraints])

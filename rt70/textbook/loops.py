@@ -119,6 +119,21 @@ def loop_bias(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.nda
     return _bias_here(model, data, q, qd)
 
 
+def loop_terms(
+    model: Model, data: Data, q: np.ndarray, qd: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Φ, B_c, C)`` from one forward pass (what a simulation step needs)."""
+    q = check_vector("q", q, model.nv)
+    qd = check_vector("qd", qd, model.nv)
+    update_structure(model, data, q)
+    residual = [_residual(data, loop) for loop in model.loops]
+    return (
+        np.concatenate(residual) if residual else np.zeros(0),
+        _jacobian_here(model, data),
+        _bias_here(model, data, q, qd),
+    )
+
+
 def constrained_forward_dynamics(
     model: Model,
     data: Data,
