@@ -14,6 +14,13 @@ Both sides' :mod:`rt70.textbook.loops` and :mod:`rt70.reference.loops` at the sa
   regularised factorisation leaks rounding/μ into the dependent directions (docs/loops.md);
   each side's own ``B_c`` times its own λ still checks λ's frame and sign.
 
+A scene with a ``frame`` loop is compared at the sampled state closed by
+:func:`rt70.closed_chains.assemble` (Newton from it): Pinocchio's ``CONTACT_6D`` rows
+are the relative twist at frame 1's origin (``ṗ₁ − v₂(p₁)``), its error ``−log₆(c₁Mc₂)``
+and its drift the derivative of the twist in a moving frame, which equal the textbook's
+``ṗ₁ − ṗ₂``, ``(p₁ − p₂, log₃)`` and ``Ḃ_c q̇`` on ``Φ = 0``, ``B_c q̇ = 0`` only. Point
+loops are compared at the random state itself, off the manifold, every term active.
+
 Each row is measured against its own max-norm (Pinocchio's value), floored as every
 row of :mod:`rt70.validate`: ``loop_residual`` by the largest distance of a loop frame
 from the ground origin, ``loop_bias`` by that distance times ``‖q̇‖²`` plus ``|C|``,
@@ -27,6 +34,7 @@ from collections.abc import Callable
 import numpy as np
 
 from rt70.baumgarte import Baumgarte
+from rt70.closed_chains import assemble
 from rt70.scene import Scene
 
 #: Rows compared for a scene with ``<rt70:loop>`` elements, after the others.
@@ -45,6 +53,8 @@ def loop_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[C
     from rt70.reference import loops as rl
     from rt70.textbook import loops as tl
 
+    if any(loop.type == "frame" for loop in scene.description.loops):
+        q, qd = assemble(scene, q, qd)  # Pinocchio's 6-D rows equal ours on the manifold
     tm, td = scene.textbook, scene.textbook_data
     ref, rd = scene.reference, scene.reference_data
     gains = Baumgarte()

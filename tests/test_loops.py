@@ -358,3 +358,13 @@ def test_saved_result_carries_the_residual(tmp_path):
     np.testing.assert_array_equal(saved["constraint_residual"], result.constraint_residual)
     header = (tmp_path / "run.csv").read_text(encoding="utf-8").splitlines()[0].split(",")
     assert header[-1] == "constraint_residual"
+
+
+def test_validate_rows_of_a_frame_loop():
+    """A weld (6 rows, rank 1): the rows compared on the manifold (rt70.loop_check)."""
+    from rt70.validate import cross_check
+
+    scene = scene_from_text(welded(), "welded")
+    records = {r.quantity: r for r in cross_check(scene, samples=3, seed=4, repeat=0)}
+    for name in ("loop_residual", "loop_jacobian", "loop_bias", "loop_dynamics", "loop_reaction"):
+        assert records[name].max_rel_err <= TOL, (name, records[name].max_rel_err)
