@@ -306,7 +306,8 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
     - points (:func:`compared_points`): the largest distance of a compared point from
       the ground origin (a position is a sum of the bodies' offsets);
     - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
-      ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel.
+      ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel;
+    - the loop rows of a scene with ``<rt70:loop>``: :func:`rt70.loop_check.loop_scales`.
 
     Raises
     ------
