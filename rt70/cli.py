@@ -112,6 +112,8 @@ def _modes(args: argparse.Namespace) -> int:
     from rt70.textbook.massless import require_diagonal
 
     scene = load_scene(args.scene)
+    if scene.description.loops:  # the tree's modes would ignore them (docs/loops.md)
+        raise Rt70Error(f"{scene.name}: closed chains (<rt70:loop>): rt70 modes takes trees only")
     has_axes, elevation, azimuth, held = _pointing(args, scene, "modes")
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
@@ -361,6 +363,8 @@ def _simulate(args: argparse.Namespace) -> int:
         f"balance drift {result.relative_drift:.2e} of {result.balance_scale:.6g} J"
         + ("  [FLAGGED: more than the tolerance explains]" if result.drift_flagged else "")
     )
+    if result.constraint_residual.size:  # closed chains (rt70.closed_chains)
+        print(f"  constraints: max |Φ| = {result.constraint_residual.max():.2e} m (Baumgarte)")
     if args.out:
         figure = None
         if not args.no_plot:

@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from rt70.arrays import check_vector
+from rt70.baumgarte import DEFAULT_STABILIZATION, Baumgarte
+from rt70.closed_chains import constrained_start, residual_trajectory
 from rt70.errors import (
     OutputError,
     Rt70Error,
@@ -186,7 +188,8 @@ class SimulationResult:
     relative to). ``drift_flagged`` is set when a passive run drifts by more than
     ``DRIFT_FACTOR · rtol`` of it. ``states`` holds the trajectory of every extra state
     by name (:mod:`rt70.states`; the energy audit's ``dissipated`` and ``input_work``
-    first).
+    first). ``constraint_residual`` is ``max |Φ|`` per sample for a scene with closed
+    chains (:mod:`rt70.closed_chains`), empty otherwise.
     """
 
     scene: str
@@ -215,6 +218,7 @@ class SimulationResult:
     drift_flagged: bool = False
     outputs: dict[str, np.ndarray] = field(default_factory=dict)
     states: dict[str, np.ndarray] = field(default_factory=dict)
+    constraint_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def relative_drift(self) -> float:
@@ -251,6 +255,8 @@ class SimulationResult:
             arrays.update(input_work=self.input_work, balance=self.balance)
             arrays.update({f"state:{k}": v for k, v in self._component_states().items()})
             arrays["coordinates"] = np.array(self.coordinates)
+            if self.constraint_residual.size:  # closed chains: max |Φ| per sample
+                arrays["constraint_residual"] = self.constraint_residual
             arrays.update({f"output:{k}": v for k, v in self.outputs.items()})
             return lambda tmp: np.savez_compressed(tmp, **arrays)
         extra = self._component_states()
@@ -261,6 +267,9 @@ class SimulationResult:
             [self.t, self.q, self.qd, self.kinetic, self.gravity, self.elastic]
             + [self.dissipated, self.input_work, self.balance, *extra.values()]
         )
+        if self.constraint_residual.size:  # closed chains: max |Φ| per sample
+            names.append("constraint_residual")
+            table = np.column_stack([table, self.constraint_residual])
         for name, values in self.outputs.items():  # rt70.outputs, one column per component
             names += column_labels(name, values.shape[1])
             table = np.column_stack([table, values])
@@ -294,6 +303,7 @@ def simulate(
     progress: bool = False,
     outputs: Sequence[Output] = (),
     components: Sequence[StateComponent] = (),
+    stabilization: Baumgarte | None = DEFAULT_STABILIZATION,
 ) -> SimulationResult:
     """Integrate the scene's equations of motion over ``t_span``.
 
@@ -328,6 +338,11 @@ def simulate(
         Quantities evaluated on the trajectory by the backend's side (e.g.
         :func:`rt70.outputs.optical_point_outputs`), in ``result.outputs`` by name,
         arrays (n_t, size); checked at the initial state before the run.
+    stabilization : rt70.baumgarte.Baumgarte or None
+        For a scene with ``<rt70:loop>`` closures (:mod:`rt70.closed_chains`): the gains
+        of the perturbation equations (2.2); None integrates ``Φ̈ = 0`` and lets Φ
+        drift. The start is assembled from rest (x0 None) or must be closed; the
+        residual ``max |Φ|`` is in ``result.constraint_residual``.
     """
     from scipy.integrate import solve_ivp
     from tqdm import tqdm
@@ -352,8 +367,9 @@ def simulate(
     n = scene.textbook.nv
     if n == 0:
         raise SimulationError(f"{scene.name}: the model has no degree of freedom: nothing moves")
-    side = BACKENDS[backend](scene)
+    side, *closed = constrained_start(scene, BACKENDS[backend](scene), x0, stabilization)
     q0, qd0 = (np.zeros(n), np.zeros(n)) if x0 is None else x0
+    q0, qd0 = (q0, qd0) if closed[0] is None else closed
     q0 = check_vector("initial state q0", q0, n)
     qd0 = check_vector("initial state qd0", qd0, n)
     output_side = "reference" if backend == "pinocchio" else "textbook"
@@ -478,6 +494,7 @@ def simulate(
         message=str(sol.message),
         coordinates=list(scene.textbook.coordinate_names),
         states=states,
+        constraint_residual=residual_trajectory(side, q),
     )
     passive = inputs is None and not pushed[0]
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol

@@ -22,6 +22,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.loads import Wrench
+from rt70.loop_check import loop_pairs, loop_quantities, loop_scales
 from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
 from rt70.reaction_check import reaction_pair, reaction_scale
 from rt70.scene import Scene, require_coordinates
@@ -55,7 +56,7 @@ WIND = "wind"
 
 def quantities(scene: Scene) -> tuple[str, ...]:
     """The rows of ``scene``'s report: :data:`QUANTITIES`, and :data:`WIND` if it has wind."""
-    return QUANTITIES + ((WIND,) if scene.description.winds else ())
+    return QUANTITIES + ((WIND,) if scene.description.winds else ()) + loop_quantities(scene)
 
 
 @dataclass(frozen=True)
@@ -260,6 +261,7 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: tb_wind.wind_force(tm, td, q, wind),
             lambda: ref_wind.wind_force(ref, rd, q, wind),
         )
+    pairs.update(loop_pairs(scene, q, qd))  # rt70.loop_check: Φ, B_c, C, (14) with (2.2)
     return pairs
 
 
@@ -308,7 +310,8 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
     - points (:func:`compared_points`): the largest distance of a compared point from
       the ground origin (a position is a sum of the bodies' offsets);
     - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
-      ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel.
+      ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel;
+    - the loop rows of a scene with ``<rt70:loop>``: :func:`rt70.loop_check.loop_scales`.
 
     Raises
     ------
@@ -342,13 +345,14 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
     Q_b, Q_g = np.abs(values["bias"][1]), np.abs(values["gravity"][1])
     f = np.abs(A).sum(axis=1) * speed2 + Q_b + g0 + Q_g + Sc + Sd
     qdd = np.abs(values["forward_dynamics"][1])
+    qdd_scale = np.abs(np.linalg.inv(A)) @ (f + np.abs(A) @ qdd)
     return {
         "mass_matrix": norm("mass_matrix"),
         "bias": norm("mass_matrix") * speed2 + norm("bias"),
         "gravity": g0 + norm("gravity"),
         "spring_force": float(np.max(Sc, initial=0.0)),
         "damper_force": float(np.max(Sd, initial=0.0)),
-        "forward_dynamics": np.abs(np.linalg.inv(A)) @ (f + np.abs(A) @ qdd),
+        "forward_dynamics": qdd_scale,
         "kinetic_energy": norm("mass_matrix") * speed2,
         "potential_energy": g0 + reference.spring_potential(ref, rd, q),
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
@@ -356,6 +360,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "drives": norm("drives"),
         "reactions": reaction_scale(scene, q, qd, state_wrench(scene, q)),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
+        **loop_scales(scene, values, q, qd, qdd_scale),
     }
 
 

@@ -42,6 +42,7 @@ SHARED = (
     "rt70.constraints",
     "rt70.wind",
     "rt70.kkt",
+    "rt70.baumgarte",
 )
 
 #: layer (module prefix) → module prefixes it may import from rt70.
@@ -50,7 +51,14 @@ RULES = {
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
     # not rt70.constraints: the reference side maps mimic joints on its own, so the
     # cross-check also checks the textbook's constraint matrix G
-    "rt70.reference": ("rt70.reference", "rt70.urdf", "rt70.resources", *SHARED[:4], "rt70.wind"),
+    "rt70.reference": (
+        "rt70.reference",
+        "rt70.urdf",
+        "rt70.resources",
+        *SHARED[:4],
+        "rt70.wind",
+        "rt70.baumgarte",
+    ),
     "rt70.resources": ("rt70.urdf.description", *SHARED),
     "rt70.rotations": (),
     "rt70.errors": (),
@@ -61,6 +69,7 @@ RULES = {
     "rt70.loads": ("rt70.arrays", "rt70.errors"),
     "rt70.wind": ("rt70.errors", "rt70.loads"),
     "rt70.kkt": ("rt70.errors",),
+    "rt70.baumgarte": ("rt70.errors",),
 }
 
 

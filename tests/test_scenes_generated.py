@@ -27,6 +27,8 @@ EXPECTED_NV = {
     "three_masses": 3,
     "two_body_gravity": 12,
     "gear_reducer": 5,
+    "four_bar": 3,
+    "crank_slider": 3,
 }
 
 RT70_BODIES = (

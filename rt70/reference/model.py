@@ -75,6 +75,8 @@ class ReferenceModel:
         Velocity index, stiffness and damping of every joint spring.
     winds, air_density : tuple of rt70.urdf.Wind, float
         The scene's exposed bodies and air density (:mod:`rt70.reference.wind`).
+    loops : list of (int, (int, pinocchio.SE3), (int, pinocchio.SE3))
+        Rows and the two frames (parent joint, placement) of every loop closure.
     """
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
@@ -94,6 +96,10 @@ class ReferenceModel:
                 np.asarray(b.damping),
             )
             for b in desc.bushings
+        ]
+        self.loops = [  # (rows, frame 1, frame 2): rt70.reference.loops
+            (loop.rows, _attachment(bodies, loop.frame1), _attachment(bodies, loop.frame2))
+            for loop in desc.loops
         ]
         self.frames1 = [b.frame1 for b in self.bushings]
         self.frames2 = [b.frame2 for b in self.bushings]

@@ -21,6 +21,7 @@ from rt70.atomic import atomic_write_text
 from rt70.geartrains import parallel_drive
 from rt70.scenes import mechanisms, rt70_data, rt70_drives, rt70_wind
 from rt70.scenes import urdf_writer as uw
+from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene
 from rt70.scenes.pairs import pair_joint_names
 from rt70.scenes.urdf_writer import ROOT_LINK, ZERO3, check_name, fmt, fmt_vec
 from rt70.urdf.description import DRIVE_PARAMETERS
@@ -535,6 +536,8 @@ SCENES: dict[str, Callable[[], str]] = {
     "three_masses": three_masses_scene,
     "two_body_gravity": two_body_gravity_scene,
     "gear_reducer": gear_reducer_scene,
+    "four_bar": four_bar_scene,
+    "crank_slider": crank_slider_scene,
 }
 
 

@@ -84,8 +84,15 @@ def start_state(scene: Scene) -> tuple[np.ndarray, np.ndarray] | None:
     -------
     (numpy.ndarray, numpy.ndarray) or None
         :func:`listing_initial_state` when the scene has the listing's coordinates,
-        else None (:func:`rt70.simulate.simulate` then starts at rest).
+        the assembled start of the four-bar and the crank–slider
+        (:func:`rt70.scenes.loop_scenes.start_state`), else None
+        (:func:`rt70.simulate.simulate` then starts at rest).
     """
+    from rt70.scenes.loop_scenes import start_state as loop_start
+
+    closed = loop_start(scene)  # the closed chains' mechanisms, assembled (docs/loops.md)
+    if closed is not None:
+        return closed
     try:
         return listing_initial_state(scene)
     except Rt70Error:

@@ -57,6 +57,24 @@ _EULER6_PATTERN = (
 
 
 @dataclass(frozen=True)
+class LoopModel:
+    """A loop closure: frame 1 on ``body1`` coincides with frame 2 on ``body2``.
+
+    Bodies are pair indices (−1 = ground); ``r``/``c`` place each frame in its body;
+    ``rows`` is 3 (the origins coincide) or 6 (the frames coincide). docs/loops.md.
+    """
+
+    name: str
+    rows: int
+    body1: int
+    r1: np.ndarray
+    c1: np.ndarray
+    body2: int
+    r2: np.ndarray
+    c2: np.ndarray
+
+
+@dataclass(frozen=True)
 class BushingModel:
     """A 6-D spring/damper between frame 1 on ``body1`` and frame 2 on ``body2``.
 
@@ -127,6 +145,7 @@ class Model:
     full_coordinate_names: list[str] = field(default_factory=list)
     link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = field(default_factory=dict)
     bushings: list[BushingModel] = field(default_factory=list)
+    loops: list[LoopModel] = field(default_factory=list)
     spring_coords: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     spring_stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
     spring_damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -211,6 +230,7 @@ def build_model(desc: RobotDescription) -> Model:
     """Build the textbook :class:`Model` from a validated URDF description."""
     referenced = {b.frame1.link for b in desc.bushings} | {b.frame2.link for b in desc.bushings}
     referenced |= {p.link for p in desc.optical_points} | {w.link for w in desc.winds}
+    referenced |= {f.link for loop in desc.loops for f in (loop.frame1, loop.frame2)}
     parent, kind, axis, r_c, c_c = [], [], [], [], []
     thetas, ndof, body_names, coord_names = [], [], [], []
     pair_joints: list[tuple[str, ...]] = []
@@ -281,6 +301,15 @@ def build_model(desc: RobotDescription) -> Model:
         body1, r1, c1 = _frame_on_body(link_frames, b.frame1.link, b.frame1.xyz, b.frame1.rpy)
         body2, r2, c2 = _frame_on_body(link_frames, b.frame2.link, b.frame2.xyz, b.frame2.rpy)
         bushings.append(BushingModel(b.name, body1, r1, c1, body2, r2, c2, b.stiffness, b.damping))
+    loops = [
+        LoopModel(
+            loop.name,
+            loop.rows,
+            *_frame_on_body(link_frames, loop.frame1.link, loop.frame1.xyz, loop.frame1.rpy),
+            *_frame_on_body(link_frames, loop.frame2.link, loop.frame2.xyz, loop.frame2.rpy),
+        )
+        for loop in desc.loops
+    ]
     G, q_offset, independent = _mimic_constraints(coord_names, desc)
     return Model(
         name=desc.name,
@@ -300,6 +329,7 @@ def build_model(desc: RobotDescription) -> Model:
         full_coordinate_names=list(coord_names),
         link_frames=link_frames,
         bushings=bushings,
+        loops=loops,
         spring_coords=np.array([joint_coord[s.joint] for s in desc.joint_springs], dtype=int),
         spring_stiffness=np.array([s.stiffness for s in desc.joint_springs], dtype=float),
         spring_damping=np.array([s.damping for s in desc.joint_springs], dtype=float),

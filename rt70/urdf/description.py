@@ -122,6 +122,26 @@ class Bushing:
 
 
 @dataclass(frozen=True)
+class Loop:
+    """A loop closure by "coincidence of bases" (source 004 (14); docs/loops.md).
+
+    The origins of the two frames coincide (``type="point"``: 3 rows) or the two frames
+    coincide (``type="frame"``: 6 rows, the position rows then the orientation rows).
+    ``frame2.link`` is the root link when the file says ``world``.
+    """
+
+    name: str
+    type: str
+    frame1: FrameRef
+    frame2: FrameRef
+
+    @property
+    def rows(self) -> int:
+        """Number of constraint rows: 3 (point) or 6 (frame)."""
+        return 3 if self.type == "point" else 6
+
+
+@dataclass(frozen=True)
 class JointSpring:
     """A scalar spring and damper on the coordinate of one 1-DOF joint."""
 
@@ -265,6 +285,8 @@ class RobotDescription:
         Exposed bodies the wind acts on (``<rt70:wind>``), in document order.
     air_density : float
         Air density ρ of ``<rt70:air>``, kg/m³ (default: ISA sea level, 1.225).
+    loops : list of Loop
+        Loop closures (``<rt70:loop>``), in document order.
     """
 
     name: str
@@ -280,6 +302,7 @@ class RobotDescription:
     drives: list[Drive] = field(default_factory=list)
     winds: tuple[Wind, ...] = ()
     air_density: float = DEFAULT_AIR_DENSITY
+    loops: list[Loop] = field(default_factory=list)
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

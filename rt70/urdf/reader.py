@@ -32,6 +32,7 @@ from rt70.urdf.description import (
     Joint,
     JointSpring,
     Link,
+    Loop,
     Mimic,
     OpticalPoint,
     RobotDescription,
@@ -69,7 +70,10 @@ _EXTENSIONS = (
     "drive",
     "wind",
     "air",
+    "loop",
 )
+#: Kinds of ``<rt70:loop>`` and their number of constraint rows.
+LOOP_TYPES = {"point": 3, "frame": 6}
 _ZERO3 = np.zeros(3)
 
 
@@ -434,6 +438,8 @@ class _Reader:
                 desc.joint_springs.append(self.joint_spring(elem, joints))
             elif kind == "bushing":
                 desc.bushings.append(self.bushing(elem, desc))
+            elif kind == "loop":
+                desc.loops.append(self.loop(elem, desc))
             elif kind == "strut_package":
                 desc.bushings.extend(self.strut_package(elem, desc))
             elif kind == "drive":
@@ -514,6 +520,32 @@ class _Reader:
         f2 = self.frame(elem, "frame2", desc, where)
         k, d = self.gains(elem, 6, where)
         return Bushing(name, f1, f2, k, d)
+
+    def loop(self, elem: ET.Element, desc: RobotDescription) -> Loop:
+        """``<rt70:loop>``: two frames that coincide (docs/loops.md)."""
+        name = self.name_of(elem)
+        where = f"<rt70:loop name='{name}'>"
+        if any(loop.name == name for loop in desc.loops):
+            raise self.fail(ExtensionError, f"{where}: two loops named '{name}'")
+        kind = elem.get("type", "point")
+        if kind not in LOOP_TYPES:
+            raise self.fail(
+                ExtensionError,
+                f"{where}: type '{kind}' is not one of {', '.join(LOOP_TYPES)}",
+            )
+        f1 = self.frame(elem, "frame1", desc, where)
+        sub = elem.find(f"{{{RT70_NS}}}frame2")
+        if sub is not None and sub.get("link") == "world" and "world" not in desc.links:
+            f2 = FrameRef(  # the ground: the root link, whatever its name
+                desc.root, self.numbers(sub, "xyz", 3, _ZERO3), self.numbers(sub, "rpy", 3, _ZERO3)
+            )
+        else:
+            f2 = self.frame(elem, "frame2", desc, where)
+        if f1.link == f2.link:
+            raise self.fail(
+                ExtensionError, f"{where}: frame1 and frame2 are both on link '{f1.link}'"
+            )
+        return Loop(name, kind, f1, f2)
 
     def strut_package(self, elem: ET.Element, desc: RobotDescription) -> list[Bushing]:
         name = self.name_of(elem)

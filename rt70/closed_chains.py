@@ -1,0 +1,305 @@
+"""Closed chains in time simulation: constraints per side, assembly, constrained q̈.
+
+A scene with ``<rt70:loop>`` elements is a tree plus the constraints ``Φ(q) = 0``
+(source 004 (14)). This module holds what :func:`rt70.simulate.simulate` needs beyond
+the tree's dynamics, written once for both sides:
+
+* :class:`Constraint` — the interface of one group of holonomic constraints on one side:
+  ``rows``, ``residual(q)`` Φ, ``jacobian(q)`` B_c, ``bias(q, q̇)`` C. The loops of a
+  scene are one (:func:`scene_constraints`); a brake or stow pin locking a coordinate
+  is another kind with the same three methods.
+* :func:`assemble` — consistent initial conditions: Newton on ``Φ(q) = 0`` keeping
+  chosen coordinates, and ``q̇`` projected onto ``B_c q̇ = 0`` keeping the chosen
+  velocities.
+* :class:`ConstrainedBackend` — wraps a backend of :mod:`rt70.simulate`: q̈ and λ of the
+  constrained equations (14) with the Baumgarte stabilisation of source 002 (2.2)
+  (:mod:`rt70.baumgarte`): on the textbook side the KKT system by the range-space method
+  (:func:`rt70.kkt.solve_kkt`); on Pinocchio's ``pin.constraintDynamics`` for the loops
+  (:func:`rt70.reference.loops.constrained_forward_dynamics`) — any further constraint
+  on that side goes through the same KKT solve with Pinocchio's A and forces.
+
+Ideal constraints do no work (``q̇ᵀ B_cᵀ λ = (B_c q̇)ᵀ λ = 0``), so the energy audit of
+the tree still closes; the residual ``max |Φ|`` is reported with the result.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rt70.arrays import check_vector
+from rt70.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
+from rt70.errors import Rt70Error, SimulationError
+from rt70.kkt import solve_kkt
+from rt70.scene import Scene
+
+#: Newton iterations of :func:`assemble` before it gives up.
+MAX_NEWTON = 50
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """One group of holonomic constraints ``Φ(q) = 0`` as one side computes them.
+
+    Attributes
+    ----------
+    name : str
+        What the rows are (for messages).
+    rows : int
+        Number of rows m.
+    residual : callable q -> (m,)
+        Φ(q).
+    jacobian : callable q -> (m, nv)
+        ``B_c`` with ``B_c q̇ = Φ̇``.
+    bias : callable (q, q̇) -> (m,)
+        ``C = Ḃ_c q̇`` (``B_c q̈ + C = Φ̈``).
+    terms : callable (q, q̇) -> (Φ, B_c, C), optional
+        All three at once when a side can share the work (one forward pass).
+    """
+
+    name: str
+    rows: int
+    residual: object
+    jacobian: object
+    bias: object
+    terms: object = None
+
+
+def scene_constraints(scene: Scene, side: str = "textbook") -> list[Constraint]:
+    """The scene's loop closures as one :class:`Constraint` of ``side`` (or none).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene, its ``<rt70:loop>`` elements.
+    side : {"textbook", "reference"}
+        Whose kinematics compute Φ, B_c and C.
+    """
+    loops = scene.description.loops
+    if not loops:
+        return []
+    if side == "textbook":
+        from rt70.textbook import loops as tl
+
+        model, data = scene.textbook, scene.textbook_data
+    elif side == "reference":
+        from rt70.reference import loops as tl
+
+        model, data = scene.reference, scene.reference_data
+    else:
+        raise Rt70Error(f"unknown side '{side}' (textbook or reference)")
+    return [
+        Constraint(
+            ", ".join(f"loop '{loop.name}'" for loop in loops),
+            sum(loop.rows for loop in loops),
+            lambda q: tl.loop_residual(model, data, q),
+            lambda q: tl.loop_jacobian(model, data, q),
+            lambda q, qd: tl.loop_bias(model, data, q, qd),
+            (lambda q, qd: tl.loop_terms(model, data, q, qd)) if side == "textbook" else None,
+        )
+    ]
+
+
+def stacked(constraints: Sequence[Constraint], q, qd=None):
+    """``(Φ, B_c, C)`` of all constraints stacked (C None without q̇)."""
+    if qd is not None and all(c.terms is not None for c in constraints):
+        parts = [c.terms(q, qd) for c in constraints]
+        phi, B, C = zip(*parts, strict=True)
+        return np.concatenate(phi), np.vstack(B), np.concatenate(C)
+    phi = np.concatenate([c.residual(q) for c in constraints])
+    B = np.vstack([c.jacobian(q) for c in constraints])
+    C = None if qd is None else np.concatenate([c.bias(q, qd) for c in constraints])
+    return phi, B, C
+
+
+def _indices(names: Sequence[str | int], coordinates: Sequence[str]) -> np.ndarray:
+    out = []
+    for name in names:
+        if isinstance(name, str):
+            if name not in coordinates:
+                raise Rt70Error(
+                    f"unknown coordinate '{name}' (coordinates: {', '.join(coordinates)})"
+                )
+            out.append(coordinates.index(name))
+        else:
+            out.append(int(name))
+    return np.array(sorted(set(out)), dtype=int)
+
+
+def assemble(
+    scene: Scene,
+    q: np.ndarray,
+    qd: np.ndarray | None = None,
+    keep: Sequence[str | int] = (),
+    side: str = "textbook",
+    tol: float = 1e-13,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Close the scene's chains from a guess: consistent ``(q, q̇)``.
+
+    Newton's method on ``Φ(q) = 0`` moves only the coordinates not in ``keep`` (the
+    least-norm step ``Δq = −B_c⁺ Φ`` on them, so dependent rows are harmless); the
+    velocities not kept are then the least-norm solution of
+    ``B_c[:, free] q̇_free = −B_c[:, kept] q̇_kept``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene with loops (without, the guess is returned unchanged).
+    q, qd : numpy.ndarray
+        The guess (q̇ default zero).
+    keep : sequence of str or int
+        Coordinates (names or indices) whose position and velocity are kept — e.g. the
+        crank angle and speed of a crank–slider.
+    side : {"textbook", "reference"}
+        Whose kinematics compute Φ and B_c.
+    tol : float
+        Convergence: ``max |Φ| ≤ tol · (1 + max |q|)``.
+
+    Raises
+    ------
+    Rt70Error
+        If Newton's method does not converge (no closed configuration near the guess
+        with the kept coordinates), or the kept velocities violate the constraints.
+    """
+    n = scene.textbook.nv
+    q = check_vector("q", q, n).copy()
+    qd = np.zeros(n) if qd is None else check_vector("qd", qd, n).copy()
+    constraints = scene_constraints(scene, side)
+    if not constraints:
+        return q, qd
+    kept = _indices(keep, scene.textbook.coordinate_names)
+    free = np.setdiff1d(np.arange(n), kept)
+    if free.size == 0:
+        raise Rt70Error(f"{scene.name}: assemble: every coordinate is kept, nothing can move")
+    for _ in range(MAX_NEWTON):
+        phi, B, _ = stacked(constraints, q)
+        if np.max(np.abs(phi)) <= tol * (1.0 + np.max(np.abs(q))):
+            break
+        q[free] -= np.linalg.lstsq(B[:, free], phi, rcond=None)[0]
+    else:
+        raise Rt70Error(
+            f"{scene.name}: assemble: Newton's method did not close "
+            f"{constraints[0].name} (|Φ| = {np.max(np.abs(phi)):.3g} after {MAX_NEWTON} "
+            "iterations): no closed configuration near the guess with the kept coordinates"
+        )
+    _, B, _ = stacked(constraints, q)
+    rhs = -B[:, kept] @ qd[kept]
+    qd[free] = np.linalg.lstsq(B[:, free], rhs, rcond=None)[0]
+    scale = 1.0 + float(np.max(np.abs(qd)))
+    if np.max(np.abs(B @ qd), initial=0.0) > 1e-10 * scale:
+        raise Rt70Error(
+            f"{scene.name}: assemble: the kept velocities violate {constraints[0].name}"
+        )
+    return q, qd
+
+
+class ConstrainedBackend:
+    """A backend of :mod:`rt70.simulate` with the scene's constraints added.
+
+    ``accelerations`` returns q̈ of the constrained equations (14) with Baumgarte
+    stabilisation; ``jacobian`` is None (the solver differences the right-hand side);
+    the mass matrix and the energies are the tree's.
+    """
+
+    def __init__(self, side, stabilization: Baumgarte | None) -> None:
+        self.side = side
+        self.name = side.name
+        self.nv = side.nv
+        self.scene = side.scene
+        self.stabilization = stabilization
+        self.side_name = "reference" if side.name == "pinocchio" else "textbook"
+        self.constraints = scene_constraints(side.scene, self.side_name)
+
+    def mass_matrix(self, q):
+        """The tree's A(q)."""
+        return self.side.mass_matrix(q)
+
+    def energies(self, q, qd):
+        """The tree's T, U_g, U_c (the constraints store no energy)."""
+        return self.side.energies(q, qd)
+
+    def jacobian(self, q, qd, Q_u):
+        """None: the solver differences the constrained right-hand side."""
+        return None
+
+    def residual(self, q) -> np.ndarray:
+        """Φ(q) of every constraint, stacked."""
+        return np.concatenate([c.residual(q) for c in self.constraints])
+
+    def accelerations(self, q, qd, Q_u):
+        """``(q̈, Q_d)``: q̈ of (14) with (2.2), the dampers' force for the energy audit."""
+        if self.side_name == "reference":
+            from rt70.reference import loops
+
+            scene = self.scene
+            qdd, _ = loops.constrained_forward_dynamics(
+                scene.reference, scene.reference_data, q, qd, Q_u, self.stabilization
+            )
+            _, Qd = self._damper(q, qd)
+            return qdd, Qd
+        qdd_free, Qd = self.side.accelerations(q, qd, Q_u)  # A⁻¹ f of the tree
+        A = self.side.mass_matrix(q)
+        phi, B, C = stacked(self.constraints, q, qd)
+        g = consistent_rhs(B, constraint_rhs(C, B @ qd, phi, self.stabilization))
+        try:
+            sol = solve_kkt(A, B, A @ qdd_free, g)
+        except Rt70Error as exc:
+            raise SimulationError(str(exc)) from None
+        return sol.x, Qd
+
+    def _damper(self, q, qd):
+        from rt70 import reference
+
+        scene = self.scene
+        return reference.spring_damper_force(scene.reference, scene.reference_data, q, qd)
+
+
+def constrained_start(
+    scene: Scene,
+    backend,
+    x0: tuple[np.ndarray, np.ndarray] | None,
+    stabilization: Baumgarte | None,
+):
+    """``(backend, q0, q̇0)`` for :func:`rt70.simulate.simulate`.
+
+    Without loops: the backend and x0 unchanged (x0 may be None). With loops: the
+    :class:`ConstrainedBackend`, and the initial state assembled from rest (x0 None) or
+    checked (a given x0 must satisfy ``Φ = 0``, ``B_c q̇ = 0`` to 1e-8 — close it with
+    :func:`assemble`).
+
+    Raises
+    ------
+    SimulationError
+        If the given initial state violates the constraints.
+    """
+    if not scene.description.loops:
+        return backend, None, None
+    wrapped = ConstrainedBackend(backend, stabilization)
+    n = scene.textbook.nv
+    if x0 is None:
+        q0, qd0 = assemble(scene, np.zeros(n), side=wrapped.side_name)
+        return wrapped, q0, qd0
+    q0, qd0 = (
+        check_vector("initial state q0", x0[0], n),
+        check_vector("initial state qd0", x0[1], n),
+    )
+    phi, B, _ = stacked(wrapped.constraints, q0)
+    rate = B @ qd0
+    if np.max(np.abs(phi)) > 1e-8 * (1.0 + np.max(np.abs(q0))) or np.max(
+        np.abs(rate), initial=0.0
+    ) > 1e-8 * (1.0 + np.max(np.abs(qd0))):
+        raise SimulationError(
+            f"{scene.name}: the initial state violates {wrapped.constraints[0].name} "
+            f"(|Φ| = {np.max(np.abs(phi)):.3g}, |B_c q̇| = {np.max(np.abs(rate)):.3g}); "
+            "close it with rt70.closed_chains.assemble"
+        )
+    return wrapped, q0, qd0
+
+
+def residual_trajectory(backend, q: np.ndarray) -> np.ndarray:
+    """``max |Φ|`` at every sample of a trajectory (empty without constraints)."""
+    if not isinstance(backend, ConstrainedBackend):
+        return np.zeros(0)
+    return np.array([np.max(np.abs(backend.residual(x))) for x in q])
