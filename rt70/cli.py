@@ -112,28 +112,33 @@ def _modes(args: argparse.Namespace) -> int:
     from rt70.textbook.massless import require_diagonal
 
     scene = load_scene(args.scene)
-    if scene.description.loops:  # the tree's modes would ignore them (docs/loops.md)
-        raise Rt70Error(f"{scene.name}: closed chains (<rt70:loop>): rt70 modes takes trees only")
     has_axes, elevation, azimuth, held = _pointing(args, scene, "modes")
+    constraints = None
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
-            q0 = lin.equilibrium(scene, held)
-            model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
-            drives = bool(scene.description.drives) and not args.lock_axes
-            if drives:  # the motors held: the reducers hold the axes (locked rotor)
-                model = lin.locked_rotor(scene, model)
+            if scene.description.loops:  # on the manifold Φ(q) = 0 (docs/constrained-modes.md)
+                result, shapes, model, damped, constraints = _loop_modes(args, scene, held)
+            else:
+                q0 = lin.equilibrium(scene, held)
+                model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
+                if scene.description.drives and not args.lock_axes:  # motors held: locked rotor
+                    model = lin.locked_rotor(scene, model)
     except SingularConfigurationError as exc:  # a state on the way: name the scene
         raise SingularConfigurationError(f"{scene.name}: {exc}") from None
-    require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
-    result = modal.modes(model.M, model.K, model.D)
-    damped = modal.damped_modes(model.M, model.K, model.D)
-    rows = mode_table.mode_rows(result, result.shapes, model.M, model.coordinates)
+    drives = bool(scene.description.drives) and not args.lock_axes
+    if constraints is None:
+        require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
+        result = modal.modes(model.M, model.K, model.D)
+        shapes = result.shapes
+        damped = modal.damped_modes(model.M, model.K, model.D)
+    rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates)
     damped_summary = mode_table.damped_summary(result, damped)
     if args.json:
         out = {
             "scene": scene.name,
             "held": held,
             "locked_rotor": drives,
+            **({"constraints": constraints} if constraints is not None else {}),
             "modes": rows,
             "damped": damped_summary,
         }
@@ -144,7 +149,13 @@ def _modes(args: argparse.Namespace) -> int:
     if drives:
         names = ", ".join(d.name for d in scene.description.drives)
         axes = f" (locked rotor: the motors of {names} held, their reducers hold the axes)"
-    print(f"{scene.name}: {len(rows)} modes at static equilibrium{where}{axes}")
+    closed = ""
+    if constraints is not None:
+        closed = (
+            f", on the manifold of {constraints['loop_rows']} loop-closure row(s) "
+            f"(rank {constraints['rank']})"
+        )
+    print(f"{scene.name}: {len(rows)} modes at static equilibrium{where}{closed}{axes}")
     print(f"{'mode':>4} {'f, Hz':>10} {'ξ':>8}  {'kind':<8} dominant coordinate (energy)")
     for r in rows:
         zeta = "" if r["zeta"] is None else f"{r['zeta']:.4f}"
@@ -171,6 +182,49 @@ def _modes(args: argparse.Namespace) -> int:
                 f"it (no spring, no drive, no gravity moment){hint}"
             )
     return 0
+
+
+def _loop_modes(args: argparse.Namespace, scene, held: dict) -> tuple:
+    """The modes of a closed-chain scene on its constraint manifold (textbook side).
+
+    From a closed start (the mechanism's own, or the zero state closed by
+    :func:`rt70.closed_chains.assemble`), the stable equilibrium with the loops closed
+    (Newton descending where the stiffness is negative), the null-space reduction with the
+    multipliers' geometric stiffness (:mod:`rt70.linear.constrained_scene`); returns the
+    modes, their shapes in the tree coordinates, the full-coordinate model, the damped
+    modes and the ``constraints`` entry of the JSON output.
+    """
+    import numpy as np
+
+    from rt70.closed_chains import assemble
+    from rt70.linear import constrained as cm
+    from rt70.linear import modal
+    from rt70.linear.constrained_scene import constrained_linearize
+    from rt70.scenes.loop_scenes import start_state
+    from rt70.textbook import loops
+
+    start = start_state(scene)  # a closed start of the repository's mechanisms
+    q_start = start[0] if start is not None else assemble(scene, np.zeros(scene.textbook.nv))[0]
+    for name, value in held.items():
+        q_start[scene.textbook.coordinate_names.index(name)] = value
+    model = constrained_linearize(
+        scene,
+        loops.loop_residual,
+        loops.loop_jacobian,
+        held,
+        lock_held=args.lock_axes,
+        q_start=q_start,
+        descend=True,
+    )
+    red = model.reduced
+    spectrum = cm.modes(red)
+    constraints = {
+        "loop_rows": model.loop_rows,
+        "rank": red.rank,
+        "multipliers": model.equilibrium.lam[: model.loop_rows].tolist(),
+    }
+    damped = modal.damped_modes(red.M_r, red.K_r, red.D_r)
+    return spectrum.modes, spectrum.shapes, model, damped, constraints
 
 
 #: Above this elevation (degrees) the pointing corrections are not given (zenith keyhole).

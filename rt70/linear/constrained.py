@@ -253,6 +253,7 @@ def equilibrium(
     tol: float = 1e-10,
     max_iter: int = 50,
     h: float = FD_STEP,
+    descend: bool = False,
 ) -> Equilibrium:
     """Solve ``Q(q) + B_cᵀ λ = 0``, ``Φ(q) = 0`` by Newton's method in null-space form.
 
@@ -281,6 +282,12 @@ def equilibrium(
         Newton steps allowed.
     h : float
         Difference step of the geometric stiffness (and of K when not given).
+    descend : bool
+        Look for a stable equilibrium (a minimum of the potential): where the stiffness
+        along the manifold has negative eigenvalues, step downhill along them
+        (``|K_r|`` for ``K_r``, steps limited to :data:`MAX_DESCENT_STEP` of the
+        coordinate scale) instead of toward the nearest stationary point. Near a stable
+        equilibrium it is Newton's method unchanged.
 
     Returns
     -------
@@ -317,13 +324,7 @@ def equilibrium(
         if N.shape[1]:
             Kt = np.asarray(K_of(q), dtype=float) + geometric_stiffness(constraints, q, lam, h)
             Kr = N.T @ Kt @ N
-            try:
-                dz = scipy.linalg.solve(Kr, N.T @ r_f - N.T @ Kt @ dq, assume_a="sym")
-            except (np.linalg.LinAlgError, ValueError):
-                raise Rt70Error(
-                    "no equilibrium on the constraint manifold: the stiffness along it is "
-                    "singular (a motion the constraints allow that nothing holds)"
-                ) from None
+            dz = _manifold_step(Kr, N.T @ r_f - N.T @ Kt @ dq, f_scale, descend, q_scale)
             dq = dq + N @ dz
         if not np.isfinite(dq).all():
             raise Rt70Error("the equilibrium's Newton step is not finite")
@@ -335,6 +336,40 @@ def equilibrium(
         f"equilibrium on the constraint manifold not found in {max_iter} Newton steps "
         f"(force left {f_left:.3g}, constraint residual {c_left:.3g})"
     )
+
+
+#: Largest step (times the coordinate scale, at least 1) of a descent toward a stable
+#: equilibrium through a region of negative stiffness.
+MAX_DESCENT_STEP = 0.25
+
+
+def _manifold_step(
+    Kr: np.ndarray, rhs: np.ndarray, f_scale: float, descend: bool, q_scale: float
+) -> np.ndarray:
+    """Solve ``K_r δz = rhs`` for the step along the manifold.
+
+    Directions of zero stiffness (a mechanism that nothing holds, as a crank–slider in a
+    horizontal plane) take no step if no force acts along them, and are refused if one
+    does. With ``descend`` the negative stiffnesses count as positive (a step downhill).
+    """
+    w, V = np.linalg.eigh(0.5 * (Kr + Kr.T))
+    scale = float(np.max(np.abs(w), initial=0.0))
+    zero = np.abs(w) <= 1e-12 * max(scale, f_scale)
+    b = V.T @ rhs
+    if np.any(np.abs(b[zero]) > 1e-10 * f_scale):
+        raise Rt70Error(
+            "no equilibrium on the constraint manifold: the stiffness along it is "
+            "singular (a motion the constraints allow that nothing holds) and a force "
+            "acts along it"
+        )
+    stiff = np.where(zero, 1.0, np.abs(w) if descend else w)
+    dz = V @ np.where(zero, 0.0, b / stiff)
+    if descend and np.any(w[~zero] < 0):
+        limit = MAX_DESCENT_STEP * q_scale
+        size = float(np.max(np.abs(dz), initial=0.0))
+        if size > limit:
+            dz *= limit / size
+    return dz
 
 
 def _force(force: Vector, q: np.ndarray) -> np.ndarray:

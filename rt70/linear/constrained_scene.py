@@ -140,6 +140,7 @@ def constrained_linearize(
     q_start: np.ndarray | None = None,
     tol: float = 1e-10,
     loop_bias: BiasFunction | None = None,
+    descend: bool = False,
 ) -> SceneConstrainedModel:
     """Equilibrium on the manifold and the reduced linear model of a closed-chain scene.
 
@@ -167,6 +168,8 @@ def constrained_linearize(
     loop_bias : callable, optional
         ``(model, data, q, q̇) → C`` of ``side``: the geometric stiffness exactly, in
         n(n+1)/2 calls, instead of 2n differenced Jacobians.
+    descend : bool
+        Look for a stable equilibrium (:func:`rt70.linear.constrained.equilibrium`).
 
     Raises
     ------
@@ -189,7 +192,7 @@ def constrained_linearize(
     K_of = lambda x: lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
     try:
         both = cm.combine(loops, hold) if held else loops
-        eq = cm.equilibrium(force, both, q, stiffness=K_of, tol=tol)
+        eq = cm.equilibrium(force, both, q, stiffness=K_of, tol=tol, descend=descend)
     except Rt70Error as exc:
         raise Rt70Error(f"{scene.name}: {exc}") from None
     m_loop = np.atleast_1d(loops.residual(eq.q)).size
