@@ -22,6 +22,8 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.loads import Wrench
+from rt70.nonholonomic_scene import ROWS as NONHOLONOMIC
+from rt70.nonholonomic_scene import validate_pairs as nonholonomic_pairs
 from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
 from rt70.scene import Scene, require_coordinates
 from rt70.textbook import drives as tb_drives
@@ -52,8 +54,13 @@ WIND = "wind"
 
 
 def quantities(scene: Scene) -> tuple[str, ...]:
-    """The rows of ``scene``'s report: :data:`QUANTITIES`, and :data:`WIND` if it has wind."""
-    return QUANTITIES + ((WIND,) if scene.description.winds else ())
+    """The rows of ``scene``'s report.
+
+    :data:`QUANTITIES`, :data:`WIND` if it has wind, and
+    :data:`rt70.nonholonomic_scene.ROWS` if it has ``<rt70:no_slip>`` constraints.
+    """
+    rows = QUANTITIES + ((WIND,) if scene.description.winds else ())
+    return rows + (NONHOLONOMIC if scene.description.no_slips else ())
 
 
 @dataclass(frozen=True)
@@ -256,6 +263,8 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: tb_wind.wind_force(tm, td, q, wind),
             lambda: ref_wind.wind_force(ref, rd, q, wind),
         )
+    if scene.description.no_slips:  # A(q), Ȧq̇; reduced q̈ and reactions (source 002)
+        pairs.update(nonholonomic_pairs(scene, q, qd))
     return pairs
 
 
@@ -351,6 +360,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "load_force": _load_scale(scene, q),
         "drives": norm("drives"),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
+        **{row: norm(row) for row in NONHOLONOMIC if row in values},
     }
 
 

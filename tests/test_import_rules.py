@@ -61,6 +61,7 @@ RULES = {
     "rt70.loads": ("rt70.arrays", "rt70.errors"),
     "rt70.wind": ("rt70.errors", "rt70.loads"),
     "rt70.kkt": ("rt70.errors",),
+    "rt70.nonholonomic": ("rt70.errors", "rt70.kkt"),
 }
 
 
