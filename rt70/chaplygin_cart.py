@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from rt70.errors import Rt70Error
 from rt70.nonholonomic import perturbation_matrix, program_acceleration, program_multipliers
 from rt70.nonholonomic_scene import constraint_rows, reduced_system
 from rt70.scene import Scene
@@ -33,6 +34,25 @@ from rt70.scene import Scene
 INDEPENDENT = (0, 1, 2)
 ROLLING = ("right_rolling", "left_rolling")
 LATERAL = ("lateral",)
+
+
+def check_scene(scene: Scene) -> None:
+    """Refuse a scene that is not a cart of this module's kind.
+
+    Raises
+    ------
+    Rt70Error
+        Unless the scene has 5 coordinates and the ``<rt70:no_slip>`` elements
+        ``right_rolling``, ``left_rolling`` and ``lateral`` (as urdf/two_wheeled_cart.urdf).
+    """
+    names = {e.name for e in scene.description.no_slips}
+    missing = [n for n in (*ROLLING, *LATERAL) if n not in names]
+    if missing or len(scene.coordinate_names) != 5:
+        raise Rt70Error(
+            f"{scene.path}: not a two-wheeled cart: needs 5 coordinates (x, y, θ, φ1, φ2) and "
+            f"<rt70:no_slip> {', '.join((*ROLLING, *LATERAL))}"
+            + (f" (missing: {', '.join(missing)})" if missing else "")
+        )
 
 
 def obstacle(x, y):
@@ -157,6 +177,11 @@ def on_manifold_start(x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
     zero.
     """
     X, Y = field(x, y)
+    if np.hypot(X, Y) < 1e-9:
+        raise Rt70Error(
+            f"start ({x:g}, {y:g}) is an equilibrium of the programmed field (4.6): no "
+            "heading is programmed there"
+        )
     q = np.array([x, y, np.arctan2(Y, X), 0.0, 0.0])
     _, grad, _ = heading_constraint(q)
     thd = -(grad[0] * X + grad[1] * Y) / grad[2]
@@ -172,12 +197,20 @@ def simulate(
     side: str = "reference",
     rtol: float = 1e-10,
     atol: float = 1e-12,
+    stop_radius: float = 0.0,
 ):
     """Integrate the controlled cart (DOP853); returns scipy's solution at ``times``.
 
-    The state is ``[q (5), q̇_ind (3)]``; ``q̇ = 𝔅 q̇_ind`` turns the wheels.
+    The state is ``[q (5), q̇_ind (3)]``; ``q̇ = 𝔅 q̇_ind`` turns the wheels. With
+    ``stop_radius`` > 0 the run stops where M comes that close to the target (the
+    origin, where the programmed speed vanishes and S becomes singular).
     """
     n = len(q0)
+
+    def near(_t, s):
+        return np.hypot(s[0], s[1]) - stop_radius
+
+    near.terminal = True
 
     def rhs(_t, s):
         forces = servo(scene, s[:n], s[n:], gains, side)
@@ -192,4 +225,5 @@ def simulate(
         t_eval=times,
         rtol=rtol,
         atol=atol,
+        events=near if stop_radius > 0.0 else None,
     )

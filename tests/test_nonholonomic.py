@@ -10,6 +10,7 @@ solution (002.4).
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -330,3 +331,39 @@ def test_sleigh_matches_the_analytic_solution(sleigh):
     kkt = ns.constrained_forward_dynamics(sleigh, "reference", q[:, i], qd[:, i])
     w, dw = qd[2, i], kkt.x[2]
     np.testing.assert_allclose(kkt.lam[0], -(m * c * dw + m * v[i] * w), rtol=1e-10)
+
+
+# --- rt70 cart ------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["cart", "--duration", "1000"], "at most 100 s"),
+        (["cart", "--duration", "1", "--step", "2"], "longer than --duration"),
+        (["cart", "--start", "0", "0"], "equilibrium of the programmed field"),
+        (["cart", "--speed-error", "-1"], "speed must stay positive"),
+        (["cart", "chaplygin_sleigh"], "not a two-wheeled cart"),
+        (["cart", "--start", "1", "nan"], "not a finite number"),
+    ],
+)
+def test_cli_cart_refuses_bad_options_in_one_line(argv, message, capsys):
+    if "nan" in argv:  # the parser's own refusal
+        with pytest.raises(SystemExit, match="2"):
+            main(argv)
+    else:
+        assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rt70: error: ") and message in err[0]
+
+
+def test_cli_cart_json(capsys):
+    assert main(["cart", "--duration", "0.2", "--step", "0.1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    initial = out["initial"]
+    np.testing.assert_allclose(
+        [initial["M1"], initial["M2"], initial["lateral"]],
+        [5.949495, 14.130045, -41.442174],
+        atol=5e-7,
+    )
+    assert [r[0] for r in out["rows"]] == pytest.approx([0.0, 0.1, 0.2])
+    assert out["min_g"] > 0 and out["stopped_at"] is None
+    assert np.max(np.abs(out["perturbations_end"])) < 1e-9
