@@ -156,15 +156,14 @@ def servo(
     c = row @ qd_ind
     f1, grad, H = heading_constraint(q)
     f4, V4, w4 = speed_constraint(q, qd_ind)
-    V = np.vstack([row, grad, V4])
-    w = np.array([A_lat[0] @ rate + A_lat_dot[0], qd_ind @ H @ qd_ind, w4])
-    P = perturbation_matrix(1, 2, gains.omega, gains.zeta, 1.0)
-    P[1, 2], P[2, 3] = -gains.baumgarte, -gains.kappa  # first-order rows: (c, f4)
+    # rows: f1 (holonomic), then c and f4 (first order), as perturbation_matrix orders them
+    V = np.vstack([grad, row, V4])
+    w = np.array([qd_ind @ H @ qd_ind, A_lat[0] @ rate + A_lat_dot[0], w4])
+    P = perturbation_matrix(1, 2, gains.omega, gains.zeta, (gains.baumgarte, gains.kappa))
     beta = P @ np.array([f1, grad @ qd_ind, c, f4])
-    beta = np.array([beta[1], beta[0], beta[2]])  # order of V: c, f1, f4
     n = q.size
     D = np.column_stack([proj.basis.T @ np.eye(n)[3], proj.basis.T @ np.eye(n)[4], row])
-    lam = program_multipliers(red.A_star, red.a, red.Q_star, V, w, beta, D)
+    lam = program_multipliers(red.A_star, red.a, red.Q_star, V, w, beta, D)  # (M1, M2, λ)
     qdd = program_acceleration(red.A_star, red.a, red.Q_star, D, lam)
     residuals = np.array([c, f1, grad @ qd_ind, f4])
     return ServoForces(lam[0], lam[1], lam[2], qdd, residuals, qd_full)

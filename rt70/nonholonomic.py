@@ -173,12 +173,14 @@ def chaplygin_property(
 
 
 # --- program constraints (Algorithm 002-B) ------------------------------------------------
-def perturbation_matrix(m: int, k: int, omega: float, zeta: float, kappa: float) -> np.ndarray:
+def perturbation_matrix(
+    m: int, k: int, omega: float, zeta: float, kappa: float | Sequence[float]
+) -> np.ndarray:
     """A stable linear choice of the perturbation equations (2.2): ``β = P (α, α̇, α')``.
 
     ``m`` holonomic constraints follow ``α̈ = −2ζω α̇ − ω² α`` (poles
-    ``ω(−ζ ± √(ζ²−1))``), ``k`` first-order ones ``α̇' = −κ α'``. P is
-    ``(m + k) × (2m + k)``.
+    ``ω(−ζ ± √(ζ²−1))``), ``k`` first-order ones ``α̇'_i = −κ_i α'_i`` (one κ for all,
+    or one per constraint). P is ``(m + k) × (2m + k)``.
 
     Raises
     ------
@@ -186,12 +188,13 @@ def perturbation_matrix(m: int, k: int, omega: float, zeta: float, kappa: float)
         If a gain is not positive (the trivial solution would not be asymptotically
         stable).
     """
-    if not (omega > 0.0 and zeta > 0.0 and kappa > 0.0):
+    kappas = np.broadcast_to(np.asarray(kappa, dtype=float), (k,))
+    if not (omega > 0.0 and zeta > 0.0 and np.all(kappas > 0.0)):
         raise Rt70Error(f"perturbation gains must be positive: ω={omega}, ζ={zeta}, κ={kappa}")
     P = np.zeros((m + k, 2 * m + k))
     P[:m, :m] = -(omega**2) * np.eye(m)
     P[:m, m : 2 * m] = -2.0 * zeta * omega * np.eye(m)
-    P[m:, 2 * m :] = -kappa * np.eye(k)
+    P[m:, 2 * m :] = -np.diag(kappas)
     return P
 
 

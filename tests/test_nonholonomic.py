@@ -303,8 +303,12 @@ def test_zero_programmed_speed_is_refused(cart_scene):
 def test_perturbation_gains_must_be_stable():
     P = nh.perturbation_matrix(1, 2, 4.0, 1.0, 3.0)
     np.testing.assert_array_equal(P, [[-16, -8, 0, 0], [0, 0, -3, 0], [0, 0, 0, -3]])
+    P = nh.perturbation_matrix(1, 2, 4.0, 1.0, (10.0, 3.0))
+    np.testing.assert_array_equal(P[1:, 2:], [[-10, 0], [0, -3]])
     with pytest.raises(Rt70Error, match="positive"):
         nh.perturbation_matrix(1, 1, 4.0, 0.0, 1.0)
+    with pytest.raises(Rt70Error, match="positive"):
+        nh.perturbation_matrix(1, 2, 4.0, 1.0, (1.0, -1.0))
 
 
 # --- the Chaplygin sleigh -------------------------------------------------------------------
