@@ -23,6 +23,8 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.loads import Wrench
 from rt70.loop_check import loop_pairs, loop_quantities, loop_scales
+from rt70.nonholonomic_scene import ROWS as NONHOLONOMIC
+from rt70.nonholonomic_scene import validate_pairs as nonholonomic_pairs
 from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
 from rt70.reaction_check import reaction_pair, reaction_scale
 from rt70.scene import Scene, require_coordinates
@@ -55,8 +57,14 @@ WIND = "wind"
 
 
 def quantities(scene: Scene) -> tuple[str, ...]:
-    """The rows of ``scene``'s report: :data:`QUANTITIES`, and :data:`WIND` if it has wind."""
-    return QUANTITIES + ((WIND,) if scene.description.winds else ()) + loop_quantities(scene)
+    """The rows of ``scene``'s report.
+
+    :data:`QUANTITIES`, :data:`WIND` if it has wind, the loop rows
+    (:func:`rt70.loop_check.loop_quantities`) if it has ``<rt70:loop>`` closures, and
+    :data:`rt70.nonholonomic_scene.ROWS` if it has ``<rt70:no_slip>`` constraints.
+    """
+    rows = QUANTITIES + ((WIND,) if scene.description.winds else ()) + loop_quantities(scene)
+    return rows + (NONHOLONOMIC if scene.description.no_slips else ())
 
 
 @dataclass(frozen=True)
@@ -262,6 +270,8 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: ref_wind.wind_force(ref, rd, q, wind),
         )
     pairs.update(loop_pairs(scene, q, qd))  # rt70.loop_check: Φ, B_c, C, (14) with (2.2)
+    if scene.description.no_slips:  # A(q), Ȧq̇; reduced q̈ and reactions (source 002)
+        pairs.update(nonholonomic_pairs(scene, q, qd))
     return pairs
 
 
@@ -361,6 +371,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "reactions": reaction_scale(scene, q, qd, state_wrench(scene, q)),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
         **loop_scales(scene, values, q, qd, qdd_scale),
+        **{row: norm(row) for row in NONHOLONOMIC if row in values},
     }
 
 

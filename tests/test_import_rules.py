@@ -70,6 +70,7 @@ RULES = {
     "rt70.wind": ("rt70.errors", "rt70.loads"),
     "rt70.kkt": ("rt70.errors",),
     "rt70.baumgarte": ("rt70.errors",),
+    "rt70.nonholonomic": ("rt70.errors", "rt70.kkt"),
 }
 
 

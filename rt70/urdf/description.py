@@ -152,6 +152,26 @@ class JointSpring:
 
 
 @dataclass(frozen=True)
+class NoSlip:
+    """A linear velocity constraint ``A(q) q̇ = 0`` (``<rt70:no_slip>``, source 002 (1.1)).
+
+    The material point of ``link`` at ``xyz`` (link frame), or, for a wheel of
+    ``radius`` a > 0, the material point at ``xyz − a n`` (``n`` the ground's unit
+    ``normal`` in ground axes: the wheel's contact point), has no velocity along the
+    unit ``direction`` fixed in the axes of link ``frame``:
+    ``dᵀ (v_p + a n × ω) = 0`` — see :mod:`rt70.urdf.no_slip` and docs/nonholonomic.md.
+    """
+
+    name: str
+    link: str
+    xyz: np.ndarray
+    direction: np.ndarray
+    frame: str
+    radius: float = 0.0
+    normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+
+@dataclass(frozen=True)
 class OpticalPoint:
     """A named point of a link (mirror focus or vertex)."""
 
@@ -287,6 +307,8 @@ class RobotDescription:
         Air density ρ of ``<rt70:air>``, kg/m³ (default: ISA sea level, 1.225).
     loops : list of Loop
         Loop closures (``<rt70:loop>``), in document order.
+    no_slips : tuple of NoSlip
+        Linear velocity constraints (``<rt70:no_slip>``), in document order.
     """
 
     name: str
@@ -303,6 +325,7 @@ class RobotDescription:
     winds: tuple[Wind, ...] = ()
     air_density: float = DEFAULT_AIR_DENSITY
     loops: list[Loop] = field(default_factory=list)
+    no_slips: tuple[NoSlip, ...] = ()
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

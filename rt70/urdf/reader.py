@@ -39,6 +39,7 @@ from rt70.urdf.description import (
 )
 from rt70.urdf.drives import read_drive
 from rt70.urdf.inertia import balanced_moments, inertia_defect, principal_moments
+from rt70.urdf.no_slip import read_no_slip
 from rt70.urdf.text import (
     EXPAND_XACRO,
     RT70_NS,
@@ -71,6 +72,7 @@ _EXTENSIONS = (
     "wind",
     "air",
     "loop",
+    "no_slip",
 )
 #: Kinds of ``<rt70:loop>`` and their number of constraint rows.
 LOOP_TYPES = {"point": 3, "frame": 6}
@@ -422,6 +424,7 @@ class _Reader:
         gravity_seen = False
         winds: list = []
         air: list[float] = []
+        no_slips: list = []
         joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
         for elem in root:
             if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
@@ -450,14 +453,19 @@ class _Reader:
                 if air:
                     raise self.fail(ExtensionError, "more than one <rt70:air>")
                 air.append(read_air(self, elem))
+            elif kind == "no_slip":
+                no_slips.append(read_no_slip(self, elem, desc, no_slips))
             else:
                 name = self.name_of(elem)
                 link = self.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
                 desc.optical_points.append(OpticalPoint(name, link, self.numbers(elem, "xyz", 3)))
-        if not (winds or air):
+        if not (winds or air or no_slips):
             return desc
         return dataclasses.replace(
-            desc, winds=tuple(winds), air_density=air[0] if air else desc.air_density
+            desc,
+            winds=tuple(winds),
+            air_density=air[0] if air else desc.air_density,
+            no_slips=tuple(no_slips),
         )
 
     def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
