@@ -9,6 +9,10 @@ matrix (erratum X.3.11: plain CG breaks down where the range-space method does n
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse.linalg
@@ -331,40 +335,46 @@ def test_kkt_matrix_is_indefinite_and_plain_cg_breaks_down(crank_slider_start):
     assert np.linalg.norm(B @ sol.x - g) <= 1e-12 * np.linalg.norm(g)
 
 
-def test_modes_refuses_a_scene_with_loops(capsys):
-    """The tree's linearisation would ignore the loops: refused, not a wrong answer."""
-    assert rt70.cli.main(["modes", "four_bar"]) == 2
-    err = capsys.readouterr().err.splitlines()
-    assert err == [
-        "rt70: error: four_bar: closed chains (<rt70:loop>): rt70 modes takes trees only"
-    ]
+def test_modes_of_the_crank_slider_on_its_table_is_one_rigid_mode(capsys):
+    """Gravity normal to its plane: one motion the loops leave, held by nothing — a rigid
+    mode on the manifold (not the tree's three, not a refusal)."""
+    assert rt70.cli.main(["modes", "crank_slider", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["constraints"]["loop_rows"] == 3 and out["constraints"]["rank"] == 2
+    assert [m["kind"] for m in out["modes"]] == ["rigid"]
 
 
-def test_cli_simulate_crank_slider_reports_the_residual(capsys):
-    args = ["simulate", "crank_slider", "--t-end", "0.5", "--method", "DOP853", "--rtol", "1e-10"]
-    assert rt70.cli.main(args) == 0
-    out = capsys.readouterr().out
-    line = next(x for x in out.splitlines() if "constraints: max |Φ|" in x)
-    assert float(line.split("=")[1].split()[0]) <= 1e-10
-    assert "T0 = 0.5 J" in out  # the closed start at 10 rad/s
+def test_rt70_modes_of_the_four_bar_match_its_simulated_small_oscillation():
+    """``rt70 modes four_bar`` (textbook side, on the manifold, with the multipliers'
+    geometric stiffness) against the period of a small oscillation integrated with
+    Pinocchio's ``constraintDynamics``: an independent check of the constrained modes."""
+    from rt70.linear.constrained_scene import constrained_linearize, constrained_modes
+    from rt70.scenes.loop_scenes import start_state
 
-
-def test_saved_result_carries_the_residual(tmp_path):
-    scene = load_scene("crank_slider")
-    result = simulate(scene, (0.0, 0.05), method="DOP853", rtol=1e-8)
-    result.save(tmp_path / "run.npz")
-    result.save(tmp_path / "run.csv")
-    saved = np.load(tmp_path / "run.npz")
-    np.testing.assert_array_equal(saved["constraint_residual"], result.constraint_residual)
-    header = (tmp_path / "run.csv").read_text(encoding="utf-8").splitlines()[0].split(",")
-    assert header[-1] == "constraint_residual"
-
-
-def test_validate_rows_of_a_frame_loop():
-    """A weld (6 rows, rank 1): the rows compared on the manifold (rt70.loop_check)."""
-    from rt70.validate import cross_check
-
-    scene = scene_from_text(welded(), "welded")
-    records = {r.quantity: r for r in cross_check(scene, samples=3, seed=4, repeat=0)}
-    for name in ("loop_residual", "loop_jacobian", "loop_bias", "loop_dynamics", "loop_reaction"):
-        assert records[name].max_rel_err <= TOL, (name, records[name].max_rel_err)
+    out = subprocess.run(
+        [sys.executable, "-m", "rt70", "modes", "four_bar", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    f_cli = json.loads(out.stdout)["modes"][0]["freq_hz"]
+    scene = load_scene("four_bar")
+    model = constrained_linearize(
+        scene,
+        tl.loop_residual,
+        tl.loop_jacobian,
+        q_start=start_state(scene)[0],
+        descend=True,
+    )
+    assert constrained_modes(model)["modes"][0]["freq_hz"] == f_cli
+    qe = model.equilibrium.q
+    assert np.linalg.eigvalsh(model.reduced.K_r).min() > 0  # the stable equilibrium
+    q0, qd0 = assemble(scene, qe + np.array([1e-4, 0.0, 0.0]), keep=["crank_joint"])
+    t = np.linspace(0.0, 3.0 / f_cli, 3001)
+    run = simulate(scene, (0.0, t[-1]), (q0, qd0), method="DOP853", rtol=1e-11, t_eval=t)
+    x = run.q[:, 0] - qe[0]
+    up = np.where((x[:-1] < 0) & (x[1:] >= 0))[0]
+    crossings = t[up] - x[up] * (t[up + 1] - t[up]) / (x[up + 1] - x[up])
+    assert len(crossings) >= 2
+    f_sim = (len(crossings) - 1) / (crossings[-1] - crossings[0])
+    assert abs(f_sim / f_cli - 1) < 1e-7
