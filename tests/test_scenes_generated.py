@@ -20,6 +20,7 @@ NS = {"rt70": RT70_NS}
 EXPECTED_NV = {
     "rt70": 42,
     "rt70_servo": 42,
+    "rt70_jack": 44,
     "rt70_elevation": 6,
     "rt70_azimuth": 7,
     "rt70_azimuth_el90": 7,

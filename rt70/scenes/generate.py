@@ -261,6 +261,66 @@ def _torsional_scene(
     return uw.end(w)
 
 
+#: The elevation jack of the ``rt70_jack`` scene (issue 12: the RT-70 with one closed
+#: loop). The book's RT-70 drives the elevation through a gear sector; this jack is an
+#: illustrative linkage of our own, not the telescope's: a hydraulic-cylinder-like pair
+#: pinned on the alidade (``platform``) 16 m from the counterweight's origin along −y,
+#: level with it, turning about x, a piston sliding along it, the piston's end pinned to
+#: the counterweight (``<rt70:loop type="point">``, three rows). Uniform rods of steel
+#: tube size, masses our assumption (negligible beside the 1570 t structure).
+RT70_JACK = {
+    "pivot": (0.0, -16.0, 36.0),  # on the platform, m: the counterweight's origin − 16 m y
+    "cylinder": (8.0, 8000.0, 0.3),  # length m, mass kg, radius m
+    "piston": (8.0, 4000.0, 0.2),  # its far end is 16 m from the pivot at q = 0
+}
+
+
+def _rt70_jack(w: uw.Writer) -> None:
+    """The elevation jack (:data:`RT70_JACK`): two bodies and the loop on the counterweight."""
+    from rt70.scenes.loop_scenes import loop
+
+    jack = RT70_JACK
+    w.comment("Elevation jack (issue 12 test linkage, not the book's drive): cylinder, piston")
+    pivot = jack["pivot"]
+    uw.joint(w, "jack_pivot", "revolute", "platform", "jack_cylinder", pivot, axis=(1, 0, 0))
+    length, mass, radius = jack["cylinder"]
+    transverse = mass * length**2 / 12.0
+    axial = 0.5 * mass * radius**2
+    uw.massive_link(
+        w, "jack_cylinder", mass, (transverse, axial, transverse), com=(0.0, length / 2.0, 0.0)
+    )
+    uw.joint(w, "jack_stroke", "prismatic", "jack_cylinder", "jack_piston", axis=(0, 1, 0))
+    p_length, p_mass, p_radius = jack["piston"]
+    reach = -jack["pivot"][1]
+    p_transverse = p_mass * p_length**2 / 12.0
+    uw.massive_link(
+        w,
+        "jack_piston",
+        p_mass,
+        (p_transverse, 0.5 * p_mass * p_radius**2, p_transverse),
+        com=(0.0, reach - p_length / 2.0, 0.0),
+    )
+    loop(w, "jack_counterweight", "jack_piston", "counterweight", xyz1=(0.0, reach, 0.0))
+
+
+def rt70_jack_scene() -> str:
+    """The 42-DOF RT-70 with an elevation jack closing one loop (issue 12's cost target).
+
+    Returns
+    -------
+    str
+        URDF text: :func:`rt70_scene`'s bodies and elements and the jack of
+        :data:`RT70_JACK` — 44 coordinates, 3 loop rows.
+    """
+    return _rt70_text(
+        "rt70_jack",
+        "RT-70 42-DOF model with an elevation jack closing one loop (an illustrative "
+        "linkage for issue 12, not the book's gear-sector drive)",
+        rt70_data.LISTING_BODIES,
+        drives=_rt70_jack,
+    )
+
+
 def rt70_elevation_scene() -> str:
     """Build the chapter-2 elevation model (§2.4, 6 masses, Γβ).
 
@@ -529,6 +589,7 @@ def gear_reducer_scene() -> str:
 SCENES: dict[str, Callable[[], str]] = {
     "rt70": rt70_scene,
     "rt70_servo": rt70_servo_scene,
+    "rt70_jack": rt70_jack_scene,
     "rt70_elevation": rt70_elevation_scene,
     "rt70_azimuth": rt70_azimuth_scene,
     "rt70_azimuth_el90": rt70_azimuth_el90_scene,

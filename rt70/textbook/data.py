@@ -33,6 +33,8 @@ class Data:
         Block-diagonal inertia ``Θ = diag(Θ_k)``, shape (6 nb, 6 nb).
     V : numpy.ndarray
         Absolute body velocities ``V⁰ = Sᵀ q̇`` (4.63), shape (nb, 6).
+    S_dot : numpy.ndarray
+        Structure rate Ṡ (4.81) of the last bias evaluation, shape of S.
     A : numpy.ndarray
         Mass matrix ``S Θ Sᵀ`` (4.79).
     """
@@ -52,4 +54,5 @@ class Data:
         for j in range(nb):
             self.Theta[6 * j : 6 * j + 6, 6 * j : 6 * j + 6] = model.Theta[j]
         self.V = np.zeros((nb, 6))
+        self.S_dot = np.zeros_like(self.S)
         self.A = np.zeros((nv, nv))

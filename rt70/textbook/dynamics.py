@@ -70,7 +70,7 @@ def _bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.
     """B of (4.80) for the configuration already in ``data`` (L, S up to date)."""
     S = data.S
     V = body_velocities(model, data, qd)
-    S_dot = structure_matrix_rate(model, data, q, qd)
+    S_dot = data.S_dot = structure_matrix_rate(model, data, q, qd)  # kept for the loops' C
     Phi0 = np.zeros_like(data.Theta)
     for k in range(model.nb):
         Phi0[6 * k : 6 * k + 6, 6 * k : 6 * k + 6] = crf(V[k])

@@ -98,10 +98,17 @@ def loop_jacobian(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
     return _jacobian_here(model, data)
 
 
-def _bias_here(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """C for the configuration in ``data`` (body velocities set by this call)."""
+def _bias_here(
+    model: Model, data: Data, q: np.ndarray, qd: np.ndarray, S_dot: np.ndarray | None = None
+) -> np.ndarray:
+    """C for the configuration in ``data`` (body velocities set by this call).
+
+    ``S_dot``: the structure rate Ṡ (4.81) at (q, q̇) when already computed (the bias
+    force's, ``data.S_dot``), else computed here.
+    """
     body_velocities(model, data, qd)
-    S_dot = structure_matrix_rate(model, data, q, qd)
+    if S_dot is None:
+        S_dot = structure_matrix_rate(model, data, q, qd)
     Vdot = (S_dot.T @ qd).reshape(model.nb, 6)
     parts = [
         _acceleration(data, lp.body1, lp.r1, Vdot, lp.rows)
@@ -168,7 +175,7 @@ def constrained_forward_dynamics(
         f = f + check_vector("Q", Q, model.nv)
     A = data.S @ data.Theta @ data.S.T
     B_c = _jacobian_here(model, data)
-    C = _bias_here(model, data, q, qd)
+    C = _bias_here(model, data, q, qd, S_dot=data.S_dot)  # Ṡ of the bias force above
     residual = np.concatenate([_residual(data, loop) for loop in model.loops] or [np.zeros(0)])
     g = consistent_rhs(B_c, constraint_rhs(C, B_c @ qd, residual, stabilization))
     sol = solve_kkt(A, B_c, f, g)
