@@ -185,46 +185,34 @@ def _modes(args: argparse.Namespace) -> int:
 
 
 def _loop_modes(args: argparse.Namespace, scene, held: dict) -> tuple:
-    """The modes of a closed-chain scene on its constraint manifold (textbook side).
+    """Modes of a closed-chain scene on its manifold (textbook side; docs/constrained-modes.md).
 
-    From a closed start (the mechanism's own, or the zero state closed by
-    :func:`rt70.closed_chains.assemble`), the stable equilibrium with the loops closed
-    (Newton descending where the stiffness is negative), the null-space reduction with the
-    multipliers' geometric stiffness (:mod:`rt70.linear.constrained_scene`); returns the
-    modes, their shapes in the tree coordinates, the full-coordinate model, the damped
-    modes and the ``constraints`` entry of the JSON output.
+    From the mechanism's closed start, or the zero state closed by
+    :func:`rt70.closed_chains.assemble`; the stable equilibrium (Newton descending where
+    the stiffness is negative). Returns modes, shapes, model, damped modes, constraints.
     """
     import numpy as np
 
     from rt70.closed_chains import assemble
-    from rt70.linear import constrained as cm
-    from rt70.linear import modal
-    from rt70.linear.constrained_scene import constrained_linearize
+    from rt70.linear import constrained_scene as cs
     from rt70.scenes.loop_scenes import start_state
     from rt70.textbook import loops
 
-    start = start_state(scene)  # a closed start of the repository's mechanisms
-    q_start = start[0] if start is not None else assemble(scene, np.zeros(scene.textbook.nv))[0]
+    start = start_state(scene)
+    q = start[0] if start is not None else assemble(scene, np.zeros(scene.textbook.nv))[0]
     for name, value in held.items():
-        q_start[scene.textbook.coordinate_names.index(name)] = value
-    model = constrained_linearize(
+        q[scene.textbook.coordinate_names.index(name)] = value
+    model = cs.constrained_linearize(
         scene,
         loops.loop_residual,
         loops.loop_jacobian,
         held,
-        lock_held=args.lock_axes,
-        q_start=q_start,
+        args.lock_axes,
+        q_start=q,
         descend=True,
     )
-    red = model.reduced
-    spectrum = cm.modes(red)
-    constraints = {
-        "loop_rows": model.loop_rows,
-        "rank": red.rank,
-        "multipliers": model.equilibrium.lam[: model.loop_rows].tolist(),
-    }
-    damped = modal.damped_modes(red.M_r, red.K_r, red.D_r)
-    return spectrum.modes, spectrum.shapes, model, damped, constraints
+    modes, shapes, damped, constraints = cs.spectrum(model)
+    return modes, shapes, model, damped, constraints
 
 
 #: Above this elevation (degrees) the pointing corrections are not given (zenith keyhole).

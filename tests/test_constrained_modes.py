@@ -321,11 +321,17 @@ def test_a_rigid_mechanism_has_no_modes():
         cm.linearize(both, eq.q, eq.lam, M, np.zeros((2, 2)))
 
 
-def test_a_free_direction_has_no_equilibrium():
-    """No gravity: nothing holds the particle anywhere on its circle."""
-    con, _, _ = particle()
-    with pytest.raises(Rt70Error, match="singular"):
-        cm.equilibrium(lambda q: np.zeros(2), con, np.array([0.4, -1.0]))
+def test_a_free_direction_is_neutral_without_a_force_and_refused_with_one():
+    """No gravity: every point of the circle is an equilibrium (the start is closed onto
+    it, a rigid mode). A force along a direction nothing holds: no equilibrium."""
+    con, _, M = particle()
+    eq = cm.equilibrium(lambda q: np.zeros(2), con, np.array([0.4, -1.0]))
+    assert abs(np.hypot(*eq.q) - 1.5) < 1e-12
+    lin = cm.linearize(con, eq.q, eq.lam, M, np.zeros((2, 2)))
+    assert cm.modes(lin).modes.rigid.all()
+    on_a_line = cm.Constraints(lambda q: q[1:], lambda q: np.array([[0.0, 1.0]]))
+    with pytest.raises(Rt70Error, match="singular.*a force acts along it"):
+        cm.equilibrium(lambda q: np.array([1.0, 0.0]), on_a_line, np.array([0.4, -1.0]))
 
 
 def test_wrong_shapes_are_refused():

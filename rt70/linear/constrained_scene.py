@@ -236,27 +236,37 @@ def constrained_linearize(
     )
 
 
+def spectrum(model: SceneConstrainedModel) -> tuple[modal.Modes, np.ndarray, Any, dict]:
+    """Modes of the reduced model, shapes, damped modes and the ``constraints`` entry.
+
+    The shapes are in the tree coordinates (``N φ``), the damped modes those of the
+    reduced system; ``constraints`` holds the loop rows, their rank at q* (with the held
+    coordinates when locked) and the loop multipliers.
+    """
+    red = model.reduced
+    result = cm.modes(red)
+    constraints = {
+        "loop_rows": model.loop_rows,
+        "rank": red.rank,
+        "multipliers": model.equilibrium.lam[: model.loop_rows].tolist(),
+    }
+    return result.modes, result.shapes, modal.damped_modes(red.M_r, red.K_r, red.D_r), constraints
+
+
 def constrained_modes(model: SceneConstrainedModel) -> dict:
     """The modes of a closed-chain scene in the form ``rt70 modes --json`` prints.
 
     The keys of ``rt70 modes --json`` (``scene``, ``held``, ``locked_rotor``, ``modes``,
-    ``damped``) and ``constraints``: the loop rows, their rank at q* (with the held
-    coordinates when locked) and the loop multipliers. The mode shapes are in the full
+    ``damped``) and ``constraints`` (:func:`spectrum`). The mode shapes are in the full
     tree coordinates (``N φ``) and the dominant coordinate is chosen by kinetic energy in
     them; the damped system is the reduced one.
     """
-    red = model.reduced
-    spectrum = cm.modes(red)
-    damped = modal.damped_modes(red.M_r, red.K_r, red.D_r)
+    modes, shapes, damped, constraints = spectrum(model)
     return {
         "scene": model.scene,
         "held": model.held,
         "locked_rotor": model.locked_rotor,
-        "constraints": {
-            "loop_rows": model.loop_rows,
-            "rank": red.rank,
-            "multipliers": model.equilibrium.lam[: model.loop_rows].tolist(),
-        },
-        "modes": mode_table.mode_rows(spectrum.modes, spectrum.shapes, model.M, model.coordinates),
-        "damped": mode_table.damped_summary(spectrum.modes, damped),
+        "constraints": constraints,
+        "modes": mode_table.mode_rows(modes, shapes, model.M, model.coordinates),
+        "damped": mode_table.damped_summary(modes, damped),
     }
