@@ -5,7 +5,8 @@ quantities — the dynamics, the positions of the links' origins and of the scen
 optical points (:mod:`rt70.outputs`), the generalised force of a random load (:mod:`rt70.loads`)
 and the angle and generalised force at unit torque of the scene's drives (``<rt70:drive>``)
 and of a random gear sector, and, for a scene with ``<rt70:wind>`` elements, the wind's
-generalised force under a random steady wind (row ``wind``);
+generalised force under a random steady wind (row ``wind``), and a random brake and
+stow pin engaging (rows ``impact`` and ``impulse``, :mod:`rt70.impact_check`);
 every row of the report gives the largest absolute error, the largest
 error relative to the reference's max-norm, and the mean wall time per evaluation of
 each side.
@@ -21,6 +22,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.impact_check import impact_pairs, impact_scales
 from rt70.loads import Wrench
 from rt70.outputs import Output, evaluate, optical_point_outputs, position_output
 from rt70.scene import Scene, require_coordinates
@@ -45,6 +47,8 @@ QUANTITIES = (
     "points",
     "load_force",
     "drives",
+    "impact",
+    "impulse",
 )
 
 #: Compared after :data:`QUANTITIES` for a scene with ``<rt70:wind>`` elements only.
@@ -250,6 +254,7 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
             lambda: _stacked_drives(ref_drives.drive_force, ref, rd, q, compared_drives),
         ),
     }
+    pairs.update(impact_pairs(scene, q, qd))  # a random brake and stow pin (15)
     if scene.description.winds:  # Q_w = S W and Jᵀ f (4.132)–(4.136), a random wind
         wind = state_wind(q)
         pairs[WIND] = (
@@ -350,6 +355,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
         "load_force": _load_scale(scene, q),
         "drives": norm("drives"),
+        **impact_scales(scene, q, qd),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
     }
 
