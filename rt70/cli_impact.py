@@ -144,13 +144,13 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         out = {
             "scene": scene.name,
-            "locks": labels(locks),
+            "locks": labels(locks),  # one label per impulse (a lock given twice: twice)
             "restitution": impact.restitution,
             "coordinates": names,
             "q": q.tolist(),
             "qd_before": impact.qd_before.tolist(),
             "qd_after": impact.qd_after.tolist(),
-            "impulses": dict(zip(labels(locks), impact.impulses.tolist(), strict=True)),
+            "impulses": impact.impulses.tolist(),  # in the order of "locks"
             "rank": impact.rank,
             "kinetic_before": impact.kinetic_before,
             "kinetic_after": impact.kinetic_after,

@@ -310,6 +310,8 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
       the ground origin (a position is a sum of the bodies' offsets);
     - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
       ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel.
+    - impact, impulse (q̇⁺ and Λ of a random brake and stow pin): their first-order
+      rounding bounds, entry by entry (:func:`rt70.impact_check.impact_scales`).
 
     Raises
     ------

@@ -200,6 +200,7 @@ def test_cli_impact_json_and_text(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["qd_after"][0] == pytest.approx(1.625, rel=1e-12)  # (A q̇⁻)₁/A₁₁ at q = 0
     assert out["energy_lost"] == pytest.approx(out["carnot"], rel=1e-12)
+    assert out["impulses"] == [pytest.approx(-7.0 / 48.0, rel=1e-12)]  # (A Δq̇)₂
     assert out["pinocchio"]["max_rel_err_impulses"] < 1e-12
     assert main([*argv, "--after", "0.1"]) == 0
     text = capsys.readouterr().out
