@@ -252,3 +252,28 @@ def test_pinocchio_needs_independent_rows_for_the_least_norm_impulse():
     np.testing.assert_allclose(qd1, ours.qd_after, atol=1e-13)
     # reduced rows: the least-norm impulse of the pin's own rows
     np.testing.assert_allclose(lam, solve_impact(A, rows, qd).impulses, atol=1e-13)
+
+
+ONE_AXIS = """<?xml version="1.0"?>
+<robot name="one_axis">
+  <link name="world"/>
+  <link name="arm"><inertial><origin xyz="0.5 0.1 0"/><mass value="2"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="world"/><child link="arm"/>
+    <axis xyz="0.3 0.4 0.866"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_one_coordinate_pin_and_brake_agree():
+    """nv = 1: Pinocchio's frame Jacobian comes back as a vector (found by random trees)."""
+    from rt70.scene import scene_from_text
+
+    scene = scene_from_text(ONE_AXIS, "one_axis")
+    q, qd = np.array([0.4]), np.array([1.5])
+    for locks in ([StowPin("arm", np.array([0.3, -0.2, 0.5]))], [Brake("hinge")]):
+        a = engage(scene, q, qd, locks, "textbook", 0.2)
+        b = engage(scene, q, qd, locks, "reference", 0.2)
+        assert a.rank == b.rank == 1
+        np.testing.assert_allclose(a.qd_after, [-0.2 * 1.5], rtol=1e-13)  # one row holds it
+        np.testing.assert_allclose(a.impulses, b.impulses, rtol=1e-13)

@@ -79,6 +79,7 @@ def pin_rows(
     placement = frame.placement * pin.SE3(np.eye(3), check_vector(f"point of {link}", xyz, 3))
     pin.computeJointJacobians(m, d, qp)
     local = pin.getFrameJacobian(m, d, frame.parentJoint, placement, pin.LOCAL)
+    local = np.reshape(local, (6, m.nv))  # (6,) when nv = 1
     rotation = (d.oMi[frame.parentJoint] * placement).rotation
     return rotation @ local[:3]
 
