@@ -22,10 +22,12 @@ KKT matrix, which needs independent rows: dependent ones (a pin on a planar mech
 two locks that overlap) are first reduced to an orthonormal basis of the row space,
 ``Ĵ = U_rᵀ J_c`` (SVD, :data:`RANK_RTOL`), and ``Λ = U_r Λ̂`` is then the least-norm
 impulse, as the textbook's :func:`rt70.kkt.solve_kkt`. Where the book's coordinates
-are not Pinocchio's ``v = J q̇`` adds the rows ``N v = 0`` (``N J = 0``: mimic joints)
-to the reduced set and the impulses are projected onto the row space of the book's
-``B_c = J_c J``. Known impulses Γ (book coordinates, the sign of :mod:`rt70.impact`)
-come in by linearity: a second ``impulseDynamics`` from ``v⁻ = J A⁻¹ Γ`` with e = 0.
+are Pinocchio's ``v = J q̇`` with J square (continuous, floating, planar joints, a
+reordering), Pinocchio solves in ``v`` and ``q̇⁺ = J⁻¹ v⁺``; with mimic joints (J tall)
+the reduced equations are solved in the book's coordinates with Pinocchio's CRBA, as
+the forward dynamics does (:func:`_reduced_impact`). Known impulses Γ (book coordinates,
+the sign of :mod:`rt70.impact`) come in by linearity: a second ``impulseDynamics`` from
+``v⁻ = J A⁻¹ Γ`` with e = 0.
 """
 
 from __future__ import annotations
@@ -34,7 +36,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import pinocchio as pin
-import scipy.linalg
 
 from rt70.arrays import check_vector
 from rt70.errors import Rt70Error, UnknownLinkError
@@ -154,30 +155,52 @@ def impulse_dynamics(
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     m, d = model.pin_model, data.pin_data
     J_c = constraint_rows(model, data, q, brakes, pins)
-    n_c = J_c.shape[0]
-    rows = J_c
-    if J is not None and J.shape[0] > J.shape[1]:  # mimic joints: v stays in range(J)
-        rows = np.vstack([J_c, scipy.linalg.null_space(J.T).T])
-    U_r, J_hat = _reduced(rows)
+    gam = None if gamma is None else check_vector("gamma", gamma, model.nv)
+    if J is not None and J.shape[0] > J.shape[1]:
+        return _reduced_impact(model, data, q, qd, J_c @ J, restitution, gam)
+    U_r, J_hat = _reduced(J_c)
 
     def solve(v_before: np.ndarray, e: float) -> tuple[np.ndarray, np.ndarray]:
         if not J_hat.shape[0]:  # the rows vanish here: nothing holds, nothing changes
-            return np.array(v_before, dtype=float), np.zeros(rows.shape[0])
+            return np.array(v_before, dtype=float), np.zeros(J_c.shape[0])
         v_after = pin.impulseDynamics(m, d, qp, v_before, J_hat, e, 0.0)
         return np.array(v_after), U_r @ np.array(d.impulse_c)
 
     v_after, lam = solve(vp, restitution)
-    if gamma is not None:
-        gam = check_vector("gamma", gamma, model.nv)
+    if gam is not None:
         extra = np.linalg.solve(mass_matrix(model, data, q), gam)  # A⁻¹ Γ
         v2, lam2 = solve(extra if J is None else J @ extra, 0.0)
         v_after, lam = v_after + v2, lam + lam2
-    lam = lam[:n_c]
     if J is None:
         return v_after, lam
-    qd_after = np.linalg.lstsq(J, v_after, rcond=None)[0]
-    B_c = J_c @ J
-    if rows.shape[0] > n_c and n_c:  # least-norm impulses of the book's rows
-        basis = scipy.linalg.orth(B_c)
-        lam = basis @ (basis.T @ lam)
-    return qd_after, lam
+    return np.linalg.solve(J, v_after), lam
+
+
+def _reduced_impact(
+    model: ReferenceModel,
+    data: ReferenceData,
+    q: np.ndarray,
+    qd: np.ndarray,
+    B_c: np.ndarray,
+    restitution: float,
+    gamma: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The impact in the book's coordinates, for models with mimic joints.
+
+    Pinocchio's ``v`` then has more entries than the book's q̇ and ``impulseDynamics``
+    would need the mimic couplings as extra rows, which loses every digit when a mimic
+    factor is large (10³⁰ in tests/test_urdf_reading.py). As the forward dynamics does
+    (:func:`rt70.reference.dynamics.forward_dynamics`), the reduced equations
+    ``A = Jᵀ crba J`` with the rows ``B_c = J_c J`` are solved instead — the KKT matrix
+    of an orthonormal basis of the rows by LU (numpy), not by the textbook's
+    range-space method.
+    """
+    n = model.nv
+    A = mass_matrix(model, data, q)
+    U_r, B_hat = _reduced(B_c)
+    r = B_hat.shape[0]
+    gam = np.zeros(n) if gamma is None else gamma
+    K = np.block([[A, B_hat.T], [B_hat, np.zeros((r, r))]])
+    rhs = np.concatenate([A @ qd + gam, -restitution * (B_hat @ qd)])
+    sol = np.linalg.solve(K, rhs)
+    return sol[:n], U_r @ -sol[n:]  # A x + B̂ᵀ y = f: y = −Λ̂
