@@ -58,17 +58,33 @@ def impact_values(scene: Scene, q: np.ndarray, qd: np.ndarray, side: str) -> dic
 
 
 def impact_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict:
-    """``{row: (textbook evaluation, reference evaluation)}`` for :mod:`rt70.validate`."""
+    """``{row: (textbook evaluation, reference evaluation)}`` for :mod:`rt70.validate`.
+
+    One solve per side gives both rows: each side's first evaluation is kept for the
+    other row's first (value) call; every later (timed) call solves afresh.
+    """
+    kept: dict[tuple[str, str], np.ndarray] = {}
+
+    def evaluate(side: str, name: str) -> np.ndarray:
+        if (side, name) in kept:
+            return kept.pop((side, name))
+        values = impact_values(scene, q, qd, side)
+        other = IMPACT_ROWS[1 - IMPACT_ROWS.index(name)]
+        kept.setdefault((side, other), values[other])
+        return values[name]
+
     return {
         name: (
-            lambda name=name: impact_values(scene, q, qd, "textbook")[name],
-            lambda name=name: impact_values(scene, q, qd, "reference")[name],
+            lambda name=name: evaluate("textbook", name),
+            lambda name=name: evaluate("reference", name),
         )
         for name in IMPACT_ROWS
     }
 
 
-def impact_scales(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict:
+def impact_scales(
+    scene: Scene, q: np.ndarray, qd: np.ndarray, reference_values: dict | None = None
+) -> dict:
     """Natural scales of the rows: first-order rounding bounds, entry by entry.
 
     From Pinocchio's A, the reference side's rows B_c and its results, with
@@ -80,18 +96,26 @@ def impact_scales(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict:
     - ``impulse`` (Λ), per row: ``|W⁺ B_c A⁻¹| (|A| |Δq̇| + |B_c|ᵀ |Λ|)
       + |W⁺| |B_c| ((1 + e) |q̇⁻| + |Δq̇|)``, from ``δΛ = W⁺ (δr − δW Λ)`` with
       ``r = −(1 + e) B_c q̇⁻``.
+
+    ``reference_values``: the reference side's ``{"impact": …, "impulse": …}`` at this
+    state (:func:`impact_values`), if already computed.
     """
     from rt70 import reference
 
     A = reference.mass_matrix(scene.reference, scene.reference_data, q)
     A_inv = np.linalg.inv(A)
     absA, absq = np.abs(A), np.abs(qd)
+    if reference_values is None:
+        reference_values = impact_values(scene, q, qd, "reference")
     speeds, impulses = [], []
+    at_v, at_l = 0, 0
     for locks, e in state_locks(scene, q):
         B = constraint_rows(scene, q, locks, "reference")
-        r = engage(scene, q, qd, locks, "reference", e)
-        lam, dv = np.abs(r.impulses), np.abs(r.qd_after - qd)
-        speeds.append(np.abs(A_inv) @ (absA @ (absq + np.abs(r.qd_after)) + np.abs(B).T @ lam))
+        qd_after = reference_values["impact"][at_v : at_v + q.size]
+        lam = np.abs(reference_values["impulse"][at_l : at_l + B.shape[0]])
+        at_v, at_l = at_v + q.size, at_l + B.shape[0]
+        dv = np.abs(qd_after - qd)
+        speeds.append(np.abs(A_inv) @ (absA @ (absq + np.abs(qd_after)) + np.abs(B).T @ lam))
         W_pinv = np.linalg.pinv(B @ A_inv @ B.T, rcond=1e-10)
         through_A = np.abs(W_pinv @ B @ A_inv) @ (absA @ dv + np.abs(B).T @ lam)
         impulses.append(through_A + np.abs(W_pinv) @ (np.abs(B) @ ((1.0 + e) * absq + dv)))

@@ -357,7 +357,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
         "load_force": _load_scale(scene, q),
         "drives": norm("drives"),
-        **impact_scales(scene, q, qd),
+        **impact_scales(scene, q, qd, {k: values[k][1] for k in ("impact", "impulse")}),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
     }
 
