@@ -21,7 +21,7 @@ import signal
 import sys
 import warnings
 
-from rt70 import cli_cart, cli_pointing, cli_reactions, cli_sweep, options
+from rt70 import cli_cart, cli_impact, cli_pointing, cli_reactions, cli_sweep, options
 from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
@@ -650,6 +650,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.set_defaults(func=_simulate)
     cli_sweep.add_parser(sub)
     cli_cart.add_parser(sub)
+    cli_impact.add_parser(sub)
     return parser
 
 

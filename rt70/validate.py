@@ -5,7 +5,8 @@ quantities — the dynamics, the positions of the links' origins and of the scen
 optical points (:mod:`rt70.outputs`), the generalised force of a random load (:mod:`rt70.loads`)
 and the angle and generalised force at unit torque of the scene's drives (``<rt70:drive>``)
 and of a random gear sector, and, for a scene with ``<rt70:wind>`` elements, the wind's
-generalised force under a random steady wind (row ``wind``);
+generalised force under a random steady wind (row ``wind``), and a random brake and
+stow pin engaging (rows ``impact`` and ``impulse``, :mod:`rt70.impact_check`);
 every row of the report gives the largest absolute error, the largest
 error relative to the reference's max-norm, and the mean wall time per evaluation of
 each side.
@@ -21,6 +22,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.impact_check import impact_pairs, impact_scales
 from rt70.loads import Wrench
 from rt70.loop_check import loop_pairs, loop_quantities, loop_scales
 from rt70.nonholonomic_scene import ROWS as NONHOLONOMIC
@@ -50,6 +52,8 @@ QUANTITIES = (
     "load_force",
     "drives",
     "reactions",
+    "impact",
+    "impulse",
 )
 
 #: Compared after :data:`QUANTITIES` for a scene with ``<rt70:wind>`` elements only.
@@ -263,6 +267,7 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
         # joint reaction wrenches, source 004 (9)–(13) (rt70.reaction_check)
         "reactions": reaction_pair(scene, q, qd, wrench),
     }
+    pairs.update(impact_pairs(scene, q, qd))  # a random brake and stow pin (15)
     if scene.description.winds:  # Q_w = S W and Jᵀ f (4.132)–(4.136), a random wind
         wind = state_wind(q)
         pairs[WIND] = (
@@ -321,6 +326,8 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
       the ground origin (a position is a sum of the bodies' offsets);
     - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
       ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel;
+    - impact, impulse (q̇⁺ and Λ of a random brake and stow pin): their first-order
+      rounding bounds, entry by entry (:func:`rt70.impact_check.impact_scales`);
     - the loop rows of a scene with ``<rt70:loop>``: :func:`rt70.loop_check.loop_scales`.
 
     Raises
@@ -369,6 +376,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "load_force": _load_scale(scene, q),
         "drives": norm("drives"),
         "reactions": reaction_scale(scene, q, qd, state_wrench(scene, q)),
+        **impact_scales(scene, q, qd, {k: values[k][1] for k in ("impact", "impulse")}),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
         **loop_scales(scene, values, q, qd, qdd_scale),
         **{row: norm(row) for row in NONHOLONOMIC if row in values},
