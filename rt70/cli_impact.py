@@ -20,6 +20,8 @@ STATES = ("start", "rest", "random")
 
 #: Coordinates listed in the text output at most (the largest velocity changes).
 SHOWN = 12
+#: Joints whose reaction impulses the text output lists (the largest).
+SHOWN_JOINTS = 6
 
 
 def _rate(text: str) -> tuple[str, float]:
@@ -122,7 +124,7 @@ def _state(scene, args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray]:
 
 def run(args: argparse.Namespace) -> int:
     """Check the options, the scene and the locks; solve on both sides; print."""
-    from rt70.locks import check_locks, engage, labels
+    from rt70.locks import check_locks, engage, joint_impulses, labels
     from rt70.scene import load_scene
 
     locks = _locks(args)  # options first
@@ -141,6 +143,11 @@ def run(args: argparse.Namespace) -> int:
     names = list(scene.textbook.coordinate_names)
     err_v = _relative(impact.qd_after, ref.qd_after)
     err_l = _relative(impact.impulses, ref.impulses)
+    shock = joint_impulses(scene, q, impact, locks, "textbook")  # (16), bearing shock loads
+    shock_ref = joint_impulses(scene, q, ref, locks, "reference")
+    err_j = _relative(
+        np.concatenate(list(shock.values())), np.concatenate(list(shock_ref.values()))
+    )
     if args.json:
         out = {
             "scene": scene.name,
@@ -162,7 +169,9 @@ def run(args: argparse.Namespace) -> int:
                 "impulses": ref.impulses.tolist(),
                 "max_rel_err_qd_after": err_v,
                 "max_rel_err_impulses": err_l,
+                "max_rel_err_joint_impulses": err_j,
             },
+            "joint_impulses": {k: v.tolist() for k, v in shock.items()},  # [F; M], joint axes
         }
         if audit is not None:
             out["audit"] = audit.to_dict()
@@ -187,7 +196,15 @@ def run(args: argparse.Namespace) -> int:
         f"lost {impact.energy_lost:.9g} J (Carnot ½Δq̇ᵀAΔq̇ = {impact.carnot:.9g} J); "
         f"balance {impact.balance:.3g} J"
     )
-    print(f"  against Pinocchio's impulseDynamics: q̇⁺ {err_v:.2e}, Λ {err_l:.2e} relative")
+    print("  joint reaction impulses (16), the largest (joint axes; N·s, N·m·s):")
+    size = {k: float(np.abs(v).max()) for k, v in shock.items()}
+    for k in sorted(size, key=size.get, reverse=True)[:SHOWN_JOINTS]:
+        F, M = shock[k][:3], shock[k][3:]
+        print(f"    {k:<28} |F| {np.linalg.norm(F):>12.6g}   |M| {np.linalg.norm(M):>12.6g}")
+    print(
+        f"  against Pinocchio (impulseDynamics; rnea for the joints): q̇⁺ {err_v:.2e}, "
+        f"Λ {err_l:.2e}, joint impulses {err_j:.2e} relative"
+    )
     if audit is not None:
         print(
             f"  energy audit at t = {audit.t:g} s: T {audit.kinetic_before:.9g} → "

@@ -215,3 +215,37 @@ def _order(locks: Sequence[Lock]) -> np.ndarray:
             order.extend(range(pin_at, pin_at + 3))
             pin_at += 3
     return np.array(order, dtype=int)
+
+
+def joint_impulses(
+    scene: Scene, q: np.ndarray, impact: Impact, locks: Sequence[Lock], side: str = "textbook"
+) -> dict[str, np.ndarray]:
+    """Reaction impulses across every URDF joint during the impact (source 004 (16)).
+
+    The two-stage kinetostatics of the impact: the velocity jump ``Δq̇ = q̇⁺ − q̇⁻`` in
+    place of q̈ (no velocity products, gravity's impulse neglected), the pins' impulses
+    Λ as forces on their points (ground axes), computed by ``side``'s
+    ``reaction_impulses`` (:mod:`rt70.textbook.reactions`: R = L W of the body
+    impulses; :mod:`rt70.reference.reactions`: ``rnea(q, 0, Δv, fext)`` with gravity
+    off). A brake's impulse is the braked joint's own: its axis component. Per joint
+    ``[F; M]`` in N·s and N·m·s, the joint's axes, about its origin (docs/reactions.md).
+    """
+    from rt70.loads import Wrench
+
+    if side not in SIDES:
+        raise Rt70Error(f"unknown side '{side}' (choose from {', '.join(SIDES)})")
+    dqd = impact.qd_after - impact.qd_before
+    pins, at = [], 0
+    for lock in locks:
+        if isinstance(lock, StowPin):
+            pins.append(Wrench(lock.link, lock.xyz, impact.impulses[at : at + 3], np.zeros(3)))
+            at += 3
+        else:
+            at += 1
+    if side == "textbook":
+        from rt70.textbook.reactions import reaction_impulses
+
+        return reaction_impulses(scene.textbook, scene.textbook_data, q, dqd, pins)
+    from rt70.reference.reactions import reaction_impulses as ref_reaction_impulses
+
+    return ref_reaction_impulses(scene.reference, scene.reference_data, q, dqd, pins)

@@ -11,7 +11,7 @@ from rt70.errors import Rt70Error, UnknownLinkError
 from rt70.impact import solve_impact
 from rt70.impact_check import impact_scales, impact_values, state_locks
 from rt70.loads import Wrench
-from rt70.locks import Brake, StowPin, check_locks, engage, parse_pin
+from rt70.locks import Brake, StowPin, check_locks, engage, joint_impulses, parse_pin
 from rt70.scene import load_scene
 from rt70.simulate import simulate
 from rt70.textbook import dynamics, points
@@ -277,3 +277,43 @@ def test_one_coordinate_pin_and_brake_agree():
         assert a.rank == b.rank == 1
         np.testing.assert_allclose(a.qd_after, [-0.2 * 1.5], rtol=1e-13)  # one row holds it
         np.testing.assert_allclose(a.impulses, b.impulses, rtol=1e-13)
+
+
+@pytest.mark.parametrize(
+    ("name", "locks"),
+    [
+        ("double_pendulum", [Brake("joint2")]),
+        ("double_pendulum", [StowPin("link2", np.array([0.7, 0.0, 0.0]))]),
+        ("rt70_servo", [Brake("platform_rz")]),
+        ("rt70_servo", [StowPin("platform", np.array([13.45, 0.0, 0.0])), Brake("base_rx")]),
+    ],
+)
+def test_joint_reaction_impulses_agree_and_carry_only_the_brakes_impulse(name, locks):
+    """Source 004 (16): the joints' reaction impulses of an impact, textbook (R = L W of
+    the body impulses) against Pinocchio (rnea(q, 0, Δv, fext)) — and their axis
+    components are the generalised impulses: the brake's Λ at the braked joint, zero at
+    every other joint (springs, bushings and gravity give no impulse)."""
+    scene = load_scene(name)
+    rng = np.random.default_rng(7)
+    q, qd = random_state(scene.textbook.nv, rng)
+    impact = engage(scene, q, qd, locks, "textbook")
+    tb = joint_impulses(scene, q, impact, locks, "textbook")
+    ref = joint_impulses(scene, q, impact, locks, "reference")
+    assert set(tb) == set(ref)
+    scale = max(float(np.abs(np.concatenate(list(ref.values()))).max()), 1e-300)
+    assert scale > 0
+    for joint in tb:
+        np.testing.assert_allclose(tb[joint], ref[joint], rtol=0, atol=1e-10 * scale)
+    braked = {}
+    at = 0
+    for lock in locks:
+        if isinstance(lock, Brake):
+            braked[lock.joint] = impact.impulses[at]
+            at += 1
+        else:
+            at += 3
+    joints = {j.name: j for j in scene.description.joints}
+    for joint, wrench in tb.items():
+        axis = joints[joint].axis
+        along = wrench[3:] @ axis if joints[joint].type != "prismatic" else wrench[:3] @ axis
+        np.testing.assert_allclose(along, braked.get(joint, 0.0), rtol=0, atol=1e-9 * scale)
