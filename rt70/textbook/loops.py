@@ -39,8 +39,9 @@ from rt70.textbook.dynamics import (
     structure_matrix_rate,
 )
 from rt70.textbook.forces import spring_damper_force
-from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure
+from rt70.textbook.kinematics import frame_pose, update_structure
 from rt70.textbook.model import LoopModel, Model
+from rt70.textbook.points import ground_bias_acceleration, ground_jacobian
 
 
 def loop_rows(model: Model) -> int:
@@ -57,22 +58,14 @@ def _residual(data: Data, loop: LoopModel) -> np.ndarray:
     return np.concatenate([p1 - p2, Rotation.from_matrix(R1 @ R2.T).as_rotvec()])
 
 
-def _jacobian(data: Data, body: int, r: np.ndarray, c: np.ndarray, rows: int) -> np.ndarray:
-    """Ground-axis ``[J_v; J_ω]`` (first ``rows`` rows) of a frame fixed to a body."""
-    J = frame_jacobian(data, body, r, c)  # in the frame's own axes (4.63)
-    R, _ = frame_pose(data, body, r, c)
-    return np.vstack([R @ J[:3], R @ J[3:]])[:rows]
+def _jacobian(data: Data, body: int, r: np.ndarray, rows: int) -> np.ndarray:
+    """Ground-axis ``[J_v; J_ω]`` (first ``rows`` rows) of the point r of a body."""
+    return np.vstack(ground_jacobian(data, body, r))[:rows]
 
 
 def _acceleration(data: Data, body: int, r: np.ndarray, Vdot: np.ndarray, rows: int):
     """Ground-axis acceleration of point r of a body (and the body's ω̇) at q̈ = 0."""
-    if body < 0:
-        return np.zeros(rows)
-    v, w = data.V[body, :3], data.V[body, 3:]
-    dv, dw = Vdot[body, :3], Vdot[body, 3:]
-    R = data.R[body]
-    acc = R @ (dv + np.cross(dw, r) + np.cross(w, v + np.cross(w, r)))
-    return acc if rows == 3 else np.concatenate([acc, R @ dw])
+    return np.concatenate(ground_bias_acceleration(data, body, r, Vdot))[:rows]
 
 
 def loop_residual(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
@@ -85,8 +78,7 @@ def loop_residual(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
 def _jacobian_here(model: Model, data: Data) -> np.ndarray:
     """B_c for the configuration already in ``data``."""
     rows = [
-        _jacobian(data, lp.body1, lp.r1, lp.c1, lp.rows)
-        - _jacobian(data, lp.body2, lp.r2, lp.c2, lp.rows)
+        _jacobian(data, lp.body1, lp.r1, lp.rows) - _jacobian(data, lp.body2, lp.r2, lp.rows)
         for lp in model.loops
     ]
     return np.vstack(rows) if rows else np.zeros((0, model.nv))

@@ -23,9 +23,9 @@ import numpy as np
 from rt70.arrays import check_vector
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import body_velocities, structure_matrix_rate
-from rt70.textbook.kinematics import frame_jacobian, update_structure
+from rt70.textbook.kinematics import update_structure
 from rt70.textbook.model import Model
-from rt70.textbook.points import link_point
+from rt70.textbook.points import ground_bias_acceleration, ground_jacobian, link_point
 from rt70.urdf.description import NoSlip
 
 
@@ -43,11 +43,9 @@ def constraint_matrix(
     update_structure(model, data, q)
     A = np.zeros((len(elements), model.nv))
     for i, e in enumerate(elements):
-        body, r = link_point(model, e.link, e.xyz)
-        J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
-        R = np.eye(3) if body < 0 else data.R[body]
+        Jv, Jw = ground_jacobian(data, *link_point(model, e.link, e.xyz))
         d = _frame_rotation(model, data, e.frame)[1] @ e.direction
-        A[i] = d @ (R @ J[:3]) + e.radius * np.cross(d, e.normal) @ (R @ J[3:])
+        A[i] = d @ Jv + e.radius * np.cross(d, e.normal) @ Jw
     return A
 
 
@@ -72,11 +70,10 @@ def constraint_bias(
         if body < 0:
             continue  # a point of the ground: A row and its rate are zero
         v, w = V[body, :3], V[body, 3:]
-        dv, dw = Vdot[body, :3], Vdot[body, 3:]
         R = data.R[body]
-        w_g, dw_g = R @ w, R @ dw
+        w_g = R @ w
         v_p = R @ (v + np.cross(w, r))
-        a_p = R @ (dv + np.cross(dw, r) + np.cross(w, v + np.cross(w, r)))
+        a_p, dw_g = ground_bias_acceleration(data, body, r, Vdot)
         fbody, Rf = _frame_rotation(model, data, e.frame)
         d = Rf @ e.direction
         w_f = np.zeros(3) if fbody < 0 else data.R[fbody] @ V[fbody, 3:]

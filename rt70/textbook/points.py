@@ -72,19 +72,45 @@ def point_position(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> n
     return point_positions(model, data, q, [(link, xyz)])[0]
 
 
+def ground_jacobian(data: Data, body: int, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(J_v, J_ω)`` in ground axes of the point r (body frame) of ``body``, from ``data``.
+
+    ``[v_p; ω]`` in the body's axes is the frame Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63);
+    both rows are turned to ground axes by the body's rotation ``c_0,body``. For the
+    configuration already in ``data`` (:func:`update_structure`); zero for the ground.
+    """
+    J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
+    R, _ = frame_pose(data, body, np.zeros(3), np.eye(3))
+    return R @ J[:3], R @ J[3:]
+
+
+def ground_bias_acceleration(
+    data: Data, body: int, r: np.ndarray, Vdot: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(a_p, ω̇)`` in ground axes of the point r of ``body`` at ``q̈ = 0``.
+
+    With the body's twist ``[v; ω] = Sᵀ q̇`` (``data.V``, body axes) and its rate at
+    q̈ = 0, ``Vdot = Ṡᵀ q̇`` (4.63), (4.81): ``a_p = c (v̇ + ω̇ × r + ω × (v + ω × r))``
+    and ``ω̇ = c ω̇_body``, ``c = c_0,body``. Zero for the ground.
+    """
+    if body < 0:
+        return np.zeros(3), np.zeros(3)
+    v, w = data.V[body, :3], data.V[body, 3:]
+    dv, dw = Vdot[body, :3], Vdot[body, 3:]
+    R = data.R[body]
+    return R @ (dv + np.cross(dw, r) + np.cross(w, v + np.cross(w, r))), R @ dw
+
+
 def point_jacobian(
     model: Model, data: Data, q: np.ndarray, link: str, xyz
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
 
-    ``[v_p; ω]`` in the body's axes is the frame Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63);
-    both rows are turned to ground axes by the body's rotation ``c_0,body``.
+    One forward pass at q, then :func:`ground_jacobian`.
     """
     body, r = link_point(model, link, xyz)
     update_structure(model, data, q)
-    J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
-    R, _ = frame_pose(data, body, np.zeros(3), np.eye(3))
-    return R @ J[:3], R @ J[3:]
+    return ground_jacobian(data, body, r)
 
 
 def generalized_force(model: Model, data: Data, q: np.ndarray, wrench: Wrench) -> np.ndarray:

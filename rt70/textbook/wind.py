@@ -16,9 +16,9 @@ import numpy as np
 from rt70.arrays import check_vector
 from rt70.loads import Wrench
 from rt70.textbook.data import Data
-from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure
+from rt70.textbook.kinematics import frame_pose, update_structure
 from rt70.textbook.model import Model
-from rt70.textbook.points import link_point
+from rt70.textbook.points import ground_jacobian, link_point
 from rt70.wind import WindCondition, wind_wrench
 
 
@@ -27,9 +27,8 @@ def _force(model: Model, data: Data, wrench: Wrench) -> np.ndarray:
     body, r = link_point(model, wrench.link, wrench.xyz)
     if body < 0:  # the ground does not move
         return np.zeros(model.nv)
-    R = frame_pose(data, body, np.zeros(3), np.eye(3))[0]
-    J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
-    return (R @ J[:3]).T @ np.asarray(wrench.force) + (R @ J[3:]).T @ np.asarray(wrench.torque)
+    Jv, Jw = ground_jacobian(data, body, r)
+    return Jv.T @ np.asarray(wrench.force) + Jw.T @ np.asarray(wrench.torque)
 
 
 def wind_wrenches(
