@@ -239,12 +239,11 @@ class ConstrainedBackend:
             )
             _, Qd = self._damper(q, qd)
             return qdd, Qd
-        qdd_free, Qd = self.side.accelerations(q, qd, Q_u)  # A⁻¹ f of the tree
-        A = self.side.mass_matrix(q)
+        A, f, Qd = self.side.system(q, qd, Q_u)  # the tree's A q̈ = f
         phi, B, C = stacked(self.constraints, q, qd)
         g = consistent_rhs(B, constraint_rhs(C, B @ qd, phi, self.stabilization))
         try:
-            sol = solve_kkt(A, B, A @ qdd_free, g)
+            sol = solve_kkt(A, B, f, g)
         except Rt70Error as exc:
             raise SimulationError(str(exc)) from None
         return sol.x, Qd

@@ -145,9 +145,8 @@ class _TextbookBackend(_Backend):
     def mass_matrix(self, q):
         return self.structured.mass_matrix(self.scene.textbook, self.bdata, q)
 
-    def accelerations(self, q, qd, Q_u):
-        import scipy.linalg
-
+    def system(self, q, qd, Q_u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, f, Q_d)`` of ``A q̈ = f``: f = gravity, springs, dampers, inputs − B q̇."""
         from rt70.textbook import forces
 
         st, model = self.structured, self.scene.textbook
@@ -158,6 +157,12 @@ class _TextbookBackend(_Backend):
         rhs -= st.bias_force(model, self.bdata, q, qd)
         if Q_u is not None:
             rhs += Q_u
+        return A, rhs, Qd
+
+    def accelerations(self, q, qd, Q_u):
+        import scipy.linalg
+
+        A, rhs, Qd = self.system(q, qd, Q_u)
         try:
             factor = scipy.linalg.cho_factor(A)
         except np.linalg.LinAlgError:
