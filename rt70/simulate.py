@@ -34,7 +34,7 @@ from rt70.outputs import Output, column_labels, evaluate, evaluate_trajectory
 from rt70.scene import Scene
 from rt70.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
-from rt70.textbook.spatial import check_euler_pairs
+from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, check_euler_pairs, euler_theta_indices
 
 #: Integration methods of scipy.integrate.solve_ivp accepted by :func:`simulate`.
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
@@ -74,11 +74,16 @@ class _Backend:
 
 
 class _PinocchioBackend(_Backend):
-    """Pinocchio's ABA with springs as tau; analytic Jacobian from computeABADerivatives."""
+    """Pinocchio's ABA with springs as tau; analytic Jacobian from computeABADerivatives.
+
+    The springs and dampers come from the compiled kernels of
+    :mod:`rt70.reference.element_kernels` where the model allows (the same forces as
+    :mod:`rt70.reference.forces`, tested); ``kernels=False`` keeps the Python path.
+    """
 
     name = "pinocchio"
 
-    def __init__(self, scene: Scene) -> None:
+    def __init__(self, scene: Scene, kernels: bool = True) -> None:
         super().__init__(scene)
         import pinocchio as pin
 
@@ -87,12 +92,30 @@ class _PinocchioBackend(_Backend):
         self.pin, self.reference = pin, reference
         self.ref, self.rd = scene.reference, scene.reference_data
         self.direct = self.ref.identity_map  # book coordinates are Pinocchio's (q, v)
+        self.kernels = None
+        if kernels and self.direct and (self.ref.bushings or self.ref.spring_v.size):
+            from rt70.reference.element_kernels import ElementKernels
+
+            self.kernels = ElementKernels.of(self.ref)
+        self.theta = euler_theta_indices(scene.textbook)
 
     def mass_matrix(self, q):
         return self.reference.mass_matrix(self.ref, self.rd, q)
 
+    def _check_pairs(self, q) -> None:
+        """check_euler_pairs, vectorised for the common case that nothing is near lock."""
+        q_full = self.scene.textbook.expand(q)
+        if self.theta.size and np.min(np.abs(np.cos(q_full[self.theta]))) < DYNAMICS_GIMBAL_COS:
+            check_euler_pairs(self.scene.textbook, q_full)
+
+    def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
+        """Spring and damper forces τ_c, τ_d in Pinocchio's velocity space."""
+        if self.kernels is not None:
+            return self.kernels.torques(q, qd)
+        return self.reference.element_torques(self.ref, self.rd, q, qd)
+
     def accelerations(self, q, qd, Q_u):
-        check_euler_pairs(self.scene.textbook, self.scene.textbook.expand(q))
+        self._check_pairs(q)
         reference, ref, rd = self.reference, self.ref, self.rd
         if not self.direct:  # general coordinates: through the book-coordinate map
             a = reference.forward_dynamics(ref, rd, q, qd)
@@ -100,7 +123,7 @@ class _PinocchioBackend(_Backend):
             if Q_u is not None:
                 a = a + np.linalg.solve(reference.mass_matrix(ref, rd, q), Q_u)
             return a, Qd
-        Qc, Qd = reference.element_torques(ref, rd, q, qd)
+        Qc, Qd = self.torques(q, qd)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
         return self.pin.aba(ref.pin_model, rd.pin_data, q, qd, tau), Qd
 
@@ -108,10 +131,13 @@ class _PinocchioBackend(_Backend):
         if not self.direct:
             return None
         reference, ref, rd, pin = self.reference, self.ref, self.rd, self.pin
-        Qc, Qd = reference.element_torques(ref, rd, q, qd)
+        if self.kernels is not None:
+            Qc, Qd, Kc, Dc = self.kernels.torques_and_gains(q, qd)
+        else:
+            Qc, Qd = reference.element_torques(ref, rd, q, qd)
+            Kc, Dc = reference.element_gains(ref, rd, q)
         tau = Qc + Qd if Q_u is None else Qc + Qd + Q_u
         dq, dv, Minv = pin.computeABADerivatives(ref.pin_model, rd.pin_data, q, qd, tau)
-        Kc, Dc = reference.element_gains(ref, rd, q)
         n = self.nv
         J = np.zeros((2 * n, 2 * n))
         J[:n, n:] = np.eye(n)
@@ -122,10 +148,14 @@ class _PinocchioBackend(_Backend):
 
     def energies(self, q, qd):
         reference, ref, rd = self.reference, self.ref, self.rd
+        if self.kernels is not None:
+            U_c = self.kernels.potential(q)
+        else:
+            U_c = reference.spring_potential(ref, rd, q)
         return (
             reference.kinetic_energy(ref, rd, q, qd),
             reference.gravity_potential(ref, rd, q),
-            reference.spring_potential(ref, rd, q),
+            U_c,
         )
 
 

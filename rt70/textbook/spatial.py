@@ -39,6 +39,14 @@ def check_euler_pairs(model, q_full: np.ndarray, threshold: float = DYNAMICS_GIM
                 )
 
 
+def euler_theta_indices(model) -> np.ndarray:
+    """Indices in the full q of every euler6 pair's θ (what :func:`check_euler_pairs` reads)."""
+    return np.array(
+        [model.q_start[j] + 4 for j, kind in enumerate(model.kind) if kind == "euler6"],
+        dtype=int,
+    )
+
+
 def skew(x: np.ndarray) -> np.ndarray:
     """Return ``<x>``, the skew matrix with ``<x> y = x × y`` (formalism §0)."""
     return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])

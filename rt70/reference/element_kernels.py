@@ -1,0 +1,409 @@
+"""Compiled spring and damper forces of the reference side: the simulation's fast path.
+
+:mod:`rt70.reference.forces` computes every element from Pinocchio's frame placements
+and frame Jacobians — two dozen Python calls and a hundred small numpy operations per
+evaluation of the RT-70, six times the cost of ``pin.aba`` itself. Here the same
+deformations, forces, gains and potential come from one numba kernel that walks, for
+each bushing, the joints between its two frames:
+
+- ``frame i = Π_k (placement_k · X_k(q_k)) · P_i`` from the frames' lowest common
+  ancestor down to each frame (the element depends on those joints only);
+- ``δ = [r12; −rpy(c12ᵀ)]`` with ``c12 = R1ᵀ R2``, ``r12 = R1ᵀ (p2 − p1)`` — the
+  definition of :func:`rt70.reference.forces.deformations`, so the two agree to rounding
+  (tested on every scene);
+- ``∂δ/∂q̇_k``: joint k moves one side relative to the other by the twist
+  ``s_k (a_k, −a_k × o_k)`` (axis ``a_k`` through ``o_k``, in the ancestor's frame;
+  ``s_k = +1`` on frame 2's branch, −1 on frame 1's), so ``ṙ12 = R1ᵀ (v + ω × p2)``
+  and the rotation rows are ``J_W(ρ)⁻¹ R2ᵀ ω`` as on the Pinocchio path;
+- ``τ_c = −Σ Jᵀ C δ``, ``τ_d = −Σ Jᵀ D δ̇``, gains ``Σ JᵀCJ``, ``Σ JᵀDJ`` (the
+  Gauss–Newton part of ``−∂τ_c/∂q``, as :func:`rt70.reference.forces.element_gains`)
+  and ``U_c = Σ ½ δᵀ C δ``, scattered only on each element's own joints.
+
+Joint springs (δ = the joint's coordinate) are in the same kernel. The tables are
+read once from Pinocchio's model (:func:`tables`); a model whose elements cross a joint
+other than revolute, prismatic or continuous has no tables (None) and keeps the Python
+path. Kernels are compiled on first use and cached on disk (``cache=True``): a second
+process pays no compilation. They use no BLAS (explicit 3×3 loops), so they import
+nothing beyond numba and numpy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from rt70.errors import SingularConfigurationError
+from rt70.reference.forces import GIMBAL_LOCK_COS
+from rt70.reference.model import ReferenceModel
+
+#: Joint kinds of the tables.
+REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
+#: Size of the kernels' fixed scratch (3×3 and 3-, 6-vectors) after the per-entry part.
+WORK_SMALL = 93
+
+
+@dataclass(frozen=True)
+class Tables:
+    """Plain arrays describing every element, for the kernels.
+
+    Bushing b owns the joint entries ``start[b]:start[b + 1]`` (frame 1's branch first,
+    ``split[b]`` is where frame 2's begins), each top-down from the common ancestor.
+
+    Attributes
+    ----------
+    start, split : numpy.ndarray
+        int64, shapes (n_b + 1,) and (n_b,).
+    kind, q_index, v_index : numpy.ndarray
+        int64 per entry: :data:`REVOLUTE` / :data:`PRISMATIC` / :data:`CONTINUOUS`, the
+        joint's first index in Pinocchio's q and its index in v.
+    axis : numpy.ndarray
+        (n, 3) unit axis of each joint in its own frame.
+    place_R, place_p : numpy.ndarray
+        (n, 3, 3), (n, 3): the joint's placement in its parent joint's frame.
+    frame_R, frame_p : numpy.ndarray
+        (n_b, 2, 3, 3), (n_b, 2, 3): each bushing's frames in their joints' frames.
+    stiffness, damping : numpy.ndarray
+        (n_b, 6) diagonals of C and D.
+    spring_q, spring_v, spring_kind : numpy.ndarray
+        int64 per joint spring: q index, v index, :data:`CONTINUOUS` or not.
+    spring_k, spring_d : numpy.ndarray
+        Joint springs' stiffness and damping.
+    """
+
+    start: np.ndarray
+    split: np.ndarray
+    kind: np.ndarray
+    q_index: np.ndarray
+    v_index: np.ndarray
+    axis: np.ndarray
+    place_R: np.ndarray
+    place_p: np.ndarray
+    frame_R: np.ndarray
+    frame_p: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    spring_q: np.ndarray
+    spring_v: np.ndarray
+    spring_kind: np.ndarray
+    spring_k: np.ndarray
+    spring_d: np.ndarray
+
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """The arrays in the kernels' argument order."""
+        return tuple(getattr(self, f) for f in self.__dataclass_fields__)
+
+
+def _joint_kind(model: ReferenceModel, joint: int) -> tuple[int, np.ndarray] | None:
+    """(kind, unit axis) of a Pinocchio joint from its motion subspace; None if other."""
+    import pinocchio as pin
+
+    pm = model.pin_model
+    jm = pm.joints[joint]
+    if jm.nv != 1 or jm.nq not in (1, 2):
+        return None
+    jd = jm.createData()
+    jm.calc(jd, pin.neutral(pm))
+    S = np.asarray(jd.S).reshape(6)
+    lin, ang = S[:3], S[3:]
+    if jm.nq == 1 and np.allclose(ang, 0.0) and not np.allclose(lin, 0.0):
+        return PRISMATIC, lin / np.linalg.norm(lin)
+    if np.allclose(lin, 0.0) and not np.allclose(ang, 0.0):
+        return (REVOLUTE if jm.nq == 1 else CONTINUOUS), ang / np.linalg.norm(ang)
+    return None
+
+
+def _chain(parents, joint: int) -> list[int]:
+    """Joints from ``joint`` up to the universe (0), ``joint`` first."""
+    out = [joint]
+    while out[-1] != 0:
+        out.append(parents[out[-1]])
+    return out
+
+
+def tables(model: ReferenceModel) -> Tables | None:
+    """The kernels' tables of the model's bushings and joint springs; None if unsupported.
+
+    Unsupported: a bushing whose frames are joined through a joint that is not
+    revolute, prismatic or continuous; such a model keeps :mod:`rt70.reference.forces`.
+    Like that module the kernels work in Pinocchio's own (q, v).
+    """
+    pm = model.pin_model
+    parents = list(pm.parents)
+    rows: list[tuple[int, int, int, np.ndarray, object]] = []
+    start, split, frame_R, frame_p = [0], [], [], []
+    for (j1, P1), (j2, P2) in zip(model.frames1, model.frames2, strict=True):
+        up1, up2 = _chain(parents, j1), _chain(parents, j2)
+        common = set(up1) & set(up2)
+        for branch, up in enumerate((up1, up2)):
+            if branch == 1:
+                split.append(len(rows))
+            for joint in reversed([j for j in up if j not in common]):  # top-down
+                found = _joint_kind(model, joint)
+                if found is None:
+                    return None
+                jm = pm.joints[joint]
+                rows.append((found[0], jm.idx_q, jm.idx_v, found[1], pm.jointPlacements[joint]))
+        start.append(len(rows))
+        frame_R.append([P1.rotation, P2.rotation])
+        frame_p.append([P1.translation, P2.translation])
+    n_b = len(model.frames1)
+    by_v = {pm.joints[j].idx_v: pm.joints[j] for j in range(1, pm.njoints) if pm.joints[j].nv}
+    spring_q = [by_v[int(v)].idx_q for v in model.spring_v]
+    spring_kind = [CONTINUOUS if by_v[int(v)].nq == 2 else REVOLUTE for v in model.spring_v]
+    i64 = np.int64
+    return Tables(
+        start=np.array(start, dtype=i64),
+        split=np.array(split, dtype=i64),
+        kind=np.array([r[0] for r in rows], dtype=i64),
+        q_index=np.array([r[1] for r in rows], dtype=i64),
+        v_index=np.array([r[2] for r in rows], dtype=i64),
+        axis=np.array([r[3] for r in rows], dtype=float).reshape(-1, 3),
+        place_R=np.array([r[4].rotation for r in rows], dtype=float).reshape(-1, 3, 3),
+        place_p=np.array([r[4].translation for r in rows], dtype=float).reshape(-1, 3),
+        frame_R=np.array(frame_R, dtype=float).reshape(n_b, 2, 3, 3),
+        frame_p=np.array(frame_p, dtype=float).reshape(n_b, 2, 3),
+        stiffness=np.ascontiguousarray(model.stiffness, dtype=float).reshape(n_b, 6),
+        damping=np.ascontiguousarray(model.damping, dtype=float).reshape(n_b, 6),
+        spring_q=np.array(spring_q, dtype=i64),
+        spring_v=np.array(model.spring_v, dtype=i64),
+        spring_kind=np.array(spring_kind, dtype=i64),
+        spring_k=np.asarray(model.spring_k, dtype=float),
+        spring_d=np.asarray(model.spring_d, dtype=float),
+    )
+
+
+@numba.njit(cache=True)
+def _walk(qp, lo, hi, kind, q_index, axis, place_R, place_p, R, p, origin, axis_out, T, X):
+    """Compose ``placement_k · X_k(q_k)`` for entries lo…hi onto (R, p) in place.
+
+    Records each joint's origin ``o_k`` and axis ``a_k`` in the starting frame; T and X
+    are 3×3 scratch.
+    """
+    for k in range(lo, hi):
+        for i in range(3):  # p += R placement_p;  R = R placement_R
+            p[i] += R[i, 0] * place_p[k, 0] + R[i, 1] * place_p[k, 1] + R[i, 2] * place_p[k, 2]
+        _mul(R, place_R[k], T)
+        R[:, :] = T
+        u = axis[k]
+        for i in range(3):
+            origin[k, i] = p[i]
+            axis_out[k, i] = R[i, 0] * u[0] + R[i, 1] * u[1] + R[i, 2] * u[2]
+        qi = q_index[k]
+        if kind[k] == PRISMATIC:
+            for i in range(3):
+                p[i] += axis_out[k, i] * qp[qi]
+            continue
+        if kind[k] == CONTINUOUS:
+            c, s = qp[qi], qp[qi + 1]
+        else:
+            c, s = math.cos(qp[qi]), math.sin(qp[qi])
+        _rotation(u, c, s, X)  # R = R · Rot(u, angle)
+        _mul(R, X, T)
+        R[:, :] = T
+
+
+@numba.njit(cache=True)
+def _mul(A, B, out):
+    """``out = A B`` for 3×3 arrays (no BLAS)."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@numba.njit(cache=True)
+def _rotation(u, c, s, out):
+    """Rotation by the angle with cosine c and sine s about the unit axis u (Rodrigues)."""
+    t = 1.0 - c
+    out[0, 0], out[0, 1], out[0, 2] = (
+        c + t * u[0] * u[0],
+        t * u[0] * u[1] - s * u[2],
+        t * u[0] * u[2] + s * u[1],
+    )
+    out[1, 0], out[1, 1], out[1, 2] = (
+        t * u[1] * u[0] + s * u[2],
+        c + t * u[1] * u[1],
+        t * u[1] * u[2] - s * u[0],
+    )
+    out[2, 0], out[2, 1], out[2, 2] = (
+        t * u[2] * u[0] - s * u[1],
+        t * u[2] * u[1] + s * u[0],
+        c + t * u[2] * u[2],
+    )
+
+
+@numba.njit(cache=True)
+def _frame(R, p, FR, Fp, R_out, p_out):
+    """``(R_out, p_out) = (R, p) · (FR, Fp)``."""
+    _mul(R, FR, R_out)
+    for i in range(3):
+        p_out[i] = p[i] + R[i, 0] * Fp[0] + R[i, 1] * Fp[1] + R[i, 2] * Fp[2]
+
+
+@numba.njit(cache=True)
+def evaluate(
+    qp, vp, gains, tau_c, tau_d, K, D, work,
+    start, split, kind, q_index, v_index, axis, place_R, place_p, frame_R, frame_p,
+    stiffness, damping, spring_q, spring_v, spring_kind, spring_k, spring_d,
+):  # fmt: skip
+    """Add every element's forces (and with ``gains`` its ``JᵀCJ``, ``JᵀDJ``) in place.
+
+    ``tau_c −= Σ Jᵀ C δ``, ``tau_d −= Σ Jᵀ D δ̇``; ``K += Σ JᵀCJ``, ``D += Σ JᵀDJ``.
+    Returns ``(U_c, b)``: the elastic potential ``Σ ½ δᵀ C δ`` and −1, or the index b
+    of a bushing at Euler-angle gimbal lock (then nothing is complete).
+    """
+    n = kind.shape[0]
+    origin = work[: 3 * n].reshape((n, 3))  # views of one buffer: no allocation per call
+    axis_w = work[3 * n : 6 * n].reshape((n, 3))
+    jac = work[6 * n : 12 * n].reshape((n, 6))
+    small = work[12 * n :]
+    R, R1 = small[0:9].reshape((3, 3)), small[9:18].reshape((3, 3))
+    R2, c12 = small[18:27].reshape((3, 3)), small[27:36].reshape((3, 3))
+    p, p1, p2 = small[36:39], small[39:42], small[42:45]
+    d, w, lin = small[45:48], small[48:51], small[51:54]
+    delta, rate = small[54:60], small[60:66]
+    inv = small[66:75].reshape((3, 3))
+    T, X = small[75:84].reshape((3, 3)), small[84:93].reshape((3, 3))
+    inv[0, 2] = inv[1, 2] = 0.0
+    U = 0.0
+    for b in range(start.shape[0] - 1):
+        lo, mid, hi = start[b], split[b], start[b + 1]
+        for side in range(2):
+            R[:, :] = 0.0
+            R[0, 0] = R[1, 1] = R[2, 2] = 1.0
+            p[:] = 0.0
+            a, z = (lo, mid) if side == 0 else (mid, hi)
+            _walk(qp, a, z, kind, q_index, axis, place_R, place_p, R, p, origin, axis_w, T, X)
+            if side == 0:
+                _frame(R, p, frame_R[b, 0], frame_p[b, 0], R1, p1)
+            else:
+                _frame(R, p, frame_R[b, 1], frame_p[b, 1], R2, p2)
+        for i in range(3):  # c12 = R1ᵀ R2, r12 = R1ᵀ (p2 − p1)
+            d[i] = p2[i] - p1[i]
+            for j in range(3):
+                c12[i, j] = R1[0, i] * R2[0, j] + R1[1, i] * R2[1, j] + R1[2, i] * R2[2, j]
+        for i in range(3):
+            delta[i] = R1[0, i] * d[0] + R1[1, i] * d[1] + R1[2, i] * d[2]
+        # ρ = rpy of ct = c12ᵀ (Pinocchio's matrixToRpy): ct[i, j] = c12[j, i]
+        pitch = math.atan2(-c12[0, 2], math.hypot(c12[0, 0], c12[0, 1]))
+        roll = math.atan2(c12[1, 2], c12[2, 2])
+        yaw = math.atan2(c12[0, 1], c12[0, 0])
+        cp = math.cos(pitch)
+        if abs(cp) < GIMBAL_LOCK_COS:
+            return math.nan, b
+        delta[3], delta[4], delta[5] = -roll, -pitch, -yaw
+        cy, sy, tp = math.cos(yaw), math.sin(yaw), math.tan(pitch)
+        inv[0, 0], inv[0, 1] = cy / cp, sy / cp
+        inv[1, 0], inv[1, 1] = -sy, cy
+        inv[2, 0], inv[2, 1], inv[2, 2] = cy * tp, sy * tp, 1.0
+        rate[:] = 0.0
+        for k in range(lo, hi):
+            sign = -1.0 if k < mid else 1.0
+            if kind[k] == PRISMATIC:
+                for i in range(3):
+                    w[i] = 0.0
+                    lin[i] = sign * axis_w[k, i]
+            else:  # ω = a_k, v + ω × p2 = a_k × (p2 − o_k)
+                a0, a1, a2 = axis_w[k, 0], axis_w[k, 1], axis_w[k, 2]
+                r0, r1, r2 = p2[0] - origin[k, 0], p2[1] - origin[k, 1], p2[2] - origin[k, 2]
+                lin[0], lin[1], lin[2] = a1 * r2 - a2 * r1, a2 * r0 - a0 * r2, a0 * r1 - a1 * r0
+                for i in range(3):
+                    w[i] = sign * axis_w[k, i]
+                    lin[i] *= sign
+            for i in range(3):
+                jac[k, i] = R1[0, i] * lin[0] + R1[1, i] * lin[1] + R1[2, i] * lin[2]
+            w0 = R2[0, 0] * w[0] + R2[1, 0] * w[1] + R2[2, 0] * w[2]  # R2ᵀ ω
+            w1 = R2[0, 1] * w[0] + R2[1, 1] * w[1] + R2[2, 1] * w[2]
+            w2 = R2[0, 2] * w[0] + R2[1, 2] * w[1] + R2[2, 2] * w[2]
+            for i in range(3):
+                jac[k, 3 + i] = inv[i, 0] * w0 + inv[i, 1] * w1 + inv[i, 2] * w2
+            vk = vp[v_index[k]]
+            for i in range(6):
+                rate[i] += jac[k, i] * vk
+        for k in range(lo, hi):
+            fc = 0.0
+            fd = 0.0
+            for i in range(6):
+                fc += jac[k, i] * stiffness[b, i] * delta[i]
+                fd += jac[k, i] * damping[b, i] * rate[i]
+            tau_c[v_index[k]] -= fc
+            tau_d[v_index[k]] -= fd
+            if gains:
+                for m in range(lo, hi):
+                    kc = 0.0
+                    kd = 0.0
+                    for i in range(6):
+                        kc += jac[k, i] * stiffness[b, i] * jac[m, i]
+                        kd += jac[k, i] * damping[b, i] * jac[m, i]
+                    K[v_index[k], v_index[m]] += kc
+                    D[v_index[k], v_index[m]] += kd
+        for i in range(6):
+            U += 0.5 * stiffness[b, i] * delta[i] * delta[i]
+    for e in range(spring_v.shape[0]):  # joint springs: δ = the joint's coordinate
+        qi, vi = spring_q[e], spring_v[e]
+        x = math.atan2(qp[qi + 1], qp[qi]) if spring_kind[e] == CONTINUOUS else qp[qi]
+        tau_c[vi] -= spring_k[e] * x
+        tau_d[vi] -= spring_d[e] * vp[vi]
+        if gains:
+            K[vi, vi] += spring_k[e]
+            D[vi, vi] += spring_d[e]
+        U += 0.5 * spring_k[e] * x * x
+    return U, -1
+
+
+class ElementKernels:
+    """The compiled forces, gains and potential of one model's elements.
+
+    Same results as :func:`rt70.reference.forces.element_torques`,
+    :func:`~rt70.reference.forces.element_gains` and
+    :func:`~rt70.reference.forces.spring_potential`, in Pinocchio's (q, v) spaces.
+    Build with :meth:`of`, which gives None when the model is not supported.
+    """
+
+    def __init__(self, model: ReferenceModel, found: Tables) -> None:
+        self.nv = model.pin_model.nv
+        self.tables = found
+        self._args = found.arrays()
+        self._none = np.zeros((0, 0))
+        self._work = np.zeros(12 * len(found.kind) + WORK_SMALL)
+
+    @classmethod
+    def of(cls, model: ReferenceModel) -> ElementKernels | None:
+        """The kernels of ``model``, or None if :func:`tables` does not support it."""
+        found = tables(model)
+        return None if found is None else cls(model, found)
+
+    def _run(self, qp, vp, gains, tau_c, tau_d, K, D) -> float:
+        U, bad = evaluate(qp, vp, gains, tau_c, tau_d, K, D, self._work, *self._args)
+        if bad >= 0:
+            raise SingularConfigurationError("bushing at Euler-angle gimbal lock (θ = ±π/2)")
+        return U
+
+    def torques(self, qp: np.ndarray, vp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Spring and damper forces ``τ_c``, ``τ_d`` (as ``element_torques``)."""
+        tau_c, tau_d = np.zeros(self.nv), np.zeros(self.nv)
+        self._run(qp, vp, False, tau_c, tau_d, self._none, self._none)
+        return tau_c, tau_d
+
+    def torques_and_gains(
+        self, qp: np.ndarray, vp: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``τ_c``, ``τ_d``, ``Σ JᵀCJ`` and ``Σ JᵀDJ`` in one pass (for a Jacobian)."""
+        n = self.nv
+        tau_c, tau_d, K, D = np.zeros(n), np.zeros(n), np.zeros((n, n)), np.zeros((n, n))
+        self._run(qp, vp, True, tau_c, tau_d, K, D)
+        return tau_c, tau_d, K, D
+
+    def gains(self, qp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``Σ JᵀCJ`` and ``Σ JᵀDJ`` (as ``element_gains``)."""
+        n = self.nv
+        K, D = np.zeros((n, n)), np.zeros((n, n))
+        self._run(qp, np.zeros(n), True, np.zeros(n), np.zeros(n), K, D)
+        return K, D
+
+    def potential(self, qp: np.ndarray) -> float:
+        """``U_c = Σ ½ δᵀ C δ`` (as ``spring_potential``)."""
+        n = self.nv
+        return self._run(qp, np.zeros(n), False, np.zeros(n), np.zeros(n), self._none, self._none)

@@ -1,0 +1,154 @@
+"""The compiled elements (rt70.reference.element_kernels) against the Python path.
+
+The kernels walk the joints between each bushing's frames instead of asking Pinocchio
+for frame placements and Jacobians; both must give the same forces, gains and
+potential (:mod:`rt70.reference.forces` is the path ``rt70 validate`` cross-checks
+against the textbook side), on every scene and on a tree whose bushings join siblings
+through unaligned revolute, prismatic and continuous joints.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from rt70.errors import SingularConfigurationError
+from rt70.reference import forces
+from rt70.reference.element_kernels import ElementKernels
+from rt70.scene import load_scene, scene_from_text
+from rt70.scenes.rt70_state import listing_initial_state
+from rt70.simulate import simulate
+
+SCENES = ("rt70", "rt70_servo", "rt70_azimuth", "rt70_elevation", "three_masses",
+          "two_body_gravity", "rt70_jack")  # fmt: skip
+
+SIBLINGS = """<?xml version="1.0"?>
+<robot name="siblings" xmlns:rt70="urn:rt70:urdf-extensions:1">
+  <link name="world"/>
+  <joint name="hub" type="revolute"><parent link="world"/><child link="a"/>
+    <origin xyz="0.1 0.2 0.3" rpy="0.2 -0.1 0.4"/><axis xyz="0.6 0 0.8"/>
+    <limit lower="-9" upper="9" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><mass value="3"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="2.5"/></inertial></link>
+  <joint name="slide" type="prismatic"><parent link="a"/><child link="b"/>
+    <origin xyz="0.5 0 0" rpy="0 0.3 0"/><axis xyz="0 0.6 0.8"/>
+    <limit lower="-9" upper="9" effort="1" velocity="1"/></joint>
+  <link name="b"><inertial><mass value="2"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="wheel" type="continuous"><parent link="b"/><child link="c"/>
+    <origin xyz="0 0.4 0" rpy="0.1 0 0"/><axis xyz="1 0 0"/></joint>
+  <link name="c"><inertial><mass value="1"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="arm" type="revolute"><parent link="a"/><child link="d"/>
+    <origin xyz="0 0 0.7" rpy="0 0 0.5"/><axis xyz="0 1 0"/>
+    <limit lower="-9" upper="9" effort="1" velocity="1"/></joint>
+  <link name="d"><inertial><mass value="1.5"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <rt70:bushing name="across" stiffness="10 20 30 40 50 60" damping="1 2 3 4 5 6">
+    <rt70:frame1 link="c" xyz="0.1 0 0.2" rpy="0.3 0.2 0.1"/>
+    <rt70:frame2 link="d" xyz="0 0.1 0" rpy="0 0 0.2"/>
+  </rt70:bushing>
+  <rt70:bushing name="to_ground" stiffness="5 5 5 7 7 7" damping="0.5 0.5 0.5 1 1 1">
+    <rt70:frame1 link="world" xyz="0 0 1"/>
+    <rt70:frame2 link="c"/>
+  </rt70:bushing>
+</robot>
+"""
+
+
+def _states(model, n: int, seed: int):
+    rng = np.random.default_rng(seed)
+    m = model.pin_model
+    for _ in range(n):
+        qp = pin.normalize(m, 0.4 * rng.standard_normal(m.nq))
+        yield qp, rng.standard_normal(m.nv)
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> float:
+    assert np.isfinite(a).all() and np.isfinite(b).all()
+    scale = float(np.max(np.abs(a)))
+    if scale == 0.0:  # e.g. a scene without dampers: then exactly zero on both
+        return float(np.max(np.abs(b)))
+    return float(np.max(np.abs(a - b))) / scale
+
+
+def _check(scene) -> None:
+    ref, rd = scene.reference, scene.reference_data
+    kernels = ElementKernels.of(ref)
+    assert kernels is not None
+    for qp, vp in _states(ref, 4, seed=len(scene.name)):
+        tau_c, tau_d = forces.element_torques(ref, rd, qp, vp)
+        K, D = forces.element_gains(ref, rd, qp)
+        U = sum(0.5 * e.squares(e.stiffness) for e in forces.elements(ref, rd, qp, False))
+        assert np.max(np.abs(tau_c)) > 0.0 and U > 0.0  # something to compare
+        fast = kernels.torques_and_gains(qp, vp)
+        for want, got in zip((tau_c, tau_d, K, D), fast, strict=True):
+            assert _relative(want, got) < 1e-13
+        assert _relative(np.array(kernels.torques(qp, vp)), np.array([tau_c, tau_d])) < 1e-13
+        assert abs(kernels.potential(qp) - U) <= 1e-13 * U
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_kernels_equal_the_python_path_on_the_scenes(name):
+    _check(load_scene(name))
+
+
+def test_kernels_on_siblings_through_unaligned_prismatic_and_continuous_joints():
+    scene = scene_from_text(SIBLINGS, "siblings")
+    kinds = set(ElementKernels.of(scene.reference).tables.kind.tolist())
+    assert kinds == {0, 1, 2}  # revolute, prismatic and continuous all walked
+    _check(scene)
+
+
+def test_a_mimic_model_keeps_the_python_path():
+    """The simulation's backend uses the kernels only where the book's coordinates are
+    Pinocchio's (q, v); the gear reducer's mimic joints map them."""
+    from rt70.simulate import BACKENDS
+
+    scene = load_scene("gear_reducer")
+    assert not scene.reference.identity_map
+    assert BACKENDS["pinocchio"](scene).kernels is None
+    assert BACKENDS["pinocchio"](load_scene("rt70")).kernels is not None
+
+
+def test_a_model_with_a_free_flyer_on_the_path_is_not_supported():
+    text = SIBLINGS.replace('name="hub" type="revolute"', 'name="hub" type="floating"')
+    scene = scene_from_text(text, "floating")
+    assert ElementKernels.of(scene.reference) is None
+
+
+def test_gimbal_lock_is_refused_like_the_python_path():
+    """Frame 2 turned by π/2 in pitch relative to frame 1: rpy of c12ᵀ is singular."""
+    text = SIBLINGS.replace('<rt70:frame2 link="d" xyz="0 0.1 0" rpy="0 0 0.2"/>',
+                            '<rt70:frame2 link="c" rpy="0 1.5707963267948966 0"/>')  # fmt: skip
+    text = text.replace('<rt70:frame1 link="c" xyz="0.1 0 0.2" rpy="0.3 0.2 0.1"/>',
+                        '<rt70:frame1 link="c"/>')  # fmt: skip
+    scene = scene_from_text(text, "locked")
+    ref, rd = scene.reference, scene.reference_data
+    qp, v = pin.neutral(ref.pin_model), np.zeros(ref.pin_model.nv)
+    with pytest.raises(SingularConfigurationError, match="gimbal lock"):
+        forces.element_torques(ref, rd, qp, v)
+    with pytest.raises(SingularConfigurationError, match="gimbal lock"):
+        ElementKernels.of(ref).torques(qp, v)
+
+
+def test_simulation_with_kernels_equals_the_python_path(monkeypatch):
+    """The RT-70 from the listing's state: the fast path's trajectory is the Python path's
+    to within the integration tolerance (same method, same rtol)."""
+    from rt70 import simulate as sim
+
+    scene = load_scene("rt70")
+    x0 = listing_initial_state(scene)
+    t = np.linspace(0.0, 0.3, 31)
+    runs = []
+    backend = sim.BACKENDS["pinocchio"]
+    for kernels in (True, False):
+        monkeypatch.setitem(sim.BACKENDS, "pinocchio", functools.partial(backend, kernels=kernels))
+        runs.append(simulate(scene, (0.0, 0.3), x0, rtol=1e-8, t_eval=t))
+    fast, slow = runs
+    scale = np.max(np.abs(slow.q))
+    assert np.max(np.abs(fast.q - slow.q)) <= 1e-6 * scale
+    assert np.max(np.abs(fast.elastic - slow.elastic)) <= 1e-6 * np.max(slow.elastic)
