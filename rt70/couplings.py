@@ -100,7 +100,10 @@ class SceneCoupling:
 
             model, data = scene.reference, scene.reference_data
         mesh = None if drive.sector is None else kin.sector_mesh(model, data, drive)
-        self._gradient = lambda q: kin.drive_force(model, data, q, drive, 1.0, mesh)
+        if self.side == "reference":  # compiled where it can (the same numbers)
+            self._gradient = kin.drive_force_function(model, data, drive, mesh)
+        else:
+            self._gradient = lambda q: kin.drive_force(model, data, q, drive, 1.0, mesh)
         self._key: bytes | None = None
         self._value: tuple[float, np.ndarray] = (0.0, np.zeros(self.n))
 

@@ -95,3 +95,42 @@ def drive_force(
     angle = mesh.angle(s.xyz, link, stator)[0]
     wrenches = mesh.wrenches(s.link, s.stator, s.xyz, torque, link, stator)
     return angle, sum(generalized_force(model, data, q, w) for w in wrenches)
+
+
+def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Drive, mesh=None):
+    """``q ↦ (θ_d, ∂θ_d/∂q)``: :func:`drive_force` at unit torque, compiled where it can.
+
+    A gear sector's θ_d depends on its mesh point P in the stator's axes only, so
+    ``∂θ_d/∂q = (∂θ_d/∂P)ᵀ ∂P/∂q`` with P and ∂P/∂q from the compiled joint walk between
+    the two links (:class:`rt70.reference.element_kernels.RelativePoints`) instead of
+    two placements and two point Jacobians from Pinocchio per evaluation; the same
+    numbers (tested). A joint drive, mapped coordinates (mimic joints) or a path the
+    kernels do not support keep :func:`drive_force`.
+    """
+    if drive.sector is None or not model.identity_map:
+        return lambda q: drive_force(model, data, q, drive, 1.0, mesh)
+    from rt70.reference.element_kernels import RelativePoints
+
+    s = drive.sector
+    mesh = sector_mesh(model, data, drive) if mesh is None else mesh
+    m = model.pin_model
+    for link in (s.link, s.stator):
+        if not m.existBodyName(link):
+            raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
+    stator = m.frames[m.getBodyId(s.stator)]
+    link = m.frames[m.getBodyId(s.link)]
+    point = link.placement * pin.SE3(np.eye(3), np.asarray(s.xyz, dtype=float))
+    points = RelativePoints.of(
+        model, [(stator.parentJoint, stator.placement)], [(link.parentJoint, point)]
+    )
+    if points is None:
+        return lambda q: drive_force(model, data, q, drive, 1.0, mesh)
+    centre, u, v = mesh.centre, mesh.u, mesh.v
+
+    def angle_gradient(q: np.ndarray) -> tuple[float, np.ndarray]:
+        P, J = points(q)
+        d = P[0] - centre
+        x, y = float(u @ d), float(v @ d)
+        return float(np.arctan2(y, x)), ((x * v - y * u) / (x * x + y * y)) @ J[0]
+
+    return angle_gradient

@@ -123,18 +123,17 @@ def _chain(parents, joint: int) -> list[int]:
     return out
 
 
-def tables(model: ReferenceModel) -> Tables | None:
-    """The kernels' tables of the model's bushings and joint springs; None if unsupported.
+def paths(model: ReferenceModel, frames1, frames2) -> dict[str, np.ndarray] | None:
+    """The joints between each pair of frames ``(joint, SE3)``, as the kernels' arrays.
 
-    Unsupported: a bushing whose frames are joined through a joint that is not
-    revolute, prismatic or continuous; such a model keeps :mod:`rt70.reference.forces`.
-    Like that module the kernels work in Pinocchio's own (q, v).
+    Returns the fields ``start`` … ``frame_p`` of :class:`Tables`, or None when a pair is
+    joined through a joint that is not revolute, prismatic or continuous.
     """
     pm = model.pin_model
     parents = list(pm.parents)
     rows: list[tuple[int, int, int, np.ndarray, object]] = []
     start, split, frame_R, frame_p = [0], [], [], []
-    for (j1, P1), (j2, P2) in zip(model.frames1, model.frames2, strict=True):
+    for (j1, P1), (j2, P2) in zip(frames1, frames2, strict=True):
         up1, up2 = _chain(parents, j1), _chain(parents, j2)
         common = set(up1) & set(up2)
         for branch, up in enumerate((up1, up2)):
@@ -149,12 +148,8 @@ def tables(model: ReferenceModel) -> Tables | None:
         start.append(len(rows))
         frame_R.append([P1.rotation, P2.rotation])
         frame_p.append([P1.translation, P2.translation])
-    n_b = len(model.frames1)
-    by_v = {pm.joints[j].idx_v: pm.joints[j] for j in range(1, pm.njoints) if pm.joints[j].nv}
-    spring_q = [by_v[int(v)].idx_q for v in model.spring_v]
-    spring_kind = [CONTINUOUS if by_v[int(v)].nq == 2 else REVOLUTE for v in model.spring_v]
-    i64 = np.int64
-    return Tables(
+    n_b, i64 = len(frames1), np.int64
+    return dict(
         start=np.array(start, dtype=i64),
         split=np.array(split, dtype=i64),
         kind=np.array([r[0] for r in rows], dtype=i64),
@@ -165,6 +160,27 @@ def tables(model: ReferenceModel) -> Tables | None:
         place_p=np.array([r[4].translation for r in rows], dtype=float).reshape(-1, 3),
         frame_R=np.array(frame_R, dtype=float).reshape(n_b, 2, 3, 3),
         frame_p=np.array(frame_p, dtype=float).reshape(n_b, 2, 3),
+    )
+
+
+def tables(model: ReferenceModel) -> Tables | None:
+    """The kernels' tables of the model's bushings and joint springs; None if unsupported.
+
+    Unsupported: a bushing whose frames are joined through a joint that is not
+    revolute, prismatic or continuous; such a model keeps :mod:`rt70.reference.forces`.
+    Like that module the kernels work in Pinocchio's own (q, v).
+    """
+    found = paths(model, model.frames1, model.frames2)
+    if found is None:
+        return None
+    pm = model.pin_model
+    n_b = len(model.frames1)
+    by_v = {pm.joints[j].idx_v: pm.joints[j] for j in range(1, pm.njoints) if pm.joints[j].nv}
+    spring_q = [by_v[int(v)].idx_q for v in model.spring_v]
+    spring_kind = [CONTINUOUS if by_v[int(v)].nq == 2 else REVOLUTE for v in model.spring_v]
+    i64 = np.int64
+    return Tables(
+        **found,
         stiffness=np.ascontiguousarray(model.stiffness, dtype=float).reshape(n_b, 6),
         damping=np.ascontiguousarray(model.damping, dtype=float).reshape(n_b, 6),
         spring_q=np.array(spring_q, dtype=i64),
@@ -243,6 +259,79 @@ def _frame(R, p, FR, Fp, R_out, p_out):
 
 
 @numba.njit(cache=True)
+def _pair_pose(
+    qp, b, lo, mid, hi, kind, q_index, axis, place_R, place_p, frame_R, frame_p,
+    R, p, R1, p1, R2, p2, origin, axis_w, T, X,
+):  # fmt: skip
+    """Poses (R1, p1), (R2, p2) of pair b's frames in their common ancestor's frame.
+
+    Fills each entry's joint origin and axis in that frame; R, p, T, X are scratch.
+    """
+    for side in range(2):
+        R[:, :] = 0.0
+        R[0, 0] = R[1, 1] = R[2, 2] = 1.0
+        p[:] = 0.0
+        a, z = (lo, mid) if side == 0 else (mid, hi)
+        _walk(qp, a, z, kind, q_index, axis, place_R, place_p, R, p, origin, axis_w, T, X)
+        if side == 0:
+            _frame(R, p, frame_R[b, 0], frame_p[b, 0], R1, p1)
+        else:
+            _frame(R, p, frame_R[b, 1], frame_p[b, 1], R2, p2)
+
+
+@numba.njit(cache=True)
+def _translation_column(k, to_frame2, kind, origin, axis_w, R1, p2, w, lin, jac):
+    """Entry k's ``∂r12/∂q̇_k = R1ᵀ s_k (v + ω × p2)`` into ``jac[k, :3]``; ω into w.
+
+    Revolute: ``ω = a_k``, ``v + ω × p2 = a_k × (p2 − o_k)``; prismatic: ``ω = 0``,
+    ``v = a_k``. ``s_k = +1`` on frame 2's branch, −1 on frame 1's.
+    """
+    sign = 1.0 if to_frame2 else -1.0
+    if kind[k] == PRISMATIC:
+        for i in range(3):
+            w[i] = 0.0
+            lin[i] = sign * axis_w[k, i]
+    else:
+        a0, a1, a2 = axis_w[k, 0], axis_w[k, 1], axis_w[k, 2]
+        r0, r1, r2 = p2[0] - origin[k, 0], p2[1] - origin[k, 1], p2[2] - origin[k, 2]
+        lin[0], lin[1], lin[2] = a1 * r2 - a2 * r1, a2 * r0 - a0 * r2, a0 * r1 - a1 * r0
+        for i in range(3):
+            w[i] = sign * axis_w[k, i]
+            lin[i] *= sign
+    for i in range(3):
+        jac[k, i] = R1[0, i] * lin[0] + R1[1, i] * lin[1] + R1[2, i] * lin[2]
+
+
+@numba.njit(cache=True)
+def relative_points(
+    qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R, frame_p, r, jac
+):  # fmt: skip
+    """Frame 2's origin in frame 1 of each pair b and its Jacobian on the pair's joints.
+
+    ``r12 = R1ᵀ (p2 − p1)`` into ``r[b]``, the columns ``∂r12/∂q̇_k`` into ``jac[k, :3]``.
+    """
+    n = kind.shape[0]
+    origin = work[: 3 * n].reshape((n, 3))
+    axis_w = work[3 * n : 6 * n].reshape((n, 3))
+    small = work[12 * n :]
+    R, R1 = small[0:9].reshape((3, 3)), small[9:18].reshape((3, 3))
+    R2 = small[18:27].reshape((3, 3))
+    p, p1, p2 = small[36:39], small[39:42], small[42:45]
+    w, lin = small[48:51], small[51:54]
+    T, X = small[75:84].reshape((3, 3)), small[84:93].reshape((3, 3))
+    for b in range(start.shape[0] - 1):
+        lo, mid, hi = start[b], split[b], start[b + 1]
+        _pair_pose(qp, b, lo, mid, hi, kind, q_index, axis, place_R, place_p, frame_R, frame_p,
+                   R, p, R1, p1, R2, p2, origin, axis_w, T, X)  # fmt: skip
+        for i in range(3):
+            r[b, i] = (
+                R1[0, i] * (p2[0] - p1[0]) + R1[1, i] * (p2[1] - p1[1]) + R1[2, i] * (p2[2] - p1[2])
+            )
+        for k in range(lo, hi):
+            _translation_column(k, k >= mid, kind, origin, axis_w, R1, p2, w, lin, jac)
+
+
+@numba.njit(cache=True)
 def evaluate(
     qp, vp, gains, tau_c, tau_d, K, D, work,
     start, split, kind, q_index, v_index, axis, place_R, place_p, frame_R, frame_p,
@@ -270,18 +359,11 @@ def evaluate(
     U = 0.0
     for b in range(start.shape[0] - 1):
         lo, mid, hi = start[b], split[b], start[b + 1]
-        for side in range(2):
-            R[:, :] = 0.0
-            R[0, 0] = R[1, 1] = R[2, 2] = 1.0
-            p[:] = 0.0
-            a, z = (lo, mid) if side == 0 else (mid, hi)
-            _walk(qp, a, z, kind, q_index, axis, place_R, place_p, R, p, origin, axis_w, T, X)
-            if side == 0:
-                _frame(R, p, frame_R[b, 0], frame_p[b, 0], R1, p1)
-            else:
-                _frame(R, p, frame_R[b, 1], frame_p[b, 1], R2, p2)
-        for i in range(3):  # c12 = R1ᵀ R2, r12 = R1ᵀ (p2 − p1)
+        _pair_pose(qp, b, lo, mid, hi, kind, q_index, axis, place_R, place_p, frame_R, frame_p,
+                   R, p, R1, p1, R2, p2, origin, axis_w, T, X)  # fmt: skip
+        for i in range(3):
             d[i] = p2[i] - p1[i]
+        for i in range(3):  # c12 = R1ᵀ R2, r12 = R1ᵀ (p2 − p1)
             for j in range(3):
                 c12[i, j] = R1[0, i] * R2[0, j] + R1[1, i] * R2[1, j] + R1[2, i] * R2[2, j]
         for i in range(3):
@@ -300,20 +382,7 @@ def evaluate(
         inv[2, 0], inv[2, 1], inv[2, 2] = cy * tp, sy * tp, 1.0
         rate[:] = 0.0
         for k in range(lo, hi):
-            sign = -1.0 if k < mid else 1.0
-            if kind[k] == PRISMATIC:
-                for i in range(3):
-                    w[i] = 0.0
-                    lin[i] = sign * axis_w[k, i]
-            else:  # ω = a_k, v + ω × p2 = a_k × (p2 − o_k)
-                a0, a1, a2 = axis_w[k, 0], axis_w[k, 1], axis_w[k, 2]
-                r0, r1, r2 = p2[0] - origin[k, 0], p2[1] - origin[k, 1], p2[2] - origin[k, 2]
-                lin[0], lin[1], lin[2] = a1 * r2 - a2 * r1, a2 * r0 - a0 * r2, a0 * r1 - a1 * r0
-                for i in range(3):
-                    w[i] = sign * axis_w[k, i]
-                    lin[i] *= sign
-            for i in range(3):
-                jac[k, i] = R1[0, i] * lin[0] + R1[1, i] * lin[1] + R1[2, i] * lin[2]
+            _translation_column(k, k >= mid, kind, origin, axis_w, R1, p2, w, lin, jac)
             w0 = R2[0, 0] * w[0] + R2[1, 0] * w[1] + R2[2, 0] * w[2]  # R2ᵀ ω
             w1 = R2[0, 1] * w[0] + R2[1, 1] * w[1] + R2[2, 1] * w[2]
             w2 = R2[0, 2] * w[0] + R2[1, 2] * w[1] + R2[2, 2] * w[2]
@@ -376,6 +445,7 @@ class ElementKernels:
         return None if found is None else cls(model, found)
 
     def _run(self, qp, vp, gains, tau_c, tau_d, K, D) -> float:
+        qp, vp = np.ascontiguousarray(qp, dtype=float), np.ascontiguousarray(vp, dtype=float)
         U, bad = evaluate(qp, vp, gains, tau_c, tau_d, K, D, self._work, *self._args)
         if bad >= 0:
             raise SingularConfigurationError("bushing at Euler-angle gimbal lock (θ = ±π/2)")
@@ -407,3 +477,42 @@ class ElementKernels:
         """``U_c = Σ ½ δᵀ C δ`` (as ``spring_potential``)."""
         n = self.nv
         return self._run(qp, np.zeros(n), False, np.zeros(n), np.zeros(n), self._none, self._none)
+
+
+class RelativePoints:
+    """Compiled positions of points in other bodies' frames and their Jacobians.
+
+    For pairs of frames ``(joint, SE3)``: frame 2's origin in frame 1's axes,
+    ``r12 = R1ᵀ (p2 − p1)``, and ``∂r12/∂v`` (3 × nv, Pinocchio's v), from the same
+    joint walk as the elements (:func:`relative_points`). A gear sector's mesh point in
+    its stator is one (:func:`rt70.reference.drives.drive_force_function`).
+    Build with :meth:`of`, which gives None when a pair's path is not supported.
+    """
+
+    def __init__(self, model: ReferenceModel, found: dict[str, np.ndarray]) -> None:
+        self.nv = model.pin_model.nv
+        self.n = len(found["split"])
+        self.v_index = found["v_index"]
+        names = ("start", "split", "kind", "q_index", "axis", "place_R", "place_p")
+        self._args = tuple(found[k] for k in names + ("frame_R", "frame_p"))
+        self.start = found["start"]
+        self._work = np.zeros(12 * len(found["kind"]) + WORK_SMALL)
+        self._jac = np.zeros((len(found["kind"]), 3))
+
+    @classmethod
+    def of(cls, model: ReferenceModel, frames1, frames2) -> RelativePoints | None:
+        """The kernels of these pairs, or None if :func:`paths` does not support them."""
+        found = paths(model, frames1, frames2)
+        return None if found is None else cls(model, found)
+
+    def __call__(self, qp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(r12, ∂r12/∂v)`` of every pair: shapes (n, 3) and (n, 3, nv)."""
+        r = np.zeros((self.n, 3))
+        relative_points(
+            np.ascontiguousarray(qp, dtype=float), self._work, *self._args, r, self._jac
+        )
+        J = np.zeros((self.n, 3, self.nv))
+        for b in range(self.n):
+            lo, hi = self.start[b], self.start[b + 1]
+            J[b][:, self.v_index[lo:hi]] = self._jac[lo:hi].T
+        return r, J
