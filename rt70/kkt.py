@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from rt70.errors import Rt70Error
 
@@ -84,6 +83,8 @@ def solve_kkt(
         If A is not positive definite, or the constraints contradict each other
         (g has a part outside the range of B_c's independent rows).
     """
+    import scipy.linalg  # here, not at import: rt70's start-up does not pay for it
+
     B_c = np.atleast_2d(np.asarray(B_c, dtype=float))
     m = B_c.shape[0]
     try:
