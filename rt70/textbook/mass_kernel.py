@@ -121,24 +121,27 @@ def _mass_matrix_one(
     p: np.ndarray,
     theta_c: np.ndarray,
     sigma: np.ndarray,
-    scratch: np.ndarray,
+    m6: np.ndarray,
+    m3: np.ndarray,
+    v3: np.ndarray,
     out: np.ndarray,
 ) -> None:
     """``A_full`` at one configuration into ``out`` (module docstring, steps 1–4).
 
-    ``scratch`` is a (8, 6, 6) work array; nothing is allocated here.
+    ``m6`` (3, 6, 6), ``m3`` (2, 3, 3) and ``v3`` (6, 3) are work arrays (contiguous
+    slices, so that the compiled loops stay simple); nothing is allocated here.
     """
     nb = parent.shape[0]
-    rows, L, T = scratch[0], scratch[1], scratch[2]
-    c, cc = scratch[3, :3, :3], scratch[3, 3:, 3:]
-    r, rr, w, v = scratch[4, 0, :3], scratch[4, 1, :3], scratch[4, 2, :3], scratch[4, 3, :3]
-    F = scratch[5, 0]
+    rows, L, T = m6[0], m6[1], m6[2]
+    c, cc = m3[0], m3[1]
+    r, rr, w, v, F = v3[0], v3[1], v3[2], v3[3], v3[4:].reshape(6)
     for j in range(nb):  # steps 1 and 2, parents first
         s0 = q_start[j]
         _pair_motion(kind[j], axis[j], qf[s0 : s0 + ndof[j]], c, r, rows)
         _matmul3(c_c[j], c, cc)  # the construction frame's rotation, then the pair's
         _matvec3(c_c[j], r, rr)
-        rr += r_c[j]
+        for m in range(3):
+            rr[m] += r_c[j, m]
         i = parent[j]
         if i < 0:
             C[j] = cc
@@ -146,7 +149,8 @@ def _mass_matrix_one(
         else:
             _matmul3(C[i], cc, C[j])
             _matvec3(C[i], rr, p[j])
-            p[j] += p[i]
+            for m in range(3):
+                p[j, m] += p[i, m]
         Cj, pj = C[j], p[j]
         for a in range(ndof[j]):  # σ = [C v + p × C w; C w]
             _matvec3(Cj, rows[a, 3:], w)
@@ -179,7 +183,9 @@ def _mass_matrix_one(
     for j in range(nb - 1, -1, -1):  # step 3: leaves to the root (children follow parents)
         i = parent[j]
         if i >= 0:
-            theta_c[i] += theta_c[j]
+            for a in range(6):
+                for b in range(6):
+                    theta_c[i, a, b] += theta_c[j, a, b]
     out[:] = 0.0
     for k in range(nb):  # step 4
         sk = q_start[k]
@@ -202,6 +208,24 @@ def _mass_matrix_one(
 
 
 @numba.njit(cache=True)
+def _reduce(
+    full: np.ndarray, g_ptr: np.ndarray, g_col: np.ndarray, g_val: np.ndarray, out: np.ndarray
+) -> None:
+    """``out = Gᵀ A_full G`` with G in compressed rows (a mimic row has one entry)."""
+    out[:] = 0.0
+    n = full.shape[0]
+    for a in range(n):
+        for b in range(n):
+            x = full[a, b]
+            if x == 0.0:
+                continue
+            for ia in range(g_ptr[a], g_ptr[a + 1]):
+                xa = g_val[ia] * x
+                for ib in range(g_ptr[b], g_ptr[b + 1]):
+                    out[g_col[ia], g_col[ib]] += xa * g_val[ib]
+
+
+@numba.njit(cache=True)
 def _mass_matrix_many(
     Qf: np.ndarray,
     parent: np.ndarray,
@@ -212,33 +236,33 @@ def _mass_matrix_many(
     r_c: np.ndarray,
     c_c: np.ndarray,
     Theta: np.ndarray,
+    g_ptr: np.ndarray,
+    g_col: np.ndarray,
+    g_val: np.ndarray,
     out: np.ndarray,
 ) -> None:
-    """``A_full`` for every row of ``Qf`` into ``out`` (K, n, n); one thread, a plain loop."""
+    """A for every row of ``Qf`` (full coordinates) into ``out``; one thread, a plain loop.
+
+    Without mimic constraints (``g_ptr`` empty) ``out`` is A_full, (K, n, n); with them
+    ``Gᵀ A_full G`` (K, nv, nv), G given in compressed rows ``g_ptr``, ``g_col``, ``g_val``.
+    """
     nb, n = parent.shape[0], Qf.shape[1]
     C = np.empty((nb, 3, 3))
     p = np.empty((nb, 3))
     theta_c = np.empty((nb, 6, 6))
     sigma = np.empty((n, 6))
-    scratch = np.empty((8, 6, 6))
+    m6, m3, v3 = np.empty((3, 6, 6)), np.empty((2, 3, 3)), np.empty((6, 3))
+    reduce = g_ptr.size > 0
+    full = np.empty((n, n)) if reduce else out[0]
     for s in range(Qf.shape[0]):
+        if not reduce:
+            full = out[s]
         _mass_matrix_one(
-            Qf[s],
-            parent,
-            kind,
-            q_start,
-            ndof,
-            axis,
-            r_c,
-            c_c,
-            Theta,
-            C,
-            p,
-            theta_c,
-            sigma,
-            scratch,
-            out[s],
-        )
+            Qf[s], parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c, sigma,
+            m6, m3, v3, full,
+        )  # fmt: skip
+        if reduce:
+            _reduce(full, g_ptr, g_col, g_val, out[s])
 
 
 @dataclass(frozen=True)
@@ -253,10 +277,14 @@ class KernelModel:
     r_c: np.ndarray
     c_c: np.ndarray
     Theta: np.ndarray
+    g_ptr: np.ndarray  # G (mimic constraints) in compressed rows; empty without them
+    g_col: np.ndarray
+    g_val: np.ndarray
 
     @classmethod
     def of(cls, model: Model) -> KernelModel:
         """The arrays of ``model`` (contiguous, int64 / float64)."""
+        G = model.G
 
         def f64(x: np.ndarray) -> np.ndarray:
             return np.ascontiguousarray(x, dtype=np.float64)
@@ -273,6 +301,11 @@ class KernelModel:
             r_c=f64(np.reshape(model.r_c, (model.nb, 3))),
             c_c=f64(np.reshape(model.c_c, (model.nb, 3, 3))),
             Theta=f64(np.reshape(model.Theta, (model.nb, 6, 6))),
+            g_ptr=i64(
+                np.zeros(0) if G is None else np.r_[0, np.cumsum(np.count_nonzero(G, axis=1))]
+            ),
+            g_col=i64(np.zeros(0) if G is None else np.nonzero(G)[1]),
+            g_val=f64(np.zeros(0) if G is None else G[np.nonzero(G)]),
         )
 
 
@@ -289,7 +322,6 @@ class KernelData:
         self.arrays = KernelModel.of(model)
         self.K = K
         self.A = np.empty((K, model.nv, model.nv))
-        self._full = None if model.G is None else np.empty((K, model.n_full, model.n_full))
         self._model = model
 
 
@@ -315,11 +347,11 @@ def mass_matrix_batch(model: Model, data: KernelData, Q: np.ndarray) -> np.ndarr
 
 def _compute(model: Model, data: KernelData, Q: np.ndarray) -> None:
     k = data.arrays
-    Qf = np.ascontiguousarray(Q if model.G is None else Q @ model.G.T + model.q_offset)
-    full = data.A if model.G is None else data._full
-    _mass_matrix_many(Qf, k.parent, k.kind, k.q_start, k.ndof, k.axis, k.r_c, k.c_c, k.Theta, full)
-    if model.G is not None:
-        np.matmul(model.G.T @ full, model.G, out=data.A)
+    Qf = Q if model.G is None else Q @ model.G.T + model.q_offset
+    _mass_matrix_many(
+        np.ascontiguousarray(Qf), k.parent, k.kind, k.q_start, k.ndof, k.axis, k.r_c, k.c_c,
+        k.Theta, k.g_ptr, k.g_col, k.g_val, data.A,
+    )  # fmt: skip
 
 
 def mass_matrix(model: Model, data: KernelData, q: np.ndarray) -> np.ndarray:
