@@ -223,6 +223,12 @@ def _reduce(
                 xa = g_val[ia] * x
                 for ib in range(g_ptr[b], g_ptr[b + 1]):
                     out[g_col[ia], g_col[ib]] += xa * g_val[ib]
+    m = out.shape[0]
+    for i in range(m):  # exactly symmetric (the sums above run in different orders)
+        for j in range(i + 1, m):
+            x = 0.5 * (out[i, j] + out[j, i])
+            out[i, j] = x
+            out[j, i] = x
 
 
 @numba.njit(cache=True)
