@@ -15,10 +15,11 @@ arithmetic instead of Python and numpy call overhead:
 4. ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` (and symmetric), walking
    from each body up its ancestors; 0 across branches.
 
-With mimic constraints the kernel returns the full-coordinate matrix and
-``A = Gᵀ A_full G`` is one product after it. The kernel is compiled on first use and
-cached on disk (``cache=True``), so a second process pays no compilation. It never runs
-threads of its own (no ``parallel=True``): a batch is a plain loop over configurations.
+With mimic constraints the kernel reduces the full-coordinate matrix to
+``A = Gᵀ A_full G`` itself, with G in compressed rows (one entry per mimic row). The
+kernel is compiled on first use and cached on disk (``cache=True``), so a second process
+pays no compilation. It never runs threads of its own (no ``parallel=True``): a batch is
+a plain loop over configurations.
 """
 
 from __future__ import annotations
@@ -259,7 +260,7 @@ def _mass_matrix_many(
     sigma = np.empty((n, 6))
     m6, m3, v3 = np.empty((3, 6, 6)), np.empty((2, 3, 3)), np.empty((6, 3))
     reduce = g_ptr.size > 0
-    full = np.empty((n, n)) if reduce else out[0]
+    full = np.empty((n, n)) if reduce else np.empty((0, 0))
     for s in range(Qf.shape[0]):
         if not reduce:
             full = out[s]
