@@ -1,5 +1,11 @@
 """Benchmarks of the textbook algorithm against Pinocchio, as ratios taken in one run.
 
+The textbook side is timed in its compiled form (:mod:`rt70.textbook.mass_kernel`, the
+rows ``per_call``, ``batched``, ``scaling_*``) and in its readable numpy form
+(:mod:`rt70.textbook.structured`, the rows ``*_numpy``), and the dense form of the book
+(``scaling_*_dense``); the targets judge the compiled form. ``first_call`` is the kernel's
+first call in the process: compilation, or loading it from numba's on-disk cache.
+
 This machine is shared and noisy, so every comparison interleaves the two sides:
 each round times the textbook call and the Pinocchio call back to back, the ratio is
 taken per round, and the median ratio is reported (with the best time of each side).
@@ -23,7 +29,7 @@ from rt70.atomic import atomic_write, atomic_write_text
 from rt70.reports.targets import TargetCheck
 from rt70.reports.threads import single_threaded
 from rt70.scene import Scene, load_scene, scene_from_text
-from rt70.textbook import dynamics, structured
+from rt70.textbook import dynamics, mass_kernel, structured
 
 
 @dataclass(frozen=True)
@@ -84,18 +90,38 @@ def _pin_crba(scene: Scene, q: np.ndarray) -> Callable[[], object]:
     return lambda: pin.crba(model, data, qp)
 
 
-def per_call(scene: Scene, rounds: int, budget_s: float) -> Row:
-    """Textbook structured A(q) against one ``pin.crba`` call."""
+def first_call(scene: Scene) -> Row:
+    """The kernel's first call in this process (compile or cache load) against ``pin.crba``'s."""
+    model = scene.textbook
+    q = np.zeros(model.nv)
+    kdata = mass_kernel.KernelData(model, 1)
+    start = time.perf_counter()
+    mass_kernel.mass_matrix(model, kdata, q)
+    t_tb = time.perf_counter() - start
+    crba = _pin_crba(scene, q)
+    start = time.perf_counter()
+    crba()
+    t_pin = time.perf_counter() - start
+    return Row("first_call", scene.name, model.nv, 1, t_tb, t_pin, t_tb / t_pin)
+
+
+def per_call(scene: Scene, rounds: int, budget_s: float, numpy_form: bool = False) -> Row:
+    """Textbook A(q) (the kernel, or the structured numpy form) against one ``pin.crba``."""
     model = scene.textbook
     q = np.random.default_rng(0).uniform(-0.5, 0.5, model.nv)
-    bdata = structured.BatchData(model, 1)
-    t_tb, t_pin, ratio = compare(
-        lambda: structured.mass_matrix(model, bdata, q), _pin_crba(scene, q), rounds, budget_s
-    )
-    return Row("per_call", scene.name, model.nv, 1, t_tb, t_pin, ratio)
+    if numpy_form:
+        bdata = structured.BatchData(model, 1)
+        textbook = lambda: structured.mass_matrix(model, bdata, q)  # noqa: E731
+    else:
+        kdata = mass_kernel.KernelData(model, 1)
+        textbook = lambda: mass_kernel.mass_matrix(model, kdata, q)  # noqa: E731
+    textbook()  # compiled (or loaded from the cache) before the timing
+    t_tb, t_pin, ratio = compare(textbook, _pin_crba(scene, q), rounds, budget_s)
+    name = "per_call_numpy" if numpy_form else "per_call"
+    return Row(name, scene.name, model.nv, 1, t_tb, t_pin, ratio)
 
 
-def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
+def batched(scene: Scene, K: int, rounds: int, budget_s: float, numpy_form: bool = False) -> Row:
     """Textbook batched A for K configurations against K calls of ``pin.crba``."""
     import pinocchio as pin
 
@@ -103,7 +129,13 @@ def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
 
     model = scene.textbook
     Q = np.random.default_rng(1).uniform(-0.5, 0.5, (K, model.nv))
-    bdata = structured.BatchData(model, K)
+    if numpy_form:
+        bdata = structured.BatchData(model, K)
+        textbook = lambda: structured.mass_matrix_batch(model, bdata, Q)  # noqa: E731
+    else:
+        kdata = mass_kernel.KernelData(model, K)
+        textbook = lambda: mass_kernel.mass_matrix_batch(model, kdata, Q)  # noqa: E731
+    textbook()
     ref = scene.reference
     QP = [reference.to_pinocchio(ref, q)[0] for q in Q]
     pm = ref.pin_model
@@ -113,10 +145,9 @@ def batched(scene: Scene, K: int, rounds: int, budget_s: float) -> Row:
         for qp in QP:
             pin.crba(pm, pd, qp)
 
-    t_tb, t_pin, ratio = compare(
-        lambda: structured.mass_matrix_batch(model, bdata, Q), pin_loop, rounds, budget_s
-    )
-    return Row("batched", scene.name, model.nv, K, t_tb / K, t_pin / K, ratio)
+    t_tb, t_pin, ratio = compare(textbook, pin_loop, rounds, budget_s)
+    name = "batched_numpy" if numpy_form else "batched"
+    return Row(name, scene.name, model.nv, K, t_tb / K, t_pin / K, ratio)
 
 
 def scaling(kind: str, sizes: list[int], rounds: int, budget_s: float, dense_max: int) -> list[Row]:
@@ -131,6 +162,8 @@ def scaling(kind: str, sizes: list[int], rounds: int, budget_s: float, dense_max
     for n in sizes:
         scene = scene_from_text(make(n), f"{kind}_{n}")
         rows.append(replace(per_call(scene, rounds, budget_s), benchmark=f"scaling_{kind}"))
+        numpy_row = per_call(scene, max(3, rounds // 2), budget_s, numpy_form=True)
+        rows.append(replace(numpy_row, benchmark=f"scaling_{kind}_numpy"))
         if n <= dense_max:
             model, data = scene.textbook, scene.textbook_data
             q = np.zeros(model.nv)
@@ -222,12 +255,15 @@ def run(
     rows = []
     with single_threaded() as pinning:
         say(pinning.describe())
+        rows.append(first_call(scenes[0]))
         for scene in scenes:
             say(f"per call: {scene.name}")
             rows.append(per_call(scene, rounds, budget_s))
+            rows.append(per_call(scene, max(3, rounds // 2), budget_s, numpy_form=True))
         for scene in scenes[:2]:
             say(f"batched K={K}: {scene.name}")
             rows.append(batched(scene, K, max(3, rounds // 2), budget_s))
+            rows.append(batched(scene, K, max(3, rounds // 2), budget_s, numpy_form=True))
         for kind in ("chain", "tree"):
             say(f"scaling: {kind}s of {', '.join(map(str, sizes))} bodies")
             rows.extend(scaling(kind, list(sizes), rounds, budget_s, dense_max))
@@ -251,8 +287,9 @@ def format_report(rows: list[Row]) -> str:
             lines.append(
                 f"exponent of textbook A(q) time vs nv, {kind}s: "
                 f"{fit_exponent(rows, bench):.2f} (all sizes), "
-                f"{fit_exponent(rows, bench, min_nv=100):.2f} (nv ≥ 100); dense form "
-                f"{fit_exponent(rows, bench + '_dense'):.2f}"
+                f"{fit_exponent(rows, bench, min_nv=100):.2f} (nv ≥ 100); numpy form "
+                f"{fit_exponent(rows, bench + '_numpy', min_nv=100):.2f} (nv ≥ 100); dense "
+                f"form {fit_exponent(rows, bench + '_dense'):.2f}"
             )
     if rows:
         lines.append(
@@ -281,7 +318,8 @@ def write_results(rows: list[Row], directory: Path) -> list[Path]:
     styles = {"chain": "o", "tree": "s"}
     for kind, marker in styles.items():
         for bench, label, ls in (
-            (f"scaling_{kind}", "textbook structured", "-"),
+            (f"scaling_{kind}", "textbook kernel", "-"),
+            (f"scaling_{kind}_numpy", "textbook structured numpy", "-."),
             (f"scaling_{kind}_dense", "textbook dense", ":"),
         ):
             pts = sorted((r.nv, r.t_textbook_s) for r in rows if r.benchmark == bench)
