@@ -638,7 +638,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--method",
         choices=METHODS,
-        help="solve_ivp method (default BDF; LSODA for the servo scenarios)",
+        help="integrator: a solve_ivp method, or CVODE / CVODE_ADAMS (SUNDIALS) "
+        "(default BDF; LSODA for the servo scenarios)",
     )
     sim.add_argument("--backend", default="pinocchio", choices=("pinocchio", "textbook"))
     sim.add_argument(
