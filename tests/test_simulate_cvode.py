@@ -134,3 +134,22 @@ def test_command_line_accepts_cvode(capsys):
     assert {"CVODE", "CVODE_ADAMS"} <= set(METHODS)
     assert main(["simulate", "double_pendulum", "--t-end", "0.1", "--method", "CVODE"]) == 0
     assert "CVODE" in capsys.readouterr().out
+
+
+def test_each_integrator_family_is_imported_only_when_used():
+    """scipy.integrate (~0.35 s) only on the solve_ivp path, sksundae (~0.45 s) only on
+    CVODE's."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from rt70.scene import load_scene\n"
+        "from rt70.simulate import simulate\n"
+        "loaded = lambda: ['scipy.integrate' in sys.modules, 'sksundae' in sys.modules]\n"
+        "print(loaded())\n"
+        "simulate(load_scene('double_pendulum'), (0, 0.01), method='CVODE')\n"
+        "print(loaded())\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split("\n")[:2] == ["[False, False]", "[False, True]"]
