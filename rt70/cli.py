@@ -468,11 +468,13 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
 def _print_solver(result) -> None:
     # with output times asked for (t_eval) scipy does not keep the step count: -1
     steps = f"{result.n_steps} steps, " if result.n_steps >= 0 else ""
+    lu = f", {result.nlu} LU" if result.nlu >= 0 else ""  # CVODE does not report it: -1
     print(
-        f"  {steps}{result.nfev} evaluations, {result.njev} Jacobians, "
-        f"{result.nlu} LU; {result.wall_time_s:.3f} s wall, "
-        f"{result.real_time_factor:.1f}× real time"
+        f"  {steps}{result.nfev} evaluations, {result.njev} Jacobians{lu}; "
+        f"{result.wall_time_s:.3f} s wall, {result.real_time_factor:.1f}× real time"
     )
+    split = ", ".join(f"{k} {v:.3f} s" for k, v in result.timing.items())
+    print(f"  time split: {split}")
 
 
 def _write_simulation(out, result, figure) -> None:
@@ -638,7 +640,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--method",
         choices=METHODS,
-        help="solve_ivp method (default BDF; LSODA for the servo scenarios)",
+        help="integrator: a solve_ivp method, or CVODE / CVODE_ADAMS (SUNDIALS) "
+        "(default BDF; LSODA for the servo scenarios)",
     )
     sim.add_argument("--backend", default="pinocchio", choices=("pinocchio", "textbook"))
     sim.add_argument(

@@ -30,25 +30,29 @@ from rt70.errors import (
     SimulationError,
     SingularConfigurationError,
 )
+from rt70.integrators import CVODE_METHODS, SCIPY_METHODS, Stopwatch, integrate
 from rt70.outputs import Output, column_labels, evaluate, evaluate_trajectory
 from rt70.scene import Scene
 from rt70.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, check_euler_pairs, euler_theta_indices
 
-#: Integration methods of scipy.integrate.solve_ivp accepted by :func:`simulate`.
-METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
+#: Integration methods of :func:`simulate`: scipy.integrate.solve_ivp's, then SUNDIALS
+#: CVODE's (BDF, and Adams for non-stiff problems; :mod:`rt70.integrators`).
+METHODS = SCIPY_METHODS + tuple(CVODE_METHODS)
 #: Smallest rtol solve_ivp honours (it raises smaller ones to 100 machine epsilons).
 MIN_RTOL = 100 * np.finfo(float).eps
 #: Output formats of :meth:`SimulationResult.save`, by suffix.
 OUTPUT_SUFFIXES = (".csv", ".npz")
-#: Methods that use the Jacobian of the right-hand side.
+#: solve_ivp methods that use the Jacobian of the right-hand side (CVODE's all do).
 IMPLICIT = ("Radau", "BDF", "LSODA")
 #: A drift of the energy balance larger than this many times rtol (relative to the energy
 #: exchanged during the run) is flagged: more than the tolerance explains.
 DRIFT_FACTOR = 100.0
 
 Inputs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+#: An event function g(t, q, q̇), with optional ``terminal`` and ``direction`` attributes.
+Event = Callable[[float, np.ndarray, np.ndarray], float]
 
 
 class _Backend:
@@ -224,7 +228,13 @@ class SimulationResult:
     ``DRIFT_FACTOR · rtol`` of it. ``states`` holds the trajectory of every extra state
     by name (:mod:`rt70.states`; the energy audit's ``dissipated`` and ``input_work``
     first). ``constraint_residual`` is ``max |Φ|`` per sample for a scene with closed
-    chains (:mod:`rt70.closed_chains`), empty otherwise.
+    chains (:mod:`rt70.closed_chains`), empty otherwise. ``t_events`` holds the times
+    at which each of the ``events`` of :func:`simulate` crossed zero. ``timing`` splits
+    ``wall_time_s``: "rhs" (s inside the right-hand side, including the calls of a
+    difference-quotient Jacobian), "jacobian" (s inside the analytic Jacobian) and
+    "integrator" (the rest: the solver's own work, its linear algebra included).
+    ``nlu`` is −1 where the solver does not report it (CVODE), ``n_steps`` −1 when
+    ``t_eval`` was given.
     """
 
     scene: str
@@ -254,6 +264,8 @@ class SimulationResult:
     outputs: dict[str, np.ndarray] = field(default_factory=dict)
     states: dict[str, np.ndarray] = field(default_factory=dict)
     constraint_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    t_events: list[np.ndarray] = field(default_factory=list)
+    timing: dict[str, float] = field(default_factory=dict)
 
     @property
     def relative_drift(self) -> float:
@@ -339,6 +351,7 @@ def simulate(
     outputs: Sequence[Output] = (),
     components: Sequence[StateComponent] = (),
     stabilization: Baumgarte | None = DEFAULT_STABILIZATION,
+    events: Sequence[Event] = (),
 ) -> SimulationResult:
     """Integrate the scene's equations of motion over ``t_span``.
 
@@ -356,7 +369,8 @@ def simulate(
         ``∂q̈/∂(q, q̇)`` of ``computeABADerivatives`` plus the springs' ``Σ JᵀCJ``,
         ``Σ JᵀDJ``; the textbook backend lets scipy difference the right-hand side).
     method : str
-        A ``scipy.integrate.solve_ivp`` method (:data:`METHODS`).
+        A ``scipy.integrate.solve_ivp`` method or "CVODE" / "CVODE_ADAMS" (SUNDIALS;
+        :data:`METHODS`, :mod:`rt70.integrators`).
     rtol, atol : float
         Tolerances; ``atol`` defaults to ``1e-3 · rtol`` on q and q̇ (m, rad) and
         ``rtol`` of the initial energy scale on the two energy states.
@@ -378,14 +392,19 @@ def simulate(
         of the perturbation equations (2.2); None integrates ``Φ̈ = 0`` and lets Φ
         drift. The start is assembled from rest (x0 None) or must be closed; the
         residual ``max |Φ|`` is in ``result.constraint_residual``.
+    events : sequence of callable (t, q, q̇) -> float
+        Functions whose zero crossings are located (e.g. a brake engaging), with the
+        optional attributes ``terminal`` (stop there) and ``direction`` of solve_ivp,
+        for every method; the times are in ``result.t_events``, one array per function.
     """
-    from scipy.integrate import solve_ivp
     from tqdm import tqdm
 
     if backend not in BACKENDS:
         raise Rt70Error(f"unknown backend '{backend}' (choose from {', '.join(BACKENDS)})")
     if method not in METHODS:
         raise Rt70Error(f"unknown method '{method}' (choose from {', '.join(METHODS)})")
+    if not all(callable(g) for g in events):
+        raise Rt70Error("events must be callables g(t, q, qd)")
     if not (np.isfinite(rtol) and MIN_RTOL <= rtol < 1.0):
         raise Rt70Error(f"rtol must lie in [{MIN_RTOL:.3g}, 1), got {rtol!r}")
     if atol is not None and not (np.isfinite(atol) and atol > 0.0):
@@ -455,8 +474,9 @@ def simulate(
         return out
 
     jac = None
+    implicit = method in IMPLICIT or method in CVODE_METHODS
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked in jac
-        analytic = method in IMPLICIT and side.jacobian(q0, qd0, None) is not None
+        analytic = implicit and side.jacobian(q0, qd0, None) is not None
     if analytic:
 
         def jac(t, x):
@@ -472,18 +492,20 @@ def simulate(
         disable=not progress,
         bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]",
     )
+    rhs_clock, jac_clock = Stopwatch(rhs), None if jac is None else Stopwatch(jac)
     start = time.perf_counter()
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked above
-            sol = solve_ivp(
-                rhs,
+            sol = integrate(
+                method,
+                rhs_clock,
+                jac_clock,
                 (t0, t1),
                 np.concatenate([q0, qd0, *layout.initial()]),
-                method=method,
-                rtol=rtol,
-                atol=atol_vec,
-                t_eval=t_eval,
-                **({} if jac is None else {"jac": jac}),
+                rtol,
+                atol_vec,
+                t_eval,
+                [_state_event(g, n) for g in events],
             )
     except (Rt70Error, ValueError) as exc:
         # Rt70Error: the model cannot be integrated beyond this state; ValueError "array
@@ -495,6 +517,8 @@ def simulate(
     finally:
         bar.close()
     wall = time.perf_counter() - start
+    spent = {"rhs": rhs_clock.seconds, "jacobian": 0.0 if jac_clock is None else jac_clock.seconds}
+    timing = {**spent, "integrator": wall - spent["rhs"] - spent["jacobian"]}
     q, qd = sol.y[:n].T, sol.y[n : 2 * n].T
     energies = np.array([side.energies(a, b) for a, b in zip(q, qd, strict=True)])
     states = layout.read(sol.y)
@@ -520,21 +544,34 @@ def simulate(
         input_work=W_u,
         balance=balance,
         balance_scale=scale,
-        nfev=int(sol.nfev),
-        njev=int(sol.njev),
-        nlu=int(sol.nlu),
-        n_steps=len(sol.t) - 1 if t_eval is None else -1,
+        nfev=sol.nfev,
+        njev=sol.njev,
+        nlu=sol.nlu,
+        n_steps=sol.n_steps,
         wall_time_s=wall,
-        success=bool(sol.success),
-        message=str(sol.message),
+        success=sol.success,
+        message=sol.message,
         coordinates=list(scene.textbook.coordinate_names),
         states=states,
         constraint_residual=residual_trajectory(side, q),
+        t_events=sol.t_events,
+        timing=timing,
     )
     passive = inputs is None and not pushed[0]
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
     result.outputs = evaluate_trajectory(scene, q, outputs, output_side)
     return result
+
+
+def _state_event(g: Event, n: int) -> Callable[[float, np.ndarray], float]:
+    """The event ``g(t, q, q̇)`` as a function of the state, its attributes kept."""
+
+    def event(t, x):
+        return float(g(t, x[:n], x[n : 2 * n]))
+
+    event.terminal = getattr(g, "terminal", False)
+    event.direction = getattr(g, "direction", 0.0)
+    return event
 
 
 def _check_mass_matrix(scene: Scene, side: _Backend, q0: np.ndarray) -> None:
