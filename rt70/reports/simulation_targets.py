@@ -21,9 +21,13 @@ Right-hand side and Jacobian
     (:func:`rt70.reports.threads.single_threaded`); the median per-round ratio must be
     ≤ :data:`KERNEL_RATIO_TARGET` (:func:`kernel_targets`).
 Servo closed
-    ``rt70 simulate rt70_servo`` (the ``hold`` scenario with the scene's drives and the
-    servo) at centre-of-mass error ≤ 1e-5 m against a tight reference of the same
+    ``rt70 simulate rt70_servo --scenario step-elevation --t-end 10`` (the scene's
+    drives and the servo closed, the elevation stepped: a 10 s transient as the free
+    one) at centre-of-mass error ≤ 1e-5 m against a tight reference of the same
     scenario, at ≥ :data:`SERVO_REAL_TIME_TARGET` × real time (:func:`servo_target`).
+    The default ``hold`` is not used: at rest its error says nothing about accuracy,
+    and LSODA at rtol ≤ 1e-10 on it did not finish within 200 s (measured), so it has
+    no tight reference.
 """
 
 from __future__ import annotations
@@ -52,11 +56,14 @@ COMMAND_REPEATS = 3
 KERNEL_RATIO_TARGET = 3.0
 #: The servo-closed run, × real time.
 SERVO_REAL_TIME_TARGET = 25.0
+#: The servo scenario and its span, s.
+SERVO_SCENARIO = "step-elevation"
+SERVO_T_END = 10.0
 #: Tolerances tried on the servo scenario (the fastest meeting the accuracy counts).
 SERVO_RTOLS = (1e-5, 1e-6, 1e-7, 1e-8)
-#: Reference of the servo scenario: LSODA (scipy's BDF and Radau stop at random on a
-#: hold, :func:`rt70.scenarios.run_scenario`) at this tolerance.
-SERVO_REFERENCE_RTOL = 1e-11
+#: Reference of the servo scenario: LSODA, the scenarios' method
+#: (:func:`rt70.scenarios.run_scenario`), at this tolerance (1e-9 took 19 s, measured).
+SERVO_REFERENCE_RTOL = 1e-10
 
 Say = Callable[[str], None]
 
@@ -201,10 +208,10 @@ def kernel_targets(rounds: int = 7, budget_s: float = 0.05) -> list[TargetCheck]
 def servo_runs(
     rtols: tuple[float, ...] = SERVO_RTOLS,
     methods: tuple[str, ...] | None = None,
-    t_end: float = 10.0,
+    t_end: float = SERVO_T_END,
     progress: Say | None = None,
 ) -> list[dict]:
-    """``rt70 simulate rt70_servo --t-end T`` (``hold``) per method and tolerance, measured.
+    """``rt70 simulate rt70_servo --scenario step-elevation --t-end T`` per method and rtol.
 
     Every run goes through :func:`rt70.scenarios.run_scenario` as the command does (the
     scene's drives and the servo closed, the default pointing), BLAS pinned; its
@@ -228,7 +235,7 @@ def servo_runs(
 
     say = progress or _quiet
     scene = load_scene("rt70_servo")
-    sc, _ = scenarios.choose(scene, None, None, None, t_end)
+    sc, _ = scenarios.choose(scene, SERVO_SCENARIO, None, None, t_end)
     drives, _ = choose_drives(scene, None)
     # LSODA is the scenarios' method (scipy's BDF and Radau stop at random on a hold);
     # the compiled integrators join once they are in METHODS
@@ -276,7 +283,8 @@ def servo_runs(
 def servo_target(runs: list[dict] | None) -> TargetCheck:
     """≥ 25× real time at centre-of-mass error ≤ 1e-5 m with drives and servo closed."""
     goal = (
-        f"rt70_servo (hold, scene drives and servo closed), centre-of-mass error ≤ "
+        f"rt70_servo ({SERVO_SCENARIO}, {SERVO_T_END:g} s, scene drives and servo closed), "
+        f"centre-of-mass error ≤ "
         f"{COM_TARGET_M:g} m: ≥ {SERVO_REAL_TIME_TARGET:g}× real time"
     )
     if runs is None:

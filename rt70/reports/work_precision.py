@@ -88,6 +88,7 @@ import numpy as np
 from rt70 import simulate as _simulate
 from rt70.atomic import atomic_write, atomic_write_text
 from rt70.errors import Rt70Error
+from rt70.reports import simulation_targets
 from rt70.reports.targets import TargetCheck
 from rt70.reports.work_precision_problems import PROBLEMS, QUICK_PROBLEMS, Problem
 from rt70.reports.work_precision_worker import Attempt, Worker
@@ -510,6 +511,15 @@ def write_results(rows: list[Row], directory: str | Path) -> list[Path]:
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.axvline(cap, color="0.5", ls="--", lw=1, label=f"time cap {cap:g} s")
+        if problem == simulation_targets.TARGET_PROBLEM:  # the issue-13 target region
+            ax.axhline(simulation_targets.COM_TARGET_M, color="C3", ls="-.", lw=1)
+            ax.axvline(
+                mine[0].t_end / simulation_targets.REAL_TIME_TARGET,
+                color="C3",
+                ls="-.",
+                lw=1,
+                label="target: ≤ 1e-5 m in ≤ T/50",
+            )
         floor = mine[0].com_floor
         if floor > 0:
             ax.axhline(floor, color="0.5", ls=":", lw=1, label="references' agreement")
