@@ -518,7 +518,8 @@ def write_results(rows: list[Row], directory: str | Path) -> list[Path]:
                 color="C3",
                 ls="-.",
                 lw=1,
-                label="target: ≤ 1e-5 m in ≤ T/50",
+                label=f"target: ≤ {simulation_targets.COM_TARGET_M:g} m in ≤ T/"
+                f"{simulation_targets.REAL_TIME_TARGET:g}",
             )
         floor = mine[0].com_floor
         if floor > 0:
