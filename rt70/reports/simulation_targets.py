@@ -60,10 +60,11 @@ SERVO_REAL_TIME_TARGET = 25.0
 SERVO_SCENARIO = "step-elevation"
 SERVO_T_END = 10.0
 #: Tolerances tried on the servo scenario (the fastest meeting the accuracy counts).
-SERVO_RTOLS = (1e-5, 1e-6, 1e-7, 1e-8)
+SERVO_RTOLS = (1e-5, 1e-6, 1e-7)
 #: Reference of the servo scenario: LSODA, the scenarios' method
-#: (:func:`rt70.scenarios.run_scenario`), at this tolerance (1e-9 took 19 s, measured).
-SERVO_REFERENCE_RTOL = 1e-10
+#: (:func:`rt70.scenarios.run_scenario`), at this tolerance: 1e-9 took 19 s, 1e-10 did
+#: not finish in 150 s (measured), so the ladder stops two decades above it.
+SERVO_REFERENCE_RTOL = 1e-9
 
 Say = Callable[[str], None]
 
