@@ -116,3 +116,31 @@ def test_real_time_target_is_judged_on_the_fastest_run_to_the_error():
     assert wp.check_targets(quick)[0].line().endswith("under the report's 2 s — not judged")
     text = wp.format_table(rows)
     assert check.line() in text and "not measured by this report" in text
+
+
+def test_centre_of_mass_error_beside_the_state_error(quick_rows, tmp_path):
+    for r in quick_rows:
+        assert r.com_floor < 1e-8  # the references' centres of mass agree
+        if r.status == "ok":
+            assert r.com_error > 0 and math.isfinite(r.com_error)
+            assert r.nfev > 0
+            if r.method in ("RK45", "DOP853"):
+                assert r.njev == r.nlu == 0
+            if r.method in ("Radau", "BDF"):
+                assert r.njev > 0 and r.nlu > 0
+        else:
+            assert math.isnan(r.com_error)
+    for problem in QUICK_PROBLEMS:
+        bdf = sorted(
+            (r.rtol, r.com_error)
+            for r in quick_rows
+            if (r.problem, r.method) == (problem.name, "BDF")
+        )
+        assert bdf[0][1] < 0.1 * bdf[-1][1], (problem.name, bdf)
+    wp.write_results(quick_rows, tmp_path)
+    with open(tmp_path / "work_precision.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    assert {"com_error", "com_floor", "n_steps", "rhs_s", "jacobian_s", "integrator_s"} <= set(
+        table[0]
+    )
+    assert "COM m" in wp.format_table(quick_rows)

@@ -4,7 +4,9 @@ Every run happens in a worker process (:mod:`multiprocessing`, ``spawn``) that k
 scenes and runs with BLAS and OpenMP pinned to one thread
 (:func:`rt70.reports.threads.single_threaded`); the parent waits for the result at most
 the cap plus a small allowance for the post-processing, then kills the worker (and
-starts a new one for the next run).
+starts a new one for the next run). Besides the state it sends back the positions of
+the bodies' centres of mass on the output grid (:func:`com_positions`), the engineering
+metric of issue 13.
 """
 
 from __future__ import annotations
@@ -30,6 +32,41 @@ _BUILD_TIMEOUT_S = 300.0
 
 #: The scenes built in this (worker) process, by problem.
 _CACHE: dict[Problem, tuple[object, tuple[np.ndarray, np.ndarray], str]] = {}
+
+
+def com_positions(scene, q: np.ndarray) -> np.ndarray:
+    """World positions of the centres of mass of the bodies with mass, m, at each row of q.
+
+    Computed on the reference side: for each Pinocchio joint ``i`` carrying mass (the
+    bodies rigidly attached to it merged into one inertia), ``c_i = oMi[i] · lever_i``
+    after ``forwardKinematics``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene the trajectory belongs to (its Pinocchio model computes the positions).
+    q : (n_t, nv) array
+        Book coordinates along a trajectory.
+
+    Returns
+    -------
+    (n_t, n_bodies, 3) array
+    """
+    import pinocchio as pin
+
+    from rt70.reference.coordinates import to_pinocchio
+
+    ref, rd = scene.reference, scene.reference_data
+    model, data = ref.pin_model, rd.pin_data
+    massive = [i for i in range(1, model.njoints) if model.inertias[i].mass > 0.0]
+    levers = [model.inertias[i].lever for i in massive]
+    out = np.empty((len(q), len(massive), 3))
+    for k, qk in enumerate(q):
+        qp = to_pinocchio(ref, qk)[0]
+        pin.forwardKinematics(model, data, qp)
+        for j, (i, lever) in enumerate(zip(massive, levers, strict=True)):
+            out[k, j] = data.oMi[i].act(lever)
+    return out
 
 
 def _worker_main(conn: multiprocessing.connection.Connection) -> None:
@@ -71,8 +108,10 @@ def _serve(conn: multiprocessing.connection.Connection, unpinned: str) -> None:
                 t_eval=problem.t_eval,
             )
             x = np.hstack([res.q, res.qd]) if res.success else None
+            com = com_positions(scene, res.q) if res.success else None
+            timing = dict(getattr(res, "timing", None) or {})  # CVODE's split, once merged
             stats = (res.wall_time_s, res.success, res.message, res.nfev, res.njev, res.nlu)
-            conn.send(("result", stats, res.atol, x))
+            conn.send(("result", stats, res.atol, x, com, res.n_steps, timing))
         except Exception:  # reported to the parent, which decides
             conn.send(("error", traceback.format_exc()))
 
@@ -88,6 +127,9 @@ class Attempt:
     njev: int = 0
     nlu: int = 0
     x: np.ndarray | None = None
+    com: np.ndarray | None = None  # (n_t, n_bodies, 3) centres of mass, m
+    n_steps: int = -1  # -1: not known (scipy with t_eval)
+    timing: dict | None = None  # {"rhs", "jacobian", "integrator"} s, when measured
 
 
 class Worker:
@@ -159,9 +201,9 @@ class Worker:
         if msg[0] == "error":
             self.kill()
             return Attempt("failed: " + msg[1].strip().splitlines()[-1])
-        (wall, success, message, nfev, njev, nlu), used_atol, x = msg[1], msg[2], msg[3]
+        (wall, success, message, nfev, njev, nlu), used_atol, x, com, steps, timing = msg[1:]
         if wall > cap:
-            return Attempt("over cap", wall, used_atol, nfev, njev, nlu)
+            return Attempt("over cap", wall, used_atol, nfev, njev, nlu, n_steps=steps)
         if not success:
-            return Attempt(f"failed: {message}", wall, used_atol, nfev, njev, nlu)
-        return Attempt("ok", wall, used_atol, nfev, njev, nlu, x)
+            return Attempt(f"failed: {message}", wall, used_atol, nfev, njev, nlu, n_steps=steps)
+        return Attempt("ok", wall, used_atol, nfev, njev, nlu, x, com, steps, timing)

@@ -1,0 +1,323 @@
+"""The simulation-speed targets of issue 13, measured and judged (``rt70 bench simulate``).
+
+Targets (:class:`~rt70.reports.targets.TargetCheck` each)
+---------------------------------------------------------
+Integration
+    The RT-70's 10 s transient with the axes free (the work–precision problem
+    ``rt70_10s``: what ``rt70 simulate rt70 --t-end 10`` runs) at a centre-of-mass error
+    ≤ :data:`COM_TARGET_M` in ≤ T / :data:`REAL_TIME_TARGET` of integration wall time:
+    the fastest ``ok`` row of any method and tolerance of the report with
+    ``com_error ≤ 1e-5 m`` (:func:`integration_target`).
+Whole command
+    ``rt70 simulate rt70 --t-end 10 --method M --rtol R`` with that row's method and
+    tolerance, run as a subprocess, best of :data:`COMMAND_REPEATS` wall times, ≤
+    :data:`COMMAND_TARGET_S` (:func:`command_target`): this includes the start-up
+    (imports, URDF, Pinocchio) and what follows the integration (energies, printing).
+Right-hand side and Jacobian
+    The reference backend's ``accelerations`` and ``jacobian``
+    (:class:`rt70.simulate._PinocchioBackend`) at the RT-70 listing's initial state,
+    timed interleaved with ``pin.aba`` and ``pin.computeABADerivatives`` on the same
+    state and the same generalized forces, BLAS/OpenMP pinned to one thread
+    (:func:`rt70.reports.threads.single_threaded`); the median per-round ratio must be
+    ≤ :data:`KERNEL_RATIO_TARGET` (:func:`kernel_targets`).
+Servo closed
+    ``rt70 simulate rt70_servo --scenario step-elevation --t-end 10`` (the scene's
+    drives and the servo closed, the elevation stepped: a 10 s transient as the free
+    one) at centre-of-mass error ≤ 1e-5 m against a tight reference of the same
+    scenario, at ≥ :data:`SERVO_REAL_TIME_TARGET` × real time (:func:`servo_target`).
+    The default ``hold`` is not used: at rest its error says nothing about accuracy,
+    and LSODA at rtol ≤ 1e-10 on it did not finish within 200 s (measured), so it has
+    no tight reference.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from rt70.reports.targets import TargetCheck
+
+#: The target problem of the work–precision report (the 10 s transient, axes free).
+TARGET_PROBLEM = "rt70_10s"
+#: Accuracy of the targets: centre-of-mass position error, m.
+COM_TARGET_M = 1e-5
+#: Integration speed of the free-axes transient, × real time.
+REAL_TIME_TARGET = 50.0
+#: Whole command, s.
+COMMAND_TARGET_S = 1.0
+#: Attempts of the whole command (best wall time).
+COMMAND_REPEATS = 3
+#: Right-hand side / pin.aba and Jacobian / pin.computeABADerivatives.
+KERNEL_RATIO_TARGET = 3.0
+#: The servo-closed run, × real time.
+SERVO_REAL_TIME_TARGET = 25.0
+#: The servo scenario and its span, s.
+SERVO_SCENARIO = "step-elevation"
+SERVO_T_END = 10.0
+#: Tolerances tried on the servo scenario (the fastest meeting the accuracy counts).
+SERVO_RTOLS = (1e-5, 1e-6, 1e-7)
+#: Reference of the servo scenario: LSODA, the scenarios' method
+#: (:func:`rt70.scenarios.run_scenario`), at this tolerance: 1e-9 took 19 s, 1e-10 did
+#: not finish in 150 s (measured), so the ladder stops two decades above it.
+SERVO_REFERENCE_RTOL = 1e-9
+
+Say = Callable[[str], None]
+
+
+def _quiet(_msg: str) -> None:
+    return None
+
+
+def integration_target(rows) -> tuple[TargetCheck, object | None]:
+    """The integration target judged on work–precision rows, and the row that counts.
+
+    Returns
+    -------
+    (TargetCheck, Row or None)
+        The check and the fastest row of :data:`TARGET_PROBLEM` with
+        ``com_error ≤ COM_TARGET_M`` (None when no row reached it, or the problem was
+        not run).
+    """
+    from rt70.reports.work_precision import time_to_reach
+
+    mine = [r for r in rows if r.problem == TARGET_PROBLEM]
+    goal = (
+        f"RT-70 10 s transient, axes free, centre-of-mass error ≤ {COM_TARGET_M:g} m: "
+        f"integration ≤ {10.0 / REAL_TIME_TARGET:g} s (≥ {REAL_TIME_TARGET:g}× real time)"
+    )
+    if not mine:
+        return TargetCheck(goal, f"— ({TARGET_PROBLEM} not in this run)", None), None
+    methods = dict.fromkeys(r.method for r in mine)
+    reach = [time_to_reach(rows, TARGET_PROBLEM, m, COM_TARGET_M, "com_error") for m in methods]
+    best = [b for b in reach if b is not None]
+    if not best:
+        done = [r for r in mine if r.status == "ok"]
+        least = min((r.com_error for r in done), default=math.nan)
+        return TargetCheck(goal, f"no run reached it (least error {least:.1e} m)", False), None
+    win = min(best, key=lambda r: r.time_s)
+    factor = win.t_end / win.time_s
+    measured = (
+        f"{win.time_s:.3f} s, {factor:.1f}× real time ({win.method}, rtol {win.rtol:g}, "
+        f"centre-of-mass error {win.com_error:.1e} m)"
+    )
+    return TargetCheck(goal, measured, factor >= REAL_TIME_TARGET), win
+
+
+def command_seconds(method: str, rtol: float, repeats: int = COMMAND_REPEATS) -> list[float]:
+    """Wall times of ``rt70 simulate rt70 --t-end 10 --method M --rtol R`` as a subprocess.
+
+    Raises
+    ------
+    Rt70Error
+        If the command fails.
+    """
+    from rt70.errors import Rt70Error
+
+    cmd = [sys.executable, "-m", "rt70", "simulate", "rt70", "--t-end", "10"]
+    cmd += ["--method", method, "--rtol", repr(rtol)]
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        walls.append(time.perf_counter() - start)
+        if done.returncode != 0:
+            tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
+            raise Rt70Error(f"{' '.join(cmd[1:])}: exit {done.returncode}: {tail}")
+    return walls
+
+
+def command_target(win, repeats: int = COMMAND_REPEATS, quick: bool = False) -> TargetCheck:
+    """The whole-command target, with the method and tolerance of the integration's row."""
+    goal = f"whole command `rt70 simulate rt70 --t-end 10` ≤ {COMMAND_TARGET_S:g} s (≥ 10×)"
+    if quick:
+        return TargetCheck(goal, "— (not measured in a quick run)", None)
+    if win is None:
+        return TargetCheck(goal, "— (no run reached the accuracy)", None)
+    walls = command_seconds(win.method, win.rtol, repeats)
+    measured = (
+        f"{min(walls):.2f} s (best of {len(walls)}, wall, start-up included; "
+        f"--method {win.method} --rtol {win.rtol:g})"
+    )
+    return TargetCheck(goal, measured, min(walls) <= COMMAND_TARGET_S)
+
+
+def kernel_ratios(rounds: int = 7, budget_s: float = 0.05) -> dict[str, tuple[float, float, float]]:
+    """The backend's right-hand side and Jacobian against Pinocchio's, on the RT-70.
+
+    Returns
+    -------
+    dict
+        ``{"rhs": (backend s/call, pin.aba s/call, median ratio), "jacobian": (...)}``
+        and ``"threads"``: the pinning's description.
+    """
+    import pinocchio as pin
+
+    from rt70.reference import element_torques
+    from rt70.reports.bench import compare
+    from rt70.reports.threads import single_threaded
+    from rt70.scene import load_scene
+    from rt70.scenes.rt70_state import listing_initial_state
+    from rt70.simulate import _PinocchioBackend
+
+    scene = load_scene("rt70")
+    backend = _PinocchioBackend(scene)
+    q, qd = listing_initial_state(scene)
+    model, data = scene.reference.pin_model, scene.reference_data.pin_data
+    Qc, Qd = element_torques(scene.reference, scene.reference_data, q, qd)
+    tau = Qc + Qd  # the same forces the backend passes: the comparison is of the algorithms
+    out = {}
+    with single_threaded() as pinning:
+        out["rhs"] = compare(
+            lambda: backend.accelerations(q, qd, None),
+            lambda: pin.aba(model, data, q, qd, tau),
+            rounds,
+            budget_s,
+        )
+        out["jacobian"] = compare(
+            lambda: backend.jacobian(q, qd, None),
+            lambda: pin.computeABADerivatives(model, data, q, qd, tau),
+            rounds,
+            budget_s,
+        )
+    out["threads"] = pinning.describe()
+    return out
+
+
+def kernel_targets(rounds: int = 7, budget_s: float = 0.05) -> list[TargetCheck]:
+    """Right-hand side ≤ 3× ``pin.aba`` and Jacobian ≤ 3× ``pin.computeABADerivatives``."""
+    got = kernel_ratios(rounds, budget_s)
+    checks = []
+    for key, what, pin_name in (
+        ("rhs", "right-hand side", "pin.aba"),
+        ("jacobian", "Jacobian", "pin.computeABADerivatives"),
+    ):
+        ours, theirs, ratio = got[key]
+        goal = f"{what} ≤ {KERNEL_RATIO_TARGET:g}× {pin_name} on the RT-70"
+        measured = (
+            f"{ratio:.1f}× ({ours * 1e6:.1f} µs against {theirs * 1e6:.1f} µs, median of "
+            f"{rounds} interleaved rounds; {got['threads']})"
+        )
+        checks.append(TargetCheck(goal, measured, ratio <= KERNEL_RATIO_TARGET))
+    return checks
+
+
+def servo_runs(
+    rtols: tuple[float, ...] = SERVO_RTOLS,
+    methods: tuple[str, ...] | None = None,
+    t_end: float = SERVO_T_END,
+    progress: Say | None = None,
+) -> list[dict]:
+    """``rt70 simulate rt70_servo --scenario step-elevation --t-end T`` per method and rtol.
+
+    Every run goes through :func:`rt70.scenarios.run_scenario` as the command does (the
+    scene's drives and the servo closed, the default pointing), BLAS pinned; its
+    centre-of-mass error (m) and the error of its mirror-axis pointing (arc seconds,
+    the optical output of the servo scene) are taken against a reference run of LSODA
+    at :data:`SERVO_REFERENCE_RTOL` on the same output grid.
+
+    Returns
+    -------
+    list of dict
+        Per run: ``method``, ``rtol``, ``wall_s``, ``t_end``, ``com_error`` (m),
+        ``pointing_error`` (″), ``nfev``, ``njev``, ``status``; the reference first.
+    """
+    from rt70 import scenarios
+    from rt70.reports.threads import single_threaded
+    from rt70.reports.work_precision import com_error
+    from rt70.reports.work_precision_worker import com_positions
+    from rt70.scene import load_scene
+    from rt70.scene_servo import choose_drives
+    from rt70.simulate import METHODS
+
+    say = progress or _quiet
+    scene = load_scene("rt70_servo")
+    sc, _ = scenarios.choose(scene, SERVO_SCENARIO, None, None, t_end)
+    drives, _ = choose_drives(scene, None)
+    # LSODA is the scenarios' method (scipy's BDF and Radau stop at random on a hold);
+    # the compiled integrators join once they are in METHODS
+    methods = methods or tuple(m for m in METHODS if m == "LSODA" or m.startswith("CVODE"))
+    out = []
+    with single_threaded():
+
+        def one(method: str, rtol: float) -> dict:
+            run = scenarios.run_scenario(scene, sc, drives=drives, rtol=rtol, method=method)
+            res = run.result
+            return dict(
+                method=method,
+                rtol=rtol,
+                wall_s=res.wall_time_s,
+                t_end=float(res.t[-1] - res.t[0]),
+                com=com_positions(scene, res.q),
+                pointing=run.pointing_error_total,
+                nfev=res.nfev,
+                njev=res.njev,
+                status="ok",
+            )
+
+        ref = one("LSODA", SERVO_REFERENCE_RTOL)
+        ref.update(com_error=0.0, pointing_error=0.0, status="reference")
+        say(f"rt70_servo: reference LSODA rtol {SERVO_REFERENCE_RTOL:g}: {ref['wall_s']:.2f} s")
+        out.append(ref)
+        for method in methods:
+            for rtol in rtols:
+                try:
+                    got = one(method, rtol)
+                except Exception as exc:  # a failed run is a row, not the end of the report
+                    out.append(dict(method=method, rtol=rtol, status=f"failed: {exc}"))
+                    continue
+                got["com_error"] = com_error(got["com"], ref["com"])
+                got["pointing_error"] = float(np.max(np.abs(got["pointing"] - ref["pointing"])))
+                say(
+                    f"rt70_servo: {method} rtol {rtol:g}: {got['wall_s']:.3f} s, "
+                    f"centre of mass {got['com_error']:.1e} m, pointing "
+                    f"{got['pointing_error']:.1e}″"
+                )
+                out.append(got)
+    return out
+
+
+def servo_target(runs: list[dict] | None) -> TargetCheck:
+    """≥ 25× real time at centre-of-mass error ≤ 1e-5 m with drives and servo closed."""
+    goal = (
+        f"rt70_servo ({SERVO_SCENARIO}, {SERVO_T_END:g} s, scene drives and servo closed), "
+        f"centre-of-mass error ≤ "
+        f"{COM_TARGET_M:g} m: ≥ {SERVO_REAL_TIME_TARGET:g}× real time"
+    )
+    if runs is None:
+        return TargetCheck(goal, "— (not measured in a quick run)", None)
+    good = [r for r in runs if r["status"] == "ok" and r["com_error"] <= COM_TARGET_M]
+    if not good:
+        return TargetCheck(goal, "no run reached the accuracy", False)
+    win = min(good, key=lambda r: r["wall_s"])
+    factor = win["t_end"] / win["wall_s"]
+    measured = (
+        f"{win['wall_s']:.3f} s for {win['t_end']:g} s, {factor:.1f}× real time "
+        f"({win['method']}, rtol {win['rtol']:g}, centre-of-mass error {win['com_error']:.1e} m, "
+        f"pointing error {win['pointing_error']:.1e}″)"
+    )
+    return TargetCheck(goal, measured, factor >= SERVO_REAL_TIME_TARGET)
+
+
+def check(rows, quick: bool = False, progress: Say | None = None) -> list[TargetCheck]:
+    """Every issue-13 target of :mod:`this module <rt70.reports.simulation_targets>`.
+
+    A quick run (``rows`` of the quick problems) judges only the right-hand side and
+    Jacobian ratios (with fewer rounds); the rest is reported as not judged.
+    """
+    say = progress or _quiet
+    integration, win = integration_target(rows)
+    if quick:
+        command = command_target(None, quick=True)
+        servo = servo_target(None)
+    else:
+        say("timing the whole command (subprocess, best of 3)")
+        command = command_target(win)
+        servo = servo_target(servo_runs(progress=say))
+    say("timing the right-hand side and Jacobian against Pinocchio's")
+    kernels = kernel_targets(rounds=3, budget_s=0.01) if quick else kernel_targets()
+    return [integration, command, *kernels, servo]

@@ -1,0 +1,107 @@
+"""The issue-13 targets of ``rt70 bench simulate`` and the centre-of-mass metric."""
+
+import math
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from rt70 import simulate as sim
+from rt70.errors import Rt70Error
+from rt70.reports import simulation_targets as st
+from rt70.reports import work_precision as wp
+from rt70.reports.work_precision_problems import PROBLEMS
+from rt70.reports.work_precision_worker import com_positions
+from rt70.scene import load_scene
+from rt70.scenes.rt70_state import listing_initial_state
+
+
+def test_centres_of_mass_average_to_pinocchio_centre_of_mass():
+    scene = load_scene("rt70")
+    q0, _ = listing_initial_state(scene)
+    q = np.vstack([q0, 0.5 * q0])
+    com = com_positions(scene, q)
+    model, data = scene.reference.pin_model, scene.reference.pin_model.createData()
+    masses = np.array([i.mass for i in model.inertias.tolist()[1:] if i.mass > 0.0])
+    assert com.shape == (2, len(masses), 3) and len(masses) == 7  # the RT-70 bodies
+    for k in range(2):
+        total = pin.centerOfMass(model, data, q[k])
+        np.testing.assert_allclose(masses @ com[k] / masses.sum(), total, atol=1e-9)
+    assert wp.com_error(com, com) == 0.0
+    moved = com.copy()
+    moved[1, 3] += [3e-6, 0.0, 4e-6]
+    assert wp.com_error(moved, com) == pytest.approx(5e-6)
+
+
+def test_methods_come_from_simulate():
+    assert wp.METHODS == tuple(m for m in sim.METHODS if m != "RK23")
+    assert set(wp.STIFF_METHODS) == {"Radau", "BDF", "LSODA"} | {
+        m for m in sim.METHODS if m.startswith("CVODE")
+    }
+
+
+def test_the_target_problem_is_the_commands_ten_second_transient():
+    (p,) = [p for p in PROBLEMS if p.name == st.TARGET_PROBLEM]
+    assert p.t_end == 10.0 and p.stiff_only and p.rtols == (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+    assert {"rt70", "rt70_light"} <= {q.name for q in PROBLEMS}  # the 2 s problems stay
+
+
+def _row(method, rtol, status, com_error, time_s):
+    return wp.Row(
+        st.TARGET_PROBLEM, 42, 10.0, method, rtol, 1e-3 * rtol, status,
+        status.startswith("over"), 1e-6, time_s, "", 0, 0, 0, 20.0, "", 1e-10, "", 1, "",
+        com_error=com_error,
+    )  # fmt: skip
+
+
+def test_integration_target_takes_the_fastest_run_to_the_accuracy():
+    rows = [
+        _row("BDF", 1e-6, "ok", 2.2e-5, 0.9),  # fast but not accurate enough
+        _row("BDF", 1e-7, "ok", 4.9e-6, 1.85),
+        _row("Radau", 1e-7, "ok", 3e-6, 1.5),
+        _row("RK45", 1e-3, "over cap", math.nan, math.nan),
+    ]
+    check, win = st.integration_target(rows)
+    assert win is rows[2] and check.met is False
+    assert check.measured.startswith("1.500 s, 6.7× real time (Radau, rtol 1e-07")
+    assert "≤ 1e-05 m: integration ≤ 0.2 s (≥ 50× real time)" in check.target
+    check, win = st.integration_target([_row("BDF", 1e-7, "ok", 9e-6, 0.19)])
+    assert check.met is True and win.time_s == 0.19
+    check, win = st.integration_target(rows[:1])
+    assert check.met is False and win is None and "least error 2.2e-05 m" in check.measured
+    check, _ = st.integration_target([])
+    assert check.met is None and check.line().endswith("— not judged")
+
+
+def test_servo_target_and_quick_run():
+    ref = dict(method="LSODA", rtol=1e-11, status="reference", com_error=0.0)
+    runs = [
+        ref,
+        dict(method="LSODA", rtol=1e-5, status="ok", com_error=2e-5, wall_s=0.1, t_end=10.0),
+        dict(
+            method="LSODA", rtol=1e-6, status="ok", com_error=1e-6, wall_s=0.5, t_end=10.0,
+            pointing_error=1e-3,
+        ),
+    ]  # fmt: skip
+    check = st.servo_target(runs)
+    assert check.met is False and check.measured.startswith("0.500 s for 10 s, 20.0× real")
+    runs[2]["wall_s"] = 0.4
+    assert st.servo_target(runs).met is True
+    assert st.servo_target(runs[:2]).met is False
+    assert st.servo_target(None).met is None
+
+
+def test_command_failure_is_an_error():
+    with pytest.raises(Rt70Error, match="exit 2"):
+        st.command_seconds("NO-SUCH-METHOD", 1e-6, repeats=1)
+    assert st.command_target(None, quick=True).met is None
+
+
+def test_kernel_targets_compare_with_pinocchio():
+    rhs, jac = st.kernel_targets(rounds=1, budget_s=0.002)
+    assert rhs.target == "right-hand side ≤ 3× pin.aba on the RT-70"
+    assert jac.target == "Jacobian ≤ 3× pin.computeABADerivatives on the RT-70"
+    for check in (rhs, jac):
+        ratio = float(check.measured.split("×")[0])
+        assert ratio > 0 and check.met is (ratio <= st.KERNEL_RATIO_TARGET)
+        assert "pinned to 1" in check.measured
