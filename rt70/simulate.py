@@ -96,12 +96,13 @@ class _PinocchioBackend(_Backend):
         self.pin, self.reference = pin, reference
         self.ref, self.rd = scene.reference, scene.reference_data
         self.direct = self.ref.identity_map  # book coordinates are Pinocchio's (q, v)
+        self.theta = euler_theta_indices(scene.textbook)
         self.kernels = None
         if kernels and self.direct and (self.ref.bushings or self.ref.spring_v.size):
             from rt70.reference.element_kernels import ElementKernels
 
-            self.kernels = ElementKernels.of(self.ref)
-        self.theta = euler_theta_indices(scene.textbook)
+            guard = lambda q: check_euler_pairs(scene.textbook, q)  # noqa: E731
+            self.kernels = ElementKernels.of(self.ref, (self.theta, DYNAMICS_GIMBAL_COS, guard))
 
     def mass_matrix(self, q):
         return self.reference.mass_matrix(self.ref, self.rd, q)
@@ -119,7 +120,8 @@ class _PinocchioBackend(_Backend):
         return self.reference.element_torques(self.ref, self.rd, q, qd)
 
     def accelerations(self, q, qd, Q_u):
-        self._check_pairs(q)
+        if self.kernels is None:  # the kernels check the pairs themselves
+            self._check_pairs(q)
         reference, ref, rd = self.reference, self.ref, self.rd
         if not self.direct:  # general coordinates: through the book-coordinate map
             a = reference.forward_dynamics(ref, rd, q, qd)

@@ -61,7 +61,8 @@ def single_threaded() -> Iterator[ThreadPinning]:
     """Pin every BLAS and OpenMP thread pool to one thread for the ``with`` block.
 
     ``threadpoolctl`` can only limit libraries already loaded, so numpy's and scipy's
-    OpenBLAS and Pinocchio's OpenMP runtime are loaded first; the pools are read back
+    OpenBLAS, Pinocchio's OpenMP runtime and scikit-sundae's own OpenBLAS and OpenMP
+    are loaded first; the pools are read back
     when the block ends, so a library loaded inside it and left threaded shows in
     ``pinned``.
 
@@ -73,6 +74,7 @@ def single_threaded() -> Iterator[ThreadPinning]:
     import numpy  # noqa: F401  (load the thread pools: only loaded ones can be limited)
     import pinocchio  # noqa: F401
     import scipy.linalg  # noqa: F401
+    import sksundae  # noqa: F401  (CVODE: its wheel brings its own OpenBLAS and OpenMP)
     from threadpoolctl import threadpool_limits
 
     pinning = ThreadPinning(unpinned=pools())
