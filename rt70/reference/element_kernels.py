@@ -191,7 +191,7 @@ def tables(model: ReferenceModel) -> Tables | None:
     )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _walk(qp, lo, hi, kind, q_index, axis, place_R, place_p, R, p, origin, axis_out, T, X):
     """Compose ``placement_k · X_k(q_k)`` for entries lo…hi onto (R, p) in place.
 
@@ -202,7 +202,7 @@ def _walk(qp, lo, hi, kind, q_index, axis, place_R, place_p, R, p, origin, axis_
         for i in range(3):  # p += R placement_p;  R = R placement_R
             p[i] += R[i, 0] * place_p[k, 0] + R[i, 1] * place_p[k, 1] + R[i, 2] * place_p[k, 2]
         _mul(R, place_R[k], T)
-        R[:, :] = T
+        _copy(T, R)
         u = axis[k]
         for i in range(3):
             origin[k, i] = p[i]
@@ -218,10 +218,18 @@ def _walk(qp, lo, hi, kind, q_index, axis, place_R, place_p, R, p, origin, axis_
             c, s = math.cos(qp[qi]), math.sin(qp[qi])
         _rotation(u, c, s, X)  # R = R · Rot(u, angle)
         _mul(R, X, T)
-        R[:, :] = T
+        _copy(T, R)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
+def _copy(A, out):
+    """``out = A`` for 3×3 arrays (an explicit loop: numba's slice assignment is slower)."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, j]
+
+
+@numba.njit(cache=True, inline="always")
 def _mul(A, B, out):
     """``out = A B`` for 3×3 arrays (no BLAS)."""
     for i in range(3):
@@ -229,7 +237,7 @@ def _mul(A, B, out):
             out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _rotation(u, c, s, out):
     """Rotation by the angle with cosine c and sine s about the unit axis u (Rodrigues)."""
     t = 1.0 - c
@@ -250,7 +258,7 @@ def _rotation(u, c, s, out):
     )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _frame(R, p, FR, Fp, R_out, p_out):
     """``(R_out, p_out) = (R, p) · (FR, Fp)``."""
     _mul(R, FR, R_out)
@@ -258,7 +266,7 @@ def _frame(R, p, FR, Fp, R_out, p_out):
         p_out[i] = p[i] + R[i, 0] * Fp[0] + R[i, 1] * Fp[1] + R[i, 2] * Fp[2]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _pair_pose(
     qp, b, lo, mid, hi, kind, q_index, axis, place_R, place_p, frame_R, frame_p,
     R, p, R1, p1, R2, p2, origin, axis_w, T, X,
@@ -279,7 +287,7 @@ def _pair_pose(
             _frame(R, p, frame_R[b, 1], frame_p[b, 1], R2, p2)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _translation_column(k, to_frame2, kind, origin, axis_w, R1, p2, w, lin, jac):
     """Entry k's ``∂r12/∂q̇_k = R1ᵀ s_k (v + ω × p2)`` into ``jac[k, :3]``; ω into w.
 
