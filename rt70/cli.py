@@ -491,7 +491,7 @@ def _write_simulation(out, result, figure) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``rt70`` command (errors: one line, exit 2)."""
-    from rt70.simulate import METHODS
+    from rt70.integrators import METHODS  # not rt70.simulate: --help stays light
 
     parser = options.Parser(
         prog="rt70", description="Models of flexible structures, cross-checked against Pinocchio."

@@ -27,6 +27,8 @@ import numpy as np
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
 #: SUNDIALS CVODE methods, by rt70's name: CVODE's linear multistep family.
 CVODE_METHODS = {"CVODE": "BDF", "CVODE_ADAMS": "Adams"}
+#: Every method :func:`rt70.simulate.simulate` takes (scipy's, then SUNDIALS').
+METHODS = SCIPY_METHODS + tuple(CVODE_METHODS)
 #: Largest number of CVODE steps between two output times (CVODE's default, 500, is
 #: for a caller that samples often; solve_ivp has no such limit).
 CVODE_MAX_STEPS = 10_000_000

@@ -30,16 +30,13 @@ from rt70.errors import (
     SimulationError,
     SingularConfigurationError,
 )
-from rt70.integrators import CVODE_METHODS, SCIPY_METHODS, Stopwatch, integrate
+from rt70.integrators import CVODE_METHODS, METHODS, Stopwatch, integrate
 from rt70.outputs import Output, column_labels, evaluate, evaluate_trajectory
 from rt70.scene import Scene
 from rt70.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, check_euler_pairs, euler_theta_indices
 
-#: Integration methods of :func:`simulate`: scipy.integrate.solve_ivp's, then SUNDIALS
-#: CVODE's (BDF, and Adams for non-stiff problems; :mod:`rt70.integrators`).
-METHODS = SCIPY_METHODS + tuple(CVODE_METHODS)
 #: Smallest rtol solve_ivp honours (it raises smaller ones to 100 machine epsilons).
 MIN_RTOL = 100 * np.finfo(float).eps
 #: Output formats of :meth:`SimulationResult.save`, by suffix.
