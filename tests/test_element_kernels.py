@@ -172,3 +172,15 @@ def test_compiled_drive_angle_and_force_equal_pinocchios():
             got_angle, got_Q = fast(q)
             assert abs(got_angle - angle) <= 1e-14 * max(abs(angle), 1.0)
             assert _relative(Q, got_Q) < 1e-13
+
+
+def test_a_new_element_kind_turns_the_kernels_off(monkeypatch):
+    """A kind added to the reference side's ELEMENTS but not to the kernels must not be
+    left out silently: the backend falls back to the Python path."""
+    from rt70.reference import element_kernels
+
+    scene = load_scene("rt70")
+    assert tuple(forces.ELEMENTS) == element_kernels.COVERED
+    assert ElementKernels.of(scene.reference) is not None
+    monkeypatch.setitem(forces.ELEMENTS, "new_kind", lambda *a: None)
+    assert ElementKernels.of(scene.reference) is None

@@ -36,9 +36,12 @@ import numba
 import numpy as np
 
 from rt70.errors import SingularConfigurationError
-from rt70.reference.forces import GIMBAL_LOCK_COS
+from rt70.reference.forces import ELEMENTS, GIMBAL_LOCK_COS
 from rt70.reference.model import ReferenceModel
 
+#: The element kinds the kernels compute (the keys of rt70.reference.forces.ELEMENTS they
+#: cover): a model is only given kernels while these are all the kinds there are.
+COVERED = ("joint_springs", "bushings")
 #: Joint kinds of the tables.
 REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
 #: Size of the kernels' fixed scratch (3×3 and 3-, 6-vectors) after the per-entry part.
@@ -168,8 +171,12 @@ def tables(model: ReferenceModel) -> Tables | None:
 
     Unsupported: a bushing whose frames are joined through a joint that is not
     revolute, prismatic or continuous; such a model keeps :mod:`rt70.reference.forces`.
-    Like that module the kernels work in Pinocchio's own (q, v).
+    So does every model once :data:`~rt70.reference.forces.ELEMENTS` lists a kind the
+    kernels do not cover (:data:`COVERED`). Like that module the kernels work in
+    Pinocchio's own (q, v).
     """
+    if tuple(ELEMENTS) != COVERED:
+        return None
     found = paths(model, model.frames1, model.frames2)
     if found is None:
         return None
