@@ -79,7 +79,10 @@ class WindLoad(StateComponent):
             from rt70.reference import wind as kin
 
             model, data = scene.reference, scene.reference_data
-        self._force = lambda q, c: kin.wind_force(model, data, q, c)
+        if self.side == "reference":  # compiled where it can (the same numbers)
+            self._force = kin.wind_force_function(model, data)
+        else:
+            self._force = lambda q, c: kin.wind_force(model, data, q, c)
 
     def speed(self, t: float) -> float:
         """The wind speed ``v̄ + v′(t)`` along the mean direction, m/s.

@@ -184,3 +184,23 @@ def test_a_new_element_kind_turns_the_kernels_off(monkeypatch):
     assert ElementKernels.of(scene.reference) is not None
     monkeypatch.setitem(forces.ELEMENTS, "new_kind", lambda *a: None)
     assert ElementKernels.of(scene.reference) is None
+
+
+@pytest.mark.parametrize("direction", (0.0, 90.0, 210.0))
+def test_compiled_wind_force_equals_pinocchios(direction):
+    """The wind's generalised force from the compiled poses and point Jacobians against
+    Pinocchio's placements and point Jacobians (rt70.reference.wind.wind_force)."""
+    from rt70.reference import wind as kin
+    from rt70.wind import WindCondition
+
+    scene = load_scene("rt70_servo")
+    ref, rd = scene.reference, scene.reference_data
+    assert ref.winds
+    fast = kin.wind_force_function(ref, rd)
+    rng = np.random.default_rng(int(direction))
+    condition = WindCondition(20.0, direction)
+    for _ in range(3):
+        q = 0.05 * rng.standard_normal(scene.textbook.nv)
+        want = kin.wind_force(ref, rd, q, condition)
+        assert np.max(np.abs(want)) > 0.0
+        assert _relative(want, fast(q, condition)) < 1e-13

@@ -319,11 +319,13 @@ def _translation_column(k, to_frame2, kind, origin, axis_w, R1, p2, w, lin, jac)
 
 @numba.njit(cache=True)
 def relative_points(
-    qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R, frame_p, r, jac
+    qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R, frame_p, c, r, jac
 ):  # fmt: skip
-    """Frame 2's origin in frame 1 of each pair b and its Jacobian on the pair's joints.
+    """Frame 2 in frame 1 for each pair b, and its Jacobian on the pair's joints.
 
-    ``r12 = R1ᵀ (p2 − p1)`` into ``r[b]``, the columns ``∂r12/∂q̇_k`` into ``jac[k, :3]``.
+    ``c12 = R1ᵀ R2`` into ``c[b]``, ``r12 = R1ᵀ (p2 − p1)`` into ``r[b]``; per joint
+    entry k the columns ``∂r12/∂q̇_k`` into ``jac[k, :3]`` and frame 2's angular velocity
+    relative to frame 1, in frame 1's axes, into ``jac[k, 3:]``.
     """
     n = kind.shape[0]
     origin = work[: 3 * n].reshape((n, 3))
@@ -342,8 +344,12 @@ def relative_points(
             r[b, i] = (
                 R1[0, i] * (p2[0] - p1[0]) + R1[1, i] * (p2[1] - p1[1]) + R1[2, i] * (p2[2] - p1[2])
             )
+            for j in range(3):
+                c[b, i, j] = R1[0, i] * R2[0, j] + R1[1, i] * R2[1, j] + R1[2, i] * R2[2, j]
         for k in range(lo, hi):
             _translation_column(k, k >= mid, kind, origin, axis_w, R1, p2, w, lin, jac)
+            for i in range(3):
+                jac[k, 3 + i] = R1[0, i] * w[0] + R1[1, i] * w[1] + R1[2, i] * w[2]
 
 
 @numba.njit(cache=True)
@@ -583,7 +589,7 @@ class RelativePoints:
         self._args = tuple(found[k] for k in names + ("frame_R", "frame_p"))
         self.start = found["start"]
         self._work = np.zeros(12 * len(found["kind"]) + WORK_SMALL)
-        self._jac = np.zeros((len(found["kind"]), 3))
+        self._jac = np.zeros((len(found["kind"]), 6))
 
     @classmethod
     def of(cls, model: ReferenceModel, frames1, frames2) -> RelativePoints | None:
@@ -591,14 +597,22 @@ class RelativePoints:
         found = paths(model, frames1, frames2)
         return None if found is None else cls(model, found)
 
-    def __call__(self, qp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(r12, ∂r12/∂v)`` of every pair: shapes (n, 3) and (n, 3, nv)."""
-        r = np.zeros((self.n, 3))
-        relative_points(
-            np.ascontiguousarray(qp, dtype=float), self._work, *self._args, r, self._jac
-        )
-        J = np.zeros((self.n, 3, self.nv))
+    def frames(self, qp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(c12, r12, J)``: frame 2's rotation and origin in frame 1, and their Jacobian.
+
+        Shapes (n, 3, 3), (n, 3) and (n, 6, nv): ``J = [∂r12/∂v; ∂ω12/∂v]``, the origin's
+        velocity and frame 2's angular velocity relative to frame 1, in frame 1's axes.
+        """
+        c, r = np.zeros((self.n, 3, 3)), np.zeros((self.n, 3))
+        qp = np.ascontiguousarray(qp, dtype=float)
+        relative_points(qp, self._work, *self._args, c, r, self._jac)
+        J = np.zeros((self.n, 6, self.nv))
         for b in range(self.n):
             lo, hi = self.start[b], self.start[b + 1]
             J[b][:, self.v_index[lo:hi]] = self._jac[lo:hi].T
-        return r, J
+        return c, r, J
+
+    def __call__(self, qp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(r12, ∂r12/∂v)`` of every pair: shapes (n, 3) and (n, 3, nv)."""
+        _, r, J = self.frames(qp)
+        return r, J[:, :3]

@@ -45,3 +45,46 @@ def wind_force(
     for value in wind_forces(model, data, q, condition).values():
         Q += value
     return Q
+
+
+def wind_force_function(model: ReferenceModel, data: ReferenceData):
+    """``(q, condition) ↦ Q_w``: :func:`wind_force`, compiled where it can.
+
+    Each exposed body's pose and the Jacobian of its load point come from the compiled
+    joint walk from the ground to the link (:class:`rt70.reference.element_kernels.
+    RelativePoints`, frame 1 the ground) instead of Pinocchio's placements and point
+    Jacobians per body and evaluation; :func:`rt70.wind.wind_wrench` gives the same
+    Wrench from the same pose, and ``Q = J_vᵀ F + J_ωᵀ M`` (tested equal to
+    :func:`wind_force`). Mapped coordinates or an unsupported path keep
+    :func:`wind_force`.
+    """
+    slow = lambda q, condition: wind_force(model, data, q, condition)  # noqa: E731
+    if not model.identity_map or not model.winds:
+        return slow
+    import pinocchio as pin
+
+    from rt70.reference.element_kernels import RelativePoints
+
+    m = model.pin_model
+    points = []
+    if not all(m.existBodyName(w.link) for w in model.winds):
+        return slow  # its error names the link
+    for w in model.winds:
+        frame = m.frames[m.getBodyId(w.link)]
+        offset = pin.SE3(np.eye(3), np.asarray(w.xyz, dtype=float))
+        points.append((frame.parentJoint, frame.placement * offset))
+    ground = [(0, pin.SE3.Identity())] * len(points)
+    frames = RelativePoints.of(model, ground, points)
+    if frames is None:
+        return slow
+    xyz = [np.asarray(w.xyz, dtype=float) for w in model.winds]
+
+    def force(q: np.ndarray, condition: WindCondition) -> np.ndarray:
+        C, r, J = frames.frames(q)
+        Q = np.zeros(model.nv)
+        for i, w in enumerate(model.winds):  # the link's pose: the point minus R·xyz
+            wrench = wind_wrench(w, (C[i], r[i] - C[i] @ xyz[i]), condition, model.air_density)
+            Q += J[i, :3].T @ np.asarray(wrench.force) + J[i, 3:].T @ np.asarray(wrench.torque)
+        return Q
+
+    return force
