@@ -94,10 +94,6 @@ class Tables:
     spring_k: np.ndarray
     spring_d: np.ndarray
 
-    def arrays(self) -> tuple[np.ndarray, ...]:
-        """The arrays in the kernels' argument order."""
-        return tuple(getattr(self, f) for f in self.__dataclass_fields__)
-
 
 def _joint_kind(model: ReferenceModel, joint: int) -> tuple[int, np.ndarray] | None:
     """(kind, unit axis) of a Pinocchio joint from its motion subspace; None if other."""
@@ -317,6 +313,29 @@ def _translation_column(k, to_frame2, kind, origin, axis_w, R1, p2, w, lin, jac)
         jac[k, i] = R1[0, i] * lin[0] + R1[1, i] * lin[1] + R1[2, i] * lin[2]
 
 
+@numba.njit(cache=True, inline="always")
+def _walk_scratch(work, n):
+    """Views of one buffer for the joint walk of n entries: no allocation per call.
+
+    ``work[:3n]`` origins, ``[3n:6n]`` axes (``[6n:12n]`` is :func:`evaluate`'s
+    Jacobian), then :data:`WORK_SMALL` numbers: R, R1, R2 (and evaluate's c12) at 0,
+    9, 18 (27); p, p1, p2 (d), w, lin at 36, 39, 42 (45), 48, 51; evaluate's δ, δ̇ and
+    J_W⁻¹ at 54, 60, 66; T, X at 75, 84.
+    """
+    origin = work[: 3 * n].reshape((n, 3))
+    axis_w = work[3 * n : 6 * n].reshape((n, 3))
+    small = work[12 * n :]
+    R, R1, R2 = (
+        small[0:9].reshape((3, 3)),
+        small[9:18].reshape((3, 3)),
+        small[18:27].reshape((3, 3)),
+    )
+    p, p1, p2 = small[36:39], small[39:42], small[42:45]
+    w, lin = small[48:51], small[51:54]
+    T, X = small[75:84].reshape((3, 3)), small[84:93].reshape((3, 3))
+    return origin, axis_w, R, R1, R2, p, p1, p2, w, lin, T, X
+
+
 @numba.njit(cache=True)
 def relative_points(
     qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R, frame_p, c, r, jac
@@ -327,15 +346,7 @@ def relative_points(
     entry k the columns ``∂r12/∂q̇_k`` into ``jac[k, :3]`` and frame 2's angular velocity
     relative to frame 1, in frame 1's axes, into ``jac[k, 3:]``.
     """
-    n = kind.shape[0]
-    origin = work[: 3 * n].reshape((n, 3))
-    axis_w = work[3 * n : 6 * n].reshape((n, 3))
-    small = work[12 * n :]
-    R, R1 = small[0:9].reshape((3, 3)), small[9:18].reshape((3, 3))
-    R2 = small[18:27].reshape((3, 3))
-    p, p1, p2 = small[36:39], small[39:42], small[42:45]
-    w, lin = small[48:51], small[51:54]
-    T, X = small[75:84].reshape((3, 3)), small[84:93].reshape((3, 3))
+    origin, axis_w, R, R1, R2, p, p1, p2, w, lin, T, X = _walk_scratch(work, kind.shape[0])
     for b in range(start.shape[0] - 1):
         lo, mid, hi = start[b], split[b], start[b + 1]
         _pair_pose(qp, b, lo, mid, hi, kind, q_index, axis, place_R, place_p, frame_R, frame_p,
@@ -365,17 +376,12 @@ def evaluate(
     of a bushing at Euler-angle gimbal lock (then nothing is complete).
     """
     n = kind.shape[0]
-    origin = work[: 3 * n].reshape((n, 3))  # views of one buffer: no allocation per call
-    axis_w = work[3 * n : 6 * n].reshape((n, 3))
+    origin, axis_w, R, R1, R2, p, p1, p2, w, lin, T, X = _walk_scratch(work, n)
     jac = work[6 * n : 12 * n].reshape((n, 6))
     small = work[12 * n :]
-    R, R1 = small[0:9].reshape((3, 3)), small[9:18].reshape((3, 3))
-    R2, c12 = small[18:27].reshape((3, 3)), small[27:36].reshape((3, 3))
-    p, p1, p2 = small[36:39], small[39:42], small[42:45]
-    d, w, lin = small[45:48], small[48:51], small[51:54]
+    c12, d = small[27:36].reshape((3, 3)), small[45:48]
     delta, rate = small[54:60], small[60:66]
     inv = small[66:75].reshape((3, 3))
-    T, X = small[75:84].reshape((3, 3)), small[84:93].reshape((3, 3))
     inv[0, 2] = inv[1, 2] = 0.0
     U = 0.0
     for b in range(start.shape[0] - 1):
