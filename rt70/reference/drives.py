@@ -22,7 +22,7 @@ from rt70.errors import UnknownLinkError
 from rt70.loads import Pose, SectorMesh
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import ReferenceData, ReferenceModel
-from rt70.reference.points import generalized_force
+from rt70.reference.points import generalized_force, link_point
 from rt70.urdf.description import Drive
 
 
@@ -113,16 +113,9 @@ def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Driv
 
     s = drive.sector
     mesh = sector_mesh(model, data, drive) if mesh is None else mesh
-    m = model.pin_model
-    for link in (s.link, s.stator):
-        if not m.existBodyName(link):
-            raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
-    stator = m.frames[m.getBodyId(s.stator)]
-    link = m.frames[m.getBodyId(s.link)]
-    point = link.placement * pin.SE3(np.eye(3), np.asarray(s.xyz, dtype=float))
-    points = RelativePoints.of(
-        model, [(stator.parentJoint, stator.placement)], [(link.parentJoint, point)]
-    )
+    mesh_point = link_point(model, s.link, s.xyz)  # (joint, placement); names a missing link
+    stator = link_point(model, s.stator, np.zeros(3))
+    points = RelativePoints.of(model, [stator], [mesh_point])
     if points is None:
         return lambda q: drive_force(model, data, q, drive, 1.0, mesh)
     centre, u, v = mesh.centre, mesh.u, mesh.v

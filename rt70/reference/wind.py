@@ -15,7 +15,7 @@ import numpy as np
 from rt70.loads import Wrench
 from rt70.reference.drives import link_pose
 from rt70.reference.model import ReferenceData, ReferenceModel
-from rt70.reference.points import generalized_force
+from rt70.reference.points import generalized_force, link_point
 from rt70.wind import WindCondition, wind_wrench
 
 
@@ -65,14 +65,9 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
 
     from rt70.reference.element_kernels import RelativePoints
 
-    m = model.pin_model
-    points = []
-    if not all(m.existBodyName(w.link) for w in model.winds):
+    if not all(model.pin_model.existBodyName(w.link) for w in model.winds):
         return slow  # its error names the link
-    for w in model.winds:
-        frame = m.frames[m.getBodyId(w.link)]
-        offset = pin.SE3(np.eye(3), np.asarray(w.xyz, dtype=float))
-        points.append((frame.parentJoint, frame.placement * offset))
+    points = [link_point(model, w.link, w.xyz) for w in model.winds]
     ground = [(0, pin.SE3.Identity())] * len(points)
     frames = RelativePoints.of(model, ground, points)
     if frames is None:
