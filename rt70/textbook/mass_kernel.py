@@ -30,9 +30,8 @@ import numba
 import numpy as np
 
 from rt70.arrays import check_vector
-from rt70.errors import ShapeError
 from rt70.textbook.model import Model
-from rt70.textbook.structured import _check_batch
+from rt70.textbook.structured import _check_batch, _data_for
 
 #: Pair kinds as the kernel's integer codes (:data:`rt70.textbook.model.PAIR_KINDS`).
 KIND_CODE = {"euler6": 0, "revolute": 1, "prismatic": 2, "planar": 3}
@@ -332,14 +331,6 @@ class KernelData:
         self._model = model
 
 
-def _data_for(model: Model, K: int, data: KernelData) -> KernelData:
-    if not isinstance(data, KernelData) or data._model is not model:
-        raise ShapeError("data: expected the KernelData of this model (KernelData(model, K))")
-    if data.K != K:
-        raise ShapeError(f"data: made for K = {data.K} configurations, got {K}")
-    return data
-
-
 def mass_matrix_batch(model: Model, data: KernelData, Q: np.ndarray) -> np.ndarray:
     """``A = S Θ Sᵀ`` for K configurations ``Q`` (K, nv) by the kernel; returns ``data.A``.
 
@@ -347,7 +338,7 @@ def mass_matrix_batch(model: Model, data: KernelData, Q: np.ndarray) -> np.ndarr
     returned array is ``data.A``, overwritten by the next call with the same ``data``.
     """
     Q = _check_batch("Q", Q, model.nv)
-    data = _data_for(model, Q.shape[0], data)
+    data = _data_for(model, Q.shape[0], data, KernelData)
     _compute(model, data, Q)
     return data.A
 
@@ -364,6 +355,6 @@ def _compute(model: Model, data: KernelData, Q: np.ndarray) -> None:
 def mass_matrix(model: Model, data: KernelData, q: np.ndarray) -> np.ndarray:
     """``A = S Θ Sᵀ`` at one configuration by the kernel, a new array (``KernelData(model, 1)``)."""
     q = check_vector("q", q, model.nv)
-    data = _data_for(model, 1, data)
+    data = _data_for(model, 1, data, KernelData)
     _compute(model, data, q[None, :])
     return data.A[0].copy()

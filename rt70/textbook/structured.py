@@ -218,10 +218,15 @@ class BatchData:
         return self._works[size]
 
 
-def _data_for(model: Model, K: int, data: BatchData) -> BatchData:
-    """``data`` if it was made for ``model`` and K configurations (a ShapeError if not)."""
-    if not isinstance(data, BatchData) or data._model is not model:
-        raise ShapeError("data: expected the BatchData of this model (BatchData(model, K))")
+def _data_for(model: Model, K: int, data, kind: type | None = None):
+    """``data`` if it is a ``kind`` made for ``model`` and K configurations (else ShapeError).
+
+    ``kind`` is :class:`BatchData` by default; the compiled form passes its own.
+    """
+    kind = BatchData if kind is None else kind
+    name = kind.__name__
+    if not isinstance(data, kind) or data._model is not model:
+        raise ShapeError(f"data: expected the {name} of this model ({name}(model, K))")
     if data.K != K:
         raise ShapeError(f"data: made for K = {data.K} configurations, got {K}")
     return data
