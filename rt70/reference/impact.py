@@ -38,10 +38,11 @@ import numpy as np
 import pinocchio as pin
 
 from rt70.arrays import check_vector
-from rt70.errors import Rt70Error, UnknownLinkError
+from rt70.errors import Rt70Error
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.dynamics import mass_matrix
 from rt70.reference.model import ReferenceData, ReferenceModel
+from rt70.reference.points import point_jacobian_pinocchio
 
 #: Singular values of the constraint rows below this fraction of the largest count as
 #: zero (dependent rows).
@@ -70,19 +71,10 @@ def pin_rows(
 ) -> np.ndarray:
     """Rows (3, nv_pin) of a stow pin at the point ``xyz`` of ``link``, ground axes.
 
-    ``qp`` is Pinocchio's configuration; the point's frame Jacobian in its own axes
-    (``LOCAL``), turned by the point's rotation.
+    ``qp`` is Pinocchio's configuration: the point's velocity rows of
+    :func:`rt70.reference.points.point_jacobian_pinocchio`.
     """
-    m, d = model.pin_model, data.pin_data
-    if not m.existBodyName(link):
-        raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
-    frame = m.frames[m.getBodyId(link)]
-    placement = frame.placement * pin.SE3(np.eye(3), check_vector(f"point of {link}", xyz, 3))
-    pin.computeJointJacobians(m, d, qp)
-    local = pin.getFrameJacobian(m, d, frame.parentJoint, placement, pin.LOCAL)
-    local = np.reshape(local, (6, m.nv))  # (6,) when nv = 1
-    rotation = (d.oMi[frame.parentJoint] * placement).rotation
-    return rotation @ local[:3]
+    return point_jacobian_pinocchio(model, data, qp, link, xyz)[:3]
 
 
 def constraint_rows(

@@ -69,28 +69,37 @@ def point_position(
     return point_positions(model, data, q, [(link, xyz)])[0]
 
 
-def point_jacobian(
-    model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: str, xyz
-) -> tuple[np.ndarray, np.ndarray]:
-    """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
+def point_jacobian_pinocchio(
+    model: ReferenceModel, data: ReferenceData, qp: np.ndarray, link: str, xyz
+) -> np.ndarray:
+    """``[J_v; J_ω]``, 6 × nv of Pinocchio's v, in ground axes, at Pinocchio's ``qp``.
 
     Pinocchio's ``computeJointJacobian`` (the joint's velocity in its own frame, from
     the placements of the ancestors relative to the joint) moved to the point by the
     action of its placement, ``Ad(placement⁻¹)``, turned to ground axes by the point
-    frame's rotation, times ``J`` (book coordinates → Pinocchio's ``v``). It is
-    Pinocchio's ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` without passing through
-    the ground origin: that form shifts velocities taken at the origin back to the
-    point, which costs ε times the point's distance from the origin (1e-12 relative on
-    the RT-70 in millimetres, against 1e-16 here).
+    frame's rotation. It is Pinocchio's ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)``
+    without passing through the ground origin: that form shifts velocities taken at the
+    origin back to the point, which costs ε times the point's distance from the origin
+    (1e-12 relative on the RT-70 in millimetres, against 1e-16 here).
     """
     joint, placement = link_point(model, link, xyz)
-    qp, _, J, _ = to_pinocchio(model, q)
     m, d = model.pin_model, data.pin_data
     pin.forwardKinematics(m, d, qp)
     local = np.reshape(pin.computeJointJacobian(m, d, qp, joint), (6, m.nv))  # (6,) if nv = 1
     local = placement.inverse().action @ local  # [v_p; ω] in the point frame's axes
     R = (d.oMi[joint] * placement).rotation
-    jac = np.vstack([R @ local[:3], R @ local[3:]])
+    return np.vstack([R @ local[:3], R @ local[3:]])
+
+
+def point_jacobian(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: str, xyz
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
+
+    :func:`point_jacobian_pinocchio` times ``J`` (book coordinates → Pinocchio's ``v``).
+    """
+    qp, _, J, _ = to_pinocchio(model, q)
+    jac = point_jacobian_pinocchio(model, data, qp, link, xyz)
     if J is not None:
         jac = jac @ J
     return jac[:3], jac[3:]
