@@ -83,6 +83,18 @@ class Integration:
     t_events: list[np.ndarray] = field(default_factory=list)
 
 
+def load(method: str) -> None:
+    """Import the integrator family of ``method`` (scipy.integrate or scikit-sundae).
+
+    Called before a run is timed, so that its wall time is the integration's, not the
+    import's (0.3–0.45 s, which the first run in a process would otherwise carry).
+    """
+    if method in CVODE_METHODS:
+        import sksundae.cvode  # noqa: F401
+    else:
+        import scipy.integrate  # noqa: F401
+
+
 def integrate(
     method: str,
     rhs: Rhs,
