@@ -15,7 +15,13 @@ rule it enforces:
   summation order, another libm), so a tighter bound would test the machine, not the
   code;
 - a NaN or an infinity on either side, a shape mismatch, an empty comparison, or a zero
-  scale that nobody stated fail — a check that compared nothing never passes.
+  scale that nobody stated fail — a check that compared nothing never passes;
+- complex values are compared by the modulus of their difference (a frequency
+  response), never by their real parts alone.
+
+The default scale is one number for the whole array. Where entries span decades and
+each must hold to its own size (a spectrum, the constants of a filter), pass
+``scale=np.abs(expected)`` (per entry) instead.
 
 Exact equality (``==``) stays the right test where one computation is repeated
 bit-for-bit on one machine (determinism, a cache, a serial run against a cluster that
@@ -70,8 +76,10 @@ def _compared(
     actual: ArrayLike, expected: ArrayLike, rel: float, scale: ArrayLike | None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
     """Both sides as float arrays, the bound, and the reason they cannot be compared."""
-    a = np.asarray(actual, dtype=float)
-    e = np.asarray(expected, dtype=float)
+    a = np.asarray(actual)
+    e = np.asarray(expected)
+    kind = complex if np.iscomplexobj(a) or np.iscomplexobj(e) else float
+    a, e = a.astype(kind), e.astype(kind)
     if a.shape != e.shape:
         raise AssertionError(f"shapes differ: actual {a.shape}, expected {e.shape}")
     if a.size == 0:

@@ -71,3 +71,19 @@ def test_bad_tolerances_are_refused():
 def test_what_names_the_quantity():
     with pytest.raises(AssertionError, match="^mass matrix: "):
         assert_close([2.0], [1.0], rel=1e-6, what="mass matrix")
+
+
+def test_complex_values_compare_by_modulus_not_by_real_parts():
+    assert_close([1.0 + 1e-13j], [1.0 + 0.0j], rel=1e-12)
+    with pytest.raises(AssertionError):
+        assert_close([1.0 + 1e-3j], [1.0 + 0.0j], rel=1e-6)
+    with pytest.raises(AssertionError, match="NaN or infinity"):
+        assert_close([complex(1.0, math.nan)], [1.0], rel=1.0)
+
+
+def test_per_entry_scale_holds_small_entries_to_their_own_size():
+    expected = np.array([1.0, 1e-6])
+    actual = expected * (1.0 + np.array([0.0, 1e-3]))
+    assert_close(actual, expected, rel=1e-6)
+    with pytest.raises(AssertionError):
+        assert_close(actual, expected, rel=1e-6, scale=np.abs(expected))
