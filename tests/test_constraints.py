@@ -12,6 +12,7 @@ from rt70.linear import holonomic, topology
 from rt70.linear import linearize as lin
 from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.rt70_state import rt70_pointing
+from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import dynamics
 
 MIMIC_URDF = """<robot name="mimic">
@@ -41,8 +42,8 @@ def test_mimic_map_is_the_textbook_models_g():
     assert np.array_equal(model.G, m.T) and np.array_equal(model.q_offset, m.offset)
     assert np.array_equal(m.T, [[1, 0], [0, 1], [-1.5, 0]])
     q = np.array([0.3, -0.7])
-    assert np.allclose(m.expand(q), [0.3, -0.7, -1.5 * 0.3 + 0.2])
-    assert np.allclose(m.expand(q, offset=False), [0.3, -0.7, -0.45])
+    assert_close(m.expand(q), [0.3, -0.7, -1.5 * 0.3 + 0.2], rel=MIN_REL)
+    assert_close(m.expand(q, offset=False), [0.3, -0.7, -0.45], rel=MIN_REL)
 
 
 def test_mimic_scene_agrees_with_pinocchio_through_the_map():
@@ -53,10 +54,11 @@ def test_mimic_scene_agrees_with_pinocchio_through_the_map():
     q = np.array([0.4, -0.9])
     A_tb = dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)
     A_ref = reference.mass_matrix(scene.reference, reference.ReferenceData(scene.reference), q)
-    assert np.allclose(A_tb, A_ref, rtol=1e-12, atol=1e-14 * np.abs(A_ref).max())
+    assert_close(A_tb, A_ref, rel=1e-12)
 
 
 def test_locking_is_the_identity_without_the_locked_columns():
+    # exact: products by 0 and 1 and sums with 0 round nothing, in any order
     m = constraints.locking(["a", "b", "c", "d"], {"b": 0.5, "d": -1.0})
     assert m.names == ("a", "c")
     assert np.array_equal(m.T, [[1, 0], [0, 0], [0, 1], [0, 0]])
@@ -81,6 +83,7 @@ def test_linearize_locked_equals_deleting_rows_and_columns():
     keep = [i for i, n in enumerate(free.coordinates) if n not in held]
     assert locked.coordinates == [free.coordinates[i] for i in keep]
     ix = np.ix_(keep, keep)
+    # exact: the same matrices computed again, reduced by a 0/1 map (nothing rounds)
     for attr in ("M", "K", "D", "K_gravity"):
         assert np.array_equal(getattr(locked, attr), getattr(free, attr)[ix]), attr
     with pytest.raises(Rt70Error, match="rt70.*no coordinate"):
@@ -110,7 +113,7 @@ def test_maps_compose():
     both = mimic.then(lock)
     assert both.full_names == ("j1", "j2", "j3") and both.names == ("j1",)
     q = np.array([0.3])
-    assert np.allclose(both.expand(q), mimic.expand(lock.expand(q)))
-    assert np.allclose(both.expand(q), [0.3, 0.25, 0.7])
+    assert_close(both.expand(q), mimic.expand(lock.expand(q)), rel=MIN_REL)
+    assert_close(both.expand(q), [0.3, 0.25, 0.7], rel=MIN_REL)
     with pytest.raises(Rt70Error, match="do not chain"):
         lock.then(mimic)

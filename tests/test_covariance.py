@@ -12,6 +12,13 @@ from threadpoolctl import threadpool_limits
 from rt70.errors import Rt70Error
 from rt70.gusts import GustFilter, realise
 from rt70.linear import covariance as cov
+from rt70.testing import assert_close, close
+
+
+def parts(z: np.ndarray) -> np.ndarray:
+    """Real and imaginary parts of ``z`` stacked on a new first axis, for assert_close."""
+    z = np.asarray(z)
+    return np.stack([z.real, z.imag])
 
 
 def oscillators(freqs_hz, zetas, gains=None, inputs=("f",), outputs=("y",)):
@@ -36,13 +43,12 @@ def first_order(a=1.0):
 def test_first_order_closed_forms():
     """ẏ = −a y + w: var = 1/(2a); std of the mean square = √(1/(2a³T))."""
     a, T = 3.0, 40.0
-    assert cov.output_covariance(first_order(a))[0, 0] == pytest.approx(1 / (2 * a), rel=1e-14)
-    assert cov.sample_variance_error(first_order(a), "y", T) == pytest.approx(
-        np.sqrt(1 / (2 * a**3 * T)), rel=1e-12
-    )
+    assert_close(cov.output_covariance(first_order(a))[0, 0], 1 / (2 * a), rel=1e-14)
+    error = cov.sample_variance_error(first_order(a), "y", T)
+    assert_close(error, np.sqrt(1 / (2 * a**3 * T)), rel=1e-12)
     # sampled records tend to the continuous mean square as dt → 0
     fine = cov.sample_variance_error(first_order(a), "y", T, dt=1e-4)
-    assert fine == pytest.approx(np.sqrt(1 / (2 * a**3 * T)), rel=1e-3)
+    assert_close(fine, np.sqrt(1 / (2 * a**3 * T)), rel=1e-3)
 
 
 def test_output_covariance_vs_frequency_integral():
@@ -61,7 +67,7 @@ def test_output_covariance_vs_frequency_integral():
         scipy.integrate.quad(density, lo, hi, limit=500, epsabs=0, epsrel=1e-12)[0]
         for lo, hi in zip(edges[:-1], edges[1:], strict=True)
     )
-    assert variance == pytest.approx(integral, rel=1e-8)
+    assert_close(variance, integral, rel=1e-8)
 
 
 def test_output_covariance_vs_long_simulation():
@@ -73,7 +79,7 @@ def test_output_covariance_vs_long_simulation():
     variance = cov.output_covariance(sys)[0, 0]
     error = cov.sample_variance_error(sys, "y", T=len(t) * dt, dt=dt)
     assert error / variance < 0.02  # the check has teeth: 2 % at most
-    assert abs(np.mean(y**2) - variance) <= 4 * error
+    assert_close(np.mean(y**2), variance, rel=4.0, scale=error)  # 4 standard errors
 
 
 def test_intensity_matrix():
@@ -84,8 +90,8 @@ def test_intensity_matrix():
     W = np.array([[2.0, 0.5], [0.5, 1.0]])
     # P_ij = W_ij / (a_i + a_j)
     expected = 2.0 / 2 + 1.0 / 4 + 2 * 0.5 / 3
-    assert cov.output_covariance((A, B, C), W)[0, 0] == pytest.approx(expected, rel=1e-13)
-    assert cov.output_covariance((A, B, C), 3.0)[0, 0] == pytest.approx(3 * (1 / 2 + 1 / 4))
+    assert_close(cov.output_covariance((A, B, C), W)[0, 0], expected, rel=1e-13)
+    assert_close(cov.output_covariance((A, B, C), 3.0)[0, 0], 3 * (1 / 2 + 1 / 4), rel=1e-13)
 
 
 def test_cascade_with_filter():
@@ -104,12 +110,13 @@ def test_cascade_with_filter():
     assert sys.nstates == 6 and sys.state_labels[0] == "filter.gust1"
     s = 2j * np.pi * np.logspace(-4, 1, 30)
     expected = plant.horner(s)[:, 1, :] * gust.horner(s)[0, 0]
-    np.testing.assert_allclose(sys.horner(s)[:, 0, :], expected, rtol=1e-10)
-    series = control.series(gust, plant[:, 1])
-    np.testing.assert_allclose(sys.horner(s), series.horner(s), rtol=1e-10)
+    # each frequency response on its own magnitude
+    assert_close(parts(sys.horner(s)[:, 0, :]), parts(expected), rel=1e-10, scale=np.abs(expected))
+    series = control.series(gust, plant[:, 1]).horner(s)
+    assert_close(parts(sys.horner(s)), parts(series), rel=1e-10, scale=np.abs(series))
     both = cov.cascade_with_filter(plant, gust, ["wind_x", "wind_y"], gain=[0.5, -1.0])
     expected = (0.5 * plant.horner(s)[:, 0, :] - plant.horner(s)[:, 1, :]) * gust.horner(s)[0, 0]
-    np.testing.assert_allclose(both.horner(s)[:, 0, :], expected, rtol=1e-10)
+    assert_close(parts(both.horner(s)[:, 0, :]), parts(expected), rel=1e-10, scale=np.abs(expected))
     with pytest.raises(Rt70Error, match="no input 'wind_z'"):
         cov.cascade_with_filter(plant, gust, "wind_z")
     with pytest.raises(Rt70Error, match="one output"):
@@ -135,26 +142,30 @@ def test_mode_contributions_two_separated_modes():
         for f, g in ((0.5, 1.0), (5.0, 30.0))
     ]
     cross = (total - sum(own)) / 2  # E[y₁ y₂]
-    assert abs(cross) < 0.01 * total
+    assert_close(cross, 0.0, rel=0.01, scale=total)  # small beside the variance
     assert len(modes) == 2
     for mode, f, v in zip(modes, (0.5, 5.0), own, strict=True):
-        assert mode.frequency_hz == pytest.approx(f * np.sqrt(1), rel=1e-9)  # |λ| = ω_n
-        assert mode.damping == pytest.approx(0.02, rel=1e-9)
-        assert mode.variance == pytest.approx(v + cross, rel=1e-10)
+        assert_close(mode.frequency_hz, f * np.sqrt(1), rel=1e-9)  # |λ| = ω_n
+        assert_close(mode.damping, 0.02, rel=1e-9)
+        assert_close(mode.variance, v + cross, rel=1e-10)
         assert mode.eigenvalue.imag > 0 and mode.eigenvector.shape == (4,)
-    assert sum(m.variance for m in modes) == pytest.approx(total, rel=1e-12)
-    assert sum(m.share for m in modes) == pytest.approx(1.0, abs=1e-12)
-    assert modes[1].share == pytest.approx(own[1] / total, abs=0.01)
+    assert_close(sum(m.variance for m in modes), total, rel=1e-12)
+    shares = [m.share for m in modes]
+    assert_close(sum(shares), 1.0, rel=1e-12, scale=np.abs(shares).sum())
+    # to the cross term's share, a fraction of the unit total
+    assert_close(modes[1].share, own[1] / total, rel=0.01, scale=1.0)
 
 
 def test_mode_contributions_can_be_negative():
     """Two close modes whose outputs cancel: the cross term is large and a share is < 0."""
     sys = oscillators([1.0, 1.02], [0.05, 0.05], gains=[1.0, -1.2])
     modes = cov.mode_contributions(sys, 0)
-    assert min(m.share for m in modes) < 0 < max(m.share for m in modes)
-    assert sum(m.share for m in modes) == pytest.approx(1.0, abs=1e-12)
+    shares = [m.share for m in modes]
+    assert min(shares) < 0 < max(shares)
+    # the shares cancel: their sum is 1 on the scale of their sizes
+    assert_close(sum(shares), 1.0, rel=1e-12, scale=np.abs(shares).sum())
     total = cov.output_covariance(sys)[0, 0]
-    assert sum(m.variance for m in modes) == pytest.approx(total, rel=1e-10)
+    assert_close(sum(m.variance for m in modes), total, rel=1e-10)
 
 
 def test_mode_contributions_with_real_modes():
@@ -162,10 +173,8 @@ def test_mode_contributions_with_real_modes():
     sys = cov.cascade_with_filter(oscillators([1.0], [0.02]), GustFilter(10.0).system, "f")
     modes = cov.mode_contributions(sys, "y")
     assert len(modes) == 5
-    assert sum(m.damping == pytest.approx(1.0) for m in modes) == 4
-    assert sum(m.variance for m in modes) == pytest.approx(
-        cov.output_covariance(sys)[0, 0], rel=1e-10
-    )
+    assert sum(close(m.damping, 1.0, rel=1e-12) for m in modes) == 4
+    assert_close(sum(m.variance for m in modes), cov.output_covariance(sys)[0, 0], rel=1e-10)
 
 
 def test_sample_variance_error_vs_independent_records():
@@ -187,10 +196,10 @@ def test_sample_variance_error_vs_independent_records():
     # standard error of a sample std: s·√((k − 1)/(4M)), k the (sample) kurtosis
     kurtosis = scipy.stats.kurtosis(mean_squares, fisher=False)
     se = measured * np.sqrt((kurtosis - 1) / (4 * records))
-    assert abs(measured - predicted) <= 4 * se
+    assert_close(measured, predicted, rel=4.0, scale=se)  # 4 standard errors
     assert se / predicted < 0.03  # the check has teeth
     # and the mean of the mean squares is the variance 1/2 (within its standard error)
-    assert abs(np.mean(mean_squares) - 0.5) <= 4 * measured / np.sqrt(records)
+    assert_close(np.mean(mean_squares), 0.5, rel=4.0, scale=measured / np.sqrt(records))
 
 
 @pytest.mark.parametrize(
@@ -236,15 +245,15 @@ def test_rt70_state_space_is_accepted():
         output_names=["tip"],
     )
     plant = control.ss(ss.A, ss.B, ss.C, ss.D, inputs=["wind"], outputs=["tip"])
-    assert cov.output_covariance(ss)[0, 0] == pytest.approx(
-        cov.output_covariance(plant)[0, 0], rel=1e-14
-    )
+    assert_close(cov.output_covariance(ss)[0, 0], cov.output_covariance(plant)[0, 0], rel=1e-14)
     gust = GustFilter(10.0).system
     ours, theirs = (cov.cascade_with_filter(p, gust, "wind") for p in (ss, plant))
     assert ours.output_labels == ["tip"]
-    np.testing.assert_array_equal(ours.A, theirs.A)
+    np.testing.assert_array_equal(ours.A, theirs.A)  # the same numbers, copied
     modes = cov.mode_contributions(ss, "tip")
-    assert len(modes) == 2 and sum(m.share for m in modes) == pytest.approx(1.0, abs=1e-12)
+    shares = [m.share for m in modes]
+    assert len(modes) == 2
+    assert_close(sum(shares), 1.0, rel=1e-12, scale=np.abs(shares).sum())
 
 
 def _two_channels(a=3.0, b=0.7):
@@ -259,13 +268,12 @@ def test_vector_output_sample_variance_error():
     sys, T = _two_channels(), 50.0
     one = [cov.sample_variance_error(sys, y, T) for y in ("y1", "y2")]
     both = cov.sample_variance_error(sys, ["y1", "y2"], T)
-    assert both == pytest.approx(np.hypot(*one), rel=1e-12)
+    assert_close(both, np.hypot(*one), rel=1e-12)
     sampled = [cov.sample_variance_error(sys, y, T, dt=0.01) for y in ("y1", "y2")]
-    assert cov.sample_variance_error(sys, ["y1", "y2"], T, dt=0.01) == pytest.approx(
-        np.hypot(*sampled), rel=1e-12
-    )
+    both_sampled = cov.sample_variance_error(sys, ["y1", "y2"], T, dt=0.01)
+    assert_close(both_sampled, np.hypot(*sampled), rel=1e-12)
     # one channel named twice: |y|² = 2 y1², its standard deviation doubles
-    assert cov.sample_variance_error(sys, ["y1", "y1"], T) == pytest.approx(2 * one[0], rel=1e-12)
+    assert_close(cov.sample_variance_error(sys, ["y1", "y1"], T), 2 * one[0], rel=1e-12)
 
 
 def test_vector_output_mode_contributions_add():
@@ -275,6 +283,6 @@ def test_vector_output_mode_contributions_add():
                      outputs=["y", "z"])  # fmt: skip
     y, z, yz = (cov.mode_contributions(sys, o) for o in ("y", "z", ["y", "z"]))
     for a, b, c in zip(y, z, yz, strict=True):
-        assert c.variance == pytest.approx(a.variance + b.variance, rel=1e-10)
+        assert_close(c.variance, a.variance + b.variance, rel=1e-10)
     total = np.trace(cov.output_covariance(sys))
-    assert sum(m.variance for m in yz) == pytest.approx(total, rel=1e-12)
+    assert_close(sum(m.variance for m in yz), total, rel=1e-12)

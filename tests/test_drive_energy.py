@@ -22,6 +22,7 @@ from rt70.drives import DcDrive, drive_parameters, scene_drive, scene_drives
 from rt70.scene import load_scene
 from rt70.servo import ServoDrive, cascade_gains
 from rt70.simulate import simulate
+from rt70.testing import MIN_REL, assert_close
 
 TURRET = Path(__file__).parent / "data" / "turret_drives.urdf"
 VOLTS = {"azimuth": 6.0, "elevation": 12.0}
@@ -56,10 +57,9 @@ def test_backends_agree_on_the_driven_trajectory(runs):
     assert a.success and b.success
     moved = np.max(np.abs(a.q))
     assert moved > 0.1  # the step turned the axes
-    assert np.max(np.abs(a.q - b.q)) < 10 * RTOL * moved
+    assert_close(b.q, a.q, rel=10 * RTOL, scale=moved)
     for name in ("azimuth:current", "elevation:motor_speed", "elevation:electrical_work"):
-        scale = np.max(np.abs(a.states[name]))
-        assert np.max(np.abs(a.states[name] - b.states[name])) < 10 * RTOL * scale, name
+        assert_close(b.states[name], a.states[name], rel=10 * RTOL, what=name)
 
 
 @pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
@@ -67,9 +67,9 @@ def test_energy_balance_closes_with_drives(runs, backend):
     run, audited = runs[backend]
     residual, scale = energy_balance(run, audited)
     assert scale > 1.0  # joules exchanged: electrical work, losses, the structure's energy
-    assert residual[0] == 0.0
+    assert residual[0] == 0.0  # the balance starts from the same numbers on both sides
     print(f"{backend}: residual {np.max(np.abs(residual)) / scale:.2e} of {scale:.3g} J")
-    assert np.max(np.abs(residual)) < RTOL * scale
+    assert_close(residual, np.zeros_like(residual), rel=RTOL, scale=scale)
     # every flow took part
     for flow in ("armature_loss", "motor_loss", "reducer_loss"):
         assert run.states[f"elevation:{flow}"][-1] > 0.0
@@ -83,7 +83,7 @@ def test_energy_balance_closes_on_the_rt70(tmp_path):
     residual, scale = energy_balance(run, audited)
     print(f"rt70_servo: residual {np.max(np.abs(residual)) / scale:.2e} of {scale:.3g} J")
     assert run.states["azimuth:electrical_work"][-1] > 1.0
-    assert np.max(np.abs(residual)) < 1e-8 * scale
+    assert_close(residual, np.zeros_like(residual), rel=1e-8, scale=scale)
 
 
 class _BookCoupling(CoordinateCoupling):
@@ -126,9 +126,9 @@ def test_servo_reads_the_drive_angle_and_its_energy_balances(turret):
     theta = servo.coupling.angle(q)
     assert abs(theta - q[1]) > 1e-3
     errors, _, _ = servo._loops(0.0, q, np.zeros(6))
-    assert errors[0] == pytest.approx(0.1 - theta, abs=1e-15)
+    assert_close(errors[0], 0.1 - theta, rel=MIN_REL, scale=0.1 + abs(theta))
     audited = [AuditedDrive(servo)]
     run = _run(turret, "pinocchio", audited, t_end=0.6)
     residual, scale = energy_balance(run, audited)
-    assert np.max(np.abs(residual)) < RTOL * scale
+    assert_close(residual, np.zeros_like(residual), rel=RTOL, scale=scale)
     assert 0.02 < servo.coupling.angle(run.q[-1]) < 0.1  # on its way to the 0.1 rad step

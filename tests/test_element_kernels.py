@@ -21,6 +21,7 @@ from rt70.reference.element_kernels import ElementKernels
 from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.rt70_state import listing_initial_state
 from rt70.simulate import simulate
+from rt70.testing import assert_close
 
 SCENES = ("rt70", "rt70_servo", "rt70_azimuth", "rt70_elevation", "three_masses",
           "two_body_gravity", "rt70_jack")  # fmt: skip
@@ -67,14 +68,6 @@ def _states(model, n: int, seed: int):
         yield qp, rng.standard_normal(m.nv)
 
 
-def _relative(a: np.ndarray, b: np.ndarray) -> float:
-    assert np.isfinite(a).all() and np.isfinite(b).all()
-    scale = float(np.max(np.abs(a)))
-    if scale == 0.0:  # e.g. a scene without dampers: then exactly zero on both
-        return float(np.max(np.abs(b)))
-    return float(np.max(np.abs(a - b))) / scale
-
-
 def _check(scene) -> None:
     ref, rd = scene.reference, scene.reference_data
     kernels = ElementKernels.of(ref)
@@ -85,10 +78,15 @@ def _check(scene) -> None:
         U = sum(0.5 * e.squares(e.stiffness) for e in forces.elements(ref, rd, qp, False))
         assert np.max(np.abs(tau_c)) > 0.0 and U > 0.0  # something to compare
         fast = kernels.torques_and_gains(qp, vp)
-        for want, got in zip((tau_c, tau_d, K, D), fast, strict=True):
-            assert _relative(want, got) < 1e-13
-        assert _relative(np.array(kernels.torques(qp, vp)), np.array([tau_c, tau_d])) < 1e-13
-        assert abs(kernels.potential(qp) - U) <= 1e-13 * U
+        # a scene without dampers: exactly zero on both sides
+        for name, want, got in zip(
+            ("τ_c", "τ_d", "K", "D"), (tau_c, tau_d, K, D), fast, strict=True
+        ):
+            assert_close(got, want, rel=1e-13, what=name)
+        torques = np.array(kernels.torques(qp, vp))
+        assert_close(torques[0], tau_c, rel=1e-13, what="τ_c")
+        assert_close(torques[1], tau_d, rel=1e-13, what="τ_d")
+        assert_close(kernels.potential(qp), U, rel=1e-13)  # a sum of positive energies
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -149,9 +147,8 @@ def test_simulation_with_kernels_equals_the_python_path(monkeypatch):
         monkeypatch.setitem(sim.BACKENDS, "pinocchio", functools.partial(backend, kernels=kernels))
         runs.append(simulate(scene, (0.0, 0.3), x0, rtol=1e-8, t_eval=t))
     fast, slow = runs
-    scale = np.max(np.abs(slow.q))
-    assert np.max(np.abs(fast.q - slow.q)) <= 1e-6 * scale
-    assert np.max(np.abs(fast.elastic - slow.elastic)) <= 1e-6 * np.max(slow.elastic)
+    assert_close(fast.q, slow.q, rel=1e-6)
+    assert_close(fast.elastic, slow.elastic, rel=1e-6)
 
 
 def test_compiled_drive_angle_and_force_equal_pinocchios():
@@ -170,8 +167,9 @@ def test_compiled_drive_angle_and_force_equal_pinocchios():
             q = 0.05 * rng.standard_normal(scene.textbook.nv)
             angle, Q = kin.drive_force(ref, rd, q, drive, 1.0, mesh)
             got_angle, got_Q = fast(q)
-            assert abs(got_angle - angle) <= 1e-14 * max(abs(angle), 1.0)
-            assert _relative(Q, got_Q) < 1e-13
+            # an angle from unit rotations: its rounding is absolute, on the scale of π
+            assert_close(got_angle, angle, rel=1e-14, scale=np.pi)
+            assert_close(got_Q, Q, rel=1e-13)
 
 
 def test_a_new_element_kind_turns_the_kernels_off(monkeypatch):
@@ -203,4 +201,4 @@ def test_compiled_wind_force_equals_pinocchios(direction):
         q = 0.05 * rng.standard_normal(scene.textbook.nv)
         want = kin.wind_force(ref, rd, q, condition)
         assert np.max(np.abs(want)) > 0.0
-        assert _relative(want, fast(q, condition)) < 1e-13
+        assert_close(fast(q, condition), want, rel=1e-13)

@@ -16,6 +16,7 @@ import rt70.reference as reference
 from rt70.reference import forces as ref_forces
 from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.synthetic import random_tree
+from rt70.testing import assert_close
 from rt70.textbook import forces as tb_forces
 from rt70.textbook.kinematics import update_structure
 from rt70.urdf.description import RobotDescription
@@ -130,9 +131,10 @@ def test_textbook_kinds_force_is_minus_jt_c_delta_of_their_own_delta(name):
         f = _flat(e, "stiffness") * np.ravel(e.delta)
         Q = np.zeros(n)
         e.subtract_jt(model, Q, (e.stiffness * e.delta))
-        assert np.allclose(Q, -J.T @ f, rtol=1e-6, atol=1e-7 * np.abs(J.T @ f).max()), kind
-        assert np.allclose(np.ravel(e.rate(model, qd)), J @ qd, rtol=1e-6, atol=1e-9), kind
-        assert np.isclose(sum(e.squares(e.stiffness)), np.ravel(e.delta) @ f, rtol=1e-13)
+        # against central differences of δ (h = 1e-6: error ≈ ε/h ≈ 1e-10 of δ's scale)
+        assert_close(Q, -J.T @ f, rel=1e-6, what=kind)
+        assert_close(np.ravel(e.rate(model, qd)), J @ qd, rel=1e-6, what=kind)
+        assert_close(sum(e.squares(e.stiffness)), np.ravel(e.delta) @ f, rel=1e-13, what=kind)
 
 
 @pytest.mark.parametrize("name", ["chain", "rt70"])
@@ -148,15 +150,15 @@ def test_reference_kinds_products_are_those_of_the_jacobian_of_their_delta(name)
     for kind, J in J_fd.items():
         e = kinds[kind]
         C, f = _flat(e, "stiffness"), _flat(e, "stiffness") * np.ravel(e.delta)
-        scale = np.abs(J.T @ f).max()
         Q, S, K = np.zeros(n), np.zeros(n), np.zeros((n, n))
         e.subtract_jt(Q, e.stiffness * e.delta)
         e.add_abs_jt(S, e.stiffness * e.delta)
         e.add_jt_w_j(K, e.stiffness)
-        assert np.allclose(Q, -J.T @ f, rtol=1e-6, atol=1e-7 * scale), kind
-        assert np.allclose(S, np.abs(J).T @ np.abs(f), rtol=1e-6, atol=1e-7 * scale), kind
-        assert np.allclose(K, J.T @ (C[:, None] * J), rtol=1e-6, atol=1e-7 * np.abs(K).max())
-        assert np.allclose(np.ravel(e.rate(v)), J @ v, rtol=1e-6, atol=1e-9), kind
+        # against central differences of δ, as on the textbook side
+        assert_close(Q, -J.T @ f, rel=1e-6, what=kind)
+        assert_close(S, np.abs(J).T @ np.abs(f), rel=1e-6, what=kind)
+        assert_close(K, J.T @ (C[:, None] * J), rel=1e-6, what=kind)
+        assert_close(np.ravel(e.rate(v)), J @ v, rel=1e-6, what=kind)
 
 
 @pytest.mark.parametrize("name", ["chain", "rt70"])
@@ -170,8 +172,8 @@ def test_the_two_sides_agree_kind_by_kind(name):
     assert present and present == [k for k, e in ref.items() if e is not None]
     for kind in present:
         a, b = tb[kind], ref[kind]
-        assert np.allclose(np.ravel(a.delta), np.ravel(b.delta), rtol=1e-12, atol=1e-14), kind
-        for gain in ("stiffness", "damping"):
+        assert_close(np.ravel(a.delta), np.ravel(b.delta), rel=1e-12, what=kind)
+        for gain in ("stiffness", "damping"):  # both read the one description: copies
             assert np.array_equal(_flat(a, gain), _flat(b, gain)), (kind, gain)
 
 
@@ -183,12 +185,13 @@ def test_two_springs_on_one_joint_add_up_in_the_gains():
     K1, D1 = reference.element_gains(one.reference, reference.ReferenceData(one.reference), q)
     K2, D2 = reference.element_gains(two.reference, reference.ReferenceData(two.reference), q)
     i = two.reference.coordinate_index(["j1"])[0]
-    assert K2[i, i] - K1[i, i] == pytest.approx(7.0, rel=1e-12)
-    assert D2[i, i] - D1[i, i] == pytest.approx(0.2, rel=1e-12)
+    # differences of sums: on the scale of the sums
+    assert_close(K2[i, i] - K1[i, i], 7.0, rel=1e-12, scale=K2[i, i])
+    assert_close(D2[i, i] - D1[i, i], 0.2, rel=1e-12, scale=D2[i, i])
     Qc1, _ = reference.spring_damper_force(
         one.reference, reference.ReferenceData(one.reference), q, 0 * q
     )
     Qc2, _ = reference.spring_damper_force(
         two.reference, reference.ReferenceData(two.reference), q, 0 * q
     )
-    assert Qc2[i] - Qc1[i] == pytest.approx(-7.0 * 0.05, rel=1e-12)
+    assert_close(Qc2[i] - Qc1[i], -7.0 * 0.05, rel=1e-12, scale=abs(Qc2[i]) + abs(Qc1[i]))

@@ -11,6 +11,7 @@ from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
 from rt70.scene import load_scene
 from rt70.scenes.rt70_state import rt70_pointing
+from rt70.testing import assert_close
 from rt70.textbook import forces
 
 
@@ -25,7 +26,7 @@ def test_equilibrium_is_the_textbook_one(servo):
     """Newton's direction changes, the textbook residual does not: the same q0."""
     scene, held, q0 = servo
     q_fast = lin.equilibrium(scene, held)
-    assert np.abs(q_fast - q0).max() <= 1e-12  # measured 7.1e-15 rad or m
+    assert_close(q_fast, q0, rel=1e-12)  # measured 7.1e-15 rad or m (max|q0| = 0.79)
 
 
 @pytest.mark.parametrize("locked", [(), ("platform_rz", "base_rx")])
@@ -36,11 +37,10 @@ def test_linearization_matches_the_textbook_path(servo, locked):
     slow = lin.linearize(scene, q0, locked=locked, side="textbook")
     fast = lin.linearize(scene, q0, locked=locked)
     assert fast.coordinates == slow.coordinates
-    np.testing.assert_array_equal(fast.M, slow.M)
+    np.testing.assert_array_equal(fast.M, slow.M)  # one code, one q0: the same numbers
     for name in ("K", "K_gravity"):
-        a, b = getattr(fast, name), getattr(slow, name)
-        assert np.abs(a - b).max() <= 1e-9 * np.abs(b).max(), name
-    assert np.abs(fast.D - slow.D).max() <= 1e-14 * np.abs(slow.D).max()
+        assert_close(getattr(fast, name), getattr(slow, name), rel=1e-9, what=name)
+    assert_close(fast.D, slow.D, rel=1e-14)
 
 
 def test_damping_matrix_equals_its_columns(servo):
@@ -51,7 +51,7 @@ def test_damping_matrix_equals_its_columns(servo):
         [-forces.spring_damper_force(model, data, q0, e)[1] for e in np.eye(model.nv)]
     )
     D = lin.damping_matrix(scene, q0)
-    assert np.abs(D - 0.5 * (columns + columns.T)).max() <= 1e-14 * np.abs(columns).max()
+    assert_close(D, 0.5 * (columns + columns.T), rel=1e-14, scale=np.abs(columns).max())
 
 
 def test_plant_is_unchanged(servo, monkeypatch):
@@ -66,8 +66,7 @@ def test_plant_is_unchanged(servo, monkeypatch):
     )
     slow = pl.plant(scene, q0, inputs, outputs)
     for name in ("A", "B", "C", "D"):
-        a, b = getattr(fast, name), getattr(slow, name)
-        assert np.abs(a - b).max() <= 1e-8 * max(np.abs(b).max(), 1e-300), name
+        assert_close(getattr(fast, name), getattr(slow, name), rel=1e-8, what=name)
 
 
 def test_unknown_side_is_refused(servo):

@@ -20,6 +20,7 @@ from rt70.geartrains import (
 from rt70.scene import scene_from_text
 from rt70.servo import ServoDrive, cascade_gains
 from rt70.simulate import simulate
+from rt70.testing import assert_close
 
 #: Stiff enough for the rigid-axis cascade design (as tests/test_servo.py).
 STIFF = replace(PARAMS, C_r=1e5, D_r=10.0)
@@ -33,15 +34,16 @@ def test_dead_zone_transmits_nothing_inside_the_gap():
     for twist in twists:
         for rate in (-5.0, 0.0, 5.0):  # whatever the teeth's relative speed
             assert backlash_torque(twist, rate, 1e5, 10.0, B) == 0.0
-    # outside: the spring of the twist past the flank, plus the damper
-    assert backlash_torque(3 * B, 0.0, 1e5, 10.0, B) == pytest.approx(1e5 * 2 * B)
-    assert backlash_torque(-3 * B, 0.0, 1e5, 10.0, B) == pytest.approx(-1e5 * 2 * B)
-    assert backlash_torque(3 * B, 1.0, 1e5, 10.0, B) == pytest.approx(1e5 * 2 * B + 10.0)
+    # outside: the spring of the twist past the flank, plus the damper (3B − B rounds
+    # on the scale of 3B: 1e-14 of the result covers it)
+    assert_close(backlash_torque(3 * B, 0.0, 1e5, 10.0, B), 1e5 * 2 * B, rel=1e-14)
+    assert_close(backlash_torque(-3 * B, 0.0, 1e5, 10.0, B), -1e5 * 2 * B, rel=1e-14)
+    assert_close(backlash_torque(3 * B, 1.0, 1e5, 10.0, B), 1e5 * 2 * B + 10.0, rel=1e-14)
     # in contact the teeth never pull: a fast separation gives zero, not a negative torque
     assert backlash_torque(1.5 * B, -1e3, 1e5, 10.0, B) == 0.0
     assert backlash_torque(-1.5 * B, 1e3, 1e5, 10.0, B) == 0.0
     # without a gap it is the linear reducer, of either sign
-    assert backlash_torque(B, -1e3, 1e5, 10.0, 0.0) == pytest.approx(1e5 * B - 1e4)
+    assert_close(backlash_torque(B, -1e3, 1e5, 10.0, 0.0), 1e5 * B - 1e4, rel=1e-14)
 
 
 def test_bad_drive_requests():
@@ -78,9 +80,9 @@ def test_pair_without_gap_or_bias_is_the_servo_drive():
         y = np.concatenate([x[:3], x[:3], x[3:], x[5:]])
         ds1, ds2 = one.derivative(0.0, q, qd, x, None), two.derivative(0.0, q, qd, y, None)
         for k in (0, 3):
-            assert np.allclose(ds2[k : k + 3], ds1[:3], rtol=1e-12, atol=1e-12)
-        assert np.allclose(ds2[6:], ds1[[3, 4, 5, 5]], rtol=1e-12, atol=1e-12)
-        assert two.force(0.0, q, qd, y)[0] == pytest.approx(one.force(0.0, q, qd, x)[0], 1e-12)
+            assert_close(ds2[k : k + 3], ds1[:3], rel=1e-12, what=f"train {k // 3 + 1}")
+        assert_close(ds2[6:], ds1[[3, 4, 5, 5]], rel=1e-12, what="integrators")
+        assert_close(two.force(0.0, q, qd, y)[0], one.force(0.0, q, qd, x)[0], rel=1e-12)
 
 
 def test_counter_torque_keeps_both_trains_engaged():
@@ -94,6 +96,7 @@ def test_counter_torque_keeps_both_trains_engaged():
         bias_torque=bias, atol=np.full(10, 1e-9),
     )  # fmt: skip
     drive.initial = np.concatenate([drive.bias_state(0.0, bias), np.zeros(4)])
+    # the two trains' states are mirror images: their torques cancel exactly
     assert sum(drive.train_torques(np.zeros(1), np.zeros(1), drive.initial)) == 0.0
     t = np.linspace(0.0, 1.5, 301)
     run = _step(drive, t, rtol=1e-7)
@@ -113,13 +116,13 @@ def test_counter_torque_keeps_both_trains_engaged():
     forces = np.array(
         [drive.force(0.0, q, v, x)[0] for q, v, x in zip(run.q, run.qd, s, strict=True)]
     )
-    assert np.array_equal(forces, net)
+    assert np.array_equal(forces, net)  # force sums the same train_torques
     # the gap is invisible and the bias cancels: the motion is the pair's without either
     linear = TwoTrainServo(
         "lin", names, "axis", STIFF, train_gains(STIFF, J_L), lambda s: STEP,
         atol=np.full(10, 1e-9),
     )  # fmt: skip
-    assert np.abs(_step(linear, t, rtol=1e-7).q - run.q).max() < 1e-5 * STEP
+    assert_close(_step(linear, t, rtol=1e-7).q, run.q, rel=1e-5, scale=STEP)
 
 
 def test_without_bias_the_gap_is_crossed():
