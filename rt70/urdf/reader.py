@@ -420,7 +420,7 @@ class _Reader:
         for elem in root:
             if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
                 continue
-            kind = elem.tag[len(ns) :]  # a kind of RT70, checked by check_scene
+            kind = elem.tag[len(ns) :]  # one of rt70.urdf.schema.RT70's, checked
             if kind == "gravity":
                 desc.gravity[:] = self.numbers(elem, "xyz", 3)
             elif kind == "joint_spring":
@@ -439,10 +439,12 @@ class _Reader:
                 air.append(read_air(self, elem))
             elif kind == "no_slip":
                 no_slips.append(read_no_slip(self, elem, desc, no_slips))
-            else:
+            elif kind == "optical_point":
                 name = self.name_of(elem)
                 link = self.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
                 desc.optical_points.append(OpticalPoint(name, link, self.numbers(elem, "xyz", 3)))
+            else:  # a kind declared in RT70 must be read here, never skipped
+                raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
         if not (winds or air or no_slips):
             return desc
         return dataclasses.replace(
