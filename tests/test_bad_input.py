@@ -310,7 +310,7 @@ CASES = {
     "optical-point-lacks-xyz": Case(
         robot(*CHAIN, '<rt70:optical_point name="focus" link="link2"/>'),
         ExtensionError,
-        ("<rt70:optical_point>", "lacks attribute 'xyz'"),
+        ("<rt70:optical_point name='focus'>", "lacks attribute 'xyz'"),
     ),
     "spring-without-name": Case(
         robot(*CHAIN, '<rt70:joint_spring joint="j1" stiffness="1"/>'),

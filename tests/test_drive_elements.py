@@ -90,7 +90,7 @@ BAD = {
     "unknown-joint": (f'<rt70:drive name="d" joint="ghost" {PARAMS}/>', "'ghost' does not exist"),
     "missing-parameter": (
         '<rt70:drive name="d" joint="az" L_a="1" R_a="1"/>',
-        "drive 'd' <rt70:drive> lacks attribute 'c_m'",
+        "<rt70:drive name='d'> lacks attribute 'c_m'",
     ),
     "zero-ratio": (
         f'<rt70:drive name="d" joint="az" {ZERO_RATIO}/>',

@@ -74,6 +74,7 @@ WARNING_KINDS = (
     ("NUL characters after the document", "NUL after the document"),
     ("inertia repaired (balance inertia", "inertia balanced"),
     ("Pinocchio's URDF parser:", "Pinocchio parser message"),
+    ("is not URDF, ignored", "unknown URDF attribute"),
 )
 
 CATEGORIES = ("agree", "refused", "disagree", "crashed")

@@ -62,10 +62,8 @@ def read_drive(
             need = "positive" if key in POSITIVE else "non-negative"
             raise reader.fail(ExtensionError, f"{where}: {key}={value:g} must be {need}")
         values[key] = value
-    subs = elem.findall(f"{{{RT70_NS}}}sector")
-    if len(subs) > 1:
-        raise reader.fail(ExtensionError, f"{where} has more than one <rt70:sector>")
-    sector = _sector(reader, subs[0], desc, name) if subs else None
+    sub = elem.find(f"{{{RT70_NS}}}sector")  # at most one (rt70.urdf.schema.RT70)
+    sector = _sector(reader, sub, desc, name) if sub is not None else None
     if sector is not None and joint.type == "prismatic":
         raise reader.fail(
             ExtensionError, f"{where}: a gear sector turns an angle, joint '{jname}' is prismatic"

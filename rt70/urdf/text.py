@@ -9,12 +9,13 @@ element and how to fix it (docs/urdf-reader.md).
 
 from __future__ import annotations
 
+import re
 import warnings
 import xml.etree.ElementTree as ET
 import xml.parsers.expat
 from pathlib import Path
 
-from rt70.errors import DtdError, Rt70Warning, UrdfError, XacroError
+from rt70.errors import DtdError, ExtensionError, Rt70Warning, UrdfError, XacroError
 
 #: XML namespace of the rt70 extension elements (docs/urdf-extensions.md).
 RT70_NS = "urn:rt70:urdf-extensions:1"
@@ -64,6 +65,9 @@ def prepare_text(text: str, source: str = "<string>") -> str:
     return text
 
 
+#: An element or attribute name with the prefix ``rt70:`` in a start tag.
+_RT70_PREFIXED = re.compile(r"(^<|\s)rt70:[\w.-]+")
+
 #: How to turn a xacro template into a URDF.
 EXPAND_XACRO = (
     "this is a xacro template, not a URDF: expand it with xacro first (xacro FILE > FILE.urdf)"
@@ -100,6 +104,69 @@ def refuse_entities(text: str, source: str) -> None:
 
 class _EntityFound(Exception):
     """Stops the entity scan at the first declaration."""
+
+
+def parse(text: str, source: str) -> tuple[ET.Element, dict[str, set[str]]]:
+    """The XML tree of a URDF text, and the prefixes its namespace declarations bind.
+
+    Returns
+    -------
+    root : xml.etree.ElementTree.Element
+        The document element.
+    prefixes : dict of str to set of str
+        For each namespace URI the document declares, the prefixes bound to it (``""``
+        for a default namespace).
+
+    Raises
+    ------
+    ExtensionError
+        If the prefix ``rt70:`` is used without its namespace declaration.
+    XacroError
+        If the prefix ``xacro:`` is used without its namespace declaration.
+    UrdfError
+        If the text is not well-formed XML.
+    """
+    builder = _NamespaceRecorder()
+    parser = ET.XMLParser(target=builder)
+    try:
+        parser.feed(text)
+        root = parser.close()
+    except ET.ParseError as exc:
+        if "unbound prefix" in str(exc):
+            tag = _start_tag(text, *exc.position)
+            if _RT70_PREFIXED.search(tag):
+                raise ExtensionError(
+                    f"{source}: line {exc.position[0]}: {tag}: the prefix 'rt70:' is not "
+                    f'declared: add xmlns:rt70="{RT70_NS}" to <robot>'
+                ) from None
+            if "xacro:" in text:
+                raise XacroError(
+                    f"{source}: xacro elements without the xacro namespace ({exc}): {EXPAND_XACRO}"
+                ) from None
+        raise UrdfError(f"{source}: malformed XML: {exc}") from None
+    return root, builder.prefixes
+
+
+class _NamespaceRecorder(ET.TreeBuilder):
+    """A tree builder that also records each namespace declaration's prefix."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.prefixes: dict[str, set[str]] = {}
+
+    def start_ns(self, prefix: str, uri: str) -> None:
+        self.prefixes.setdefault(uri, set()).add(prefix)
+
+
+def _start_tag(text: str, line: int, column: int) -> str:
+    """The start tag at ``line`` (1-based) and ``column`` (0-based) of ``text``, shortened."""
+    lines = text.splitlines()
+    if not 1 <= line <= len(lines):
+        return ""
+    rest = lines[line - 1][column:] + " " + " ".join(lines[line : line + 5])
+    end = rest.find(">")
+    tag = rest[: end + 1] if end >= 0 else rest
+    return tag if len(tag) <= 80 else tag[:76] + " ..."
 
 
 def refuse_xacro(root: ET.Element, source: str) -> None:
