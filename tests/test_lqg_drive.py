@@ -97,7 +97,7 @@ def test_hold_starts_at_rest(scene, start):
     # at rest: in one second no state moves by its integration tolerance
     assert_close(ds, np.zeros_like(ds), rel=1.0, scale=az.atol)
     assert_close(
-        az.voltage_of(0.0, q0, np.zeros(nv), az.initial), az.p.R_a * az.initial[0], rel=1e-9
+        az.voltage_of(0.0, q0, np.zeros(nv), az.initial), az.p.R_a * az.initial[0], rel=1e-12
     )
 
 
