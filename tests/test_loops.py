@@ -23,8 +23,10 @@ from rt70.closed_chains import assemble
 from rt70.errors import ExtensionError, Rt70Error, SimulationError
 from rt70.kkt import solve_kkt
 from rt70.reference import loops as rl
+from rt70.reference import points as ref_points
 from rt70.scene import load_scene, scene_from_text
 from rt70.simulate import simulate
+from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import dynamics, forces
 from rt70.textbook import loops as tl
 
@@ -65,6 +67,19 @@ def scene(request):
     return load_scene(request.param)
 
 
+def reach(scene, q) -> float:
+    """The largest distance of a loop's frame from the ground origin (m), the scale of Φ.
+
+    Φ is a difference of such positions, each a sum of the links' offsets; the same scale
+    as :func:`rt70.loop_check.loop_scales` gives the loop rows of ``rt70 validate``.
+    """
+    located = [
+        (f.link, f.xyz) for loop in scene.description.loops for f in (loop.frame1, loop.frame2)
+    ]
+    positions = ref_points.point_positions(scene.reference, scene.reference_data, q, located)
+    return float(np.max(np.linalg.norm(positions, axis=1)))
+
+
 def _state(scene, seed=3):
     rng = np.random.default_rng(seed)
     n = scene.textbook.nv
@@ -89,10 +104,11 @@ def test_world_means_the_ground_even_when_the_root_has_another_name():
     (loop,) = scene.description.loops
     assert loop.frame2.link == "ground"
     q = np.array([0.0, 0.0])
-    np.testing.assert_allclose(
+    assert_close(
         tl.loop_residual(scene.textbook, scene.textbook_data, q),
         rl.loop_residual(scene.reference, scene.reference_data, q),
-        atol=1e-15,
+        rel=1e-14,
+        scale=reach(scene, q),
     )
 
 
@@ -157,10 +173,13 @@ def test_jacobian_and_bias_are_the_derivatives_of_the_residual(scene):
     h = 1e-6
     B = tl.loop_jacobian(tm, td, q)
     dphi = (tl.loop_residual(tm, td, q + h * qd) - tl.loop_residual(tm, td, q - h * qd)) / (2 * h)
-    np.testing.assert_allclose(B @ qd, dphi, atol=1e-8 * (1 + np.abs(dphi).max()))
+    # central differences, O(h²) and O(ε |Φ| / h): on the loop's velocity scale |q̇| · reach
+    length, speed = reach(scene, q), np.abs(qd).max()
+    assert_close(B @ qd, dphi, rel=1e-8, scale=max(length, np.abs(B).max()) * speed)
     dB = (tl.loop_jacobian(tm, td, q + h * qd) - tl.loop_jacobian(tm, td, q - h * qd)) / (2 * h)
     C = tl.loop_bias(tm, td, q, qd)
-    np.testing.assert_allclose(C, dB @ qd, atol=1e-7 * (1 + np.abs(C).max()))
+    # on the scale of the bias: the centripetal terms |q̇|² · reach
+    assert_close(C, dB @ qd, rel=1e-7, scale=length * speed**2 + np.abs(C).max())
 
 
 @pytest.mark.parametrize("stabilization", [None, Baumgarte(), Baumgarte(50.0, 0.7)])
@@ -171,20 +190,22 @@ def test_both_sides_agree(scene, stabilization):
     if scene.name == "welded":  # Pinocchio's 6-D error is log₆, ours (p₁−p₂, log₃): on Φ = 0
         q, qd = assemble(scene, q, qd)
 
-    def close(a, b):
-        assert np.max(np.abs(a - b)) <= TOL * max(np.max(np.abs(b)), 1.0), (a, b)
-
-    close(tl.loop_residual(tm, td, q), rl.loop_residual(ref, rd, q))
-    close(tl.loop_jacobian(tm, td, q), rl.loop_jacobian(ref, rd, q))
-    close(tl.loop_bias(tm, td, q, qd), rl.loop_bias(ref, rd, q, qd))
+    # the scales of rt70.loop_check.loop_scales: Φ is welded shut (0) on the manifold
+    length, speed = reach(scene, q), np.abs(qd).max()
+    B_ref, C_ref = rl.loop_jacobian(ref, rd, q), rl.loop_bias(ref, rd, q, qd)
+    assert_close(tl.loop_residual(tm, td, q), rl.loop_residual(ref, rd, q), rel=TOL, scale=length)
+    jacobian_scale = max(length, np.abs(B_ref).max())
+    assert_close(tl.loop_jacobian(tm, td, q), B_ref, rel=TOL, scale=jacobian_scale)
+    bias_scale = length * speed**2 + np.abs(C_ref).max()
+    assert_close(tl.loop_bias(tm, td, q, qd), C_ref, rel=TOL, scale=bias_scale)
     Q = np.linspace(-1.0, 1.0, tm.nv)
     qdd_t, lam_t = tl.constrained_forward_dynamics(tm, td, q, qd, Q, stabilization)
     qdd_r, lam_r = rl.constrained_forward_dynamics(ref, rd, q, qd, Q, stabilization)
-    close(qdd_t, qdd_r)
+    assert_close(qdd_t, qdd_r, rel=TOL)
     B = tl.loop_jacobian(tm, td, q)
-    close(B.T @ lam_t, B.T @ lam_r)  # the generalised reactions: unique
+    assert_close(B.T @ lam_t, B.T @ lam_r, rel=TOL)  # the generalised reactions: unique
     if scene.name != "welded":  # λ itself where the rows are independent (z row: zero)
-        close(lam_t, lam_r)
+        assert_close(lam_t, lam_r, rel=TOL)
 
 
 def test_constrained_equations_and_the_perturbation_law(scene):
@@ -199,13 +220,19 @@ def test_constrained_equations_and_the_perturbation_law(scene):
     B = tl.loop_jacobian(tm, td, q)
     phi, C = tl.loop_residual(tm, td, q), tl.loop_bias(tm, td, q, qd)
     scale = np.abs(A @ qdd).max() + np.abs(f).max()
-    assert np.abs(A @ qdd - f - B.T @ lam).max() <= 1e-12 * scale
+    assert_close(A @ qdd, f + B.T @ lam, rel=1e-12, scale=scale)
     target = -2 * 0.5 * 30.0 * (B @ qd) - 900.0 * phi - C
+    # Φ̈ on the scale of its terms: B q̈, C and the law's 2ζω B q̇ and ω² Φ
+    terms = (
+        np.abs(B) @ np.abs(qdd) + np.abs(C) + 30.0 * np.abs(B) @ np.abs(qd) + 900.0 * np.abs(phi)
+    )
     target = B @ np.linalg.lstsq(B, target, rcond=1e-10)[0] + C  # dependent rows: least squares
-    assert np.abs(B @ qdd + C - target).max() <= 1e-10 * (1 + np.abs(target).max())
+    assert_close(B @ qdd + C, target, rel=1e-10, scale=terms.max())
     _, s, Vt = np.linalg.svd(B.T)
     null = Vt[int((s > 1e-10 * s[0]).sum()) :].T  # the null space of B_cᵀ
-    assert np.abs(null.T @ lam).max(initial=0.0) <= 1e-12 * (1 + np.abs(lam).max())  # least norm
+    assert null.shape[1] > 0  # every loop scene here has a dependent row
+    # least norm: no component of λ in the null space of B_cᵀ, on λ's scale
+    assert_close(null.T @ lam, np.zeros(null.shape[1]), rel=1e-12, scale=np.abs(lam).max())
 
 
 def test_planar_loops_have_a_dependent_row():
@@ -213,7 +240,8 @@ def test_planar_loops_have_a_dependent_row():
         scene = load_scene(name)
         B = tl.loop_jacobian(scene.textbook, scene.textbook_data, np.array([0.3, 0.2, 0.1]))
         assert B.shape == (3, 3) and np.linalg.matrix_rank(B) == 2
-        np.testing.assert_array_equal(B[2], 0.0)  # z: the mechanisms are planar
+        # z: the mechanisms are planar
+        assert_close(B[2], np.zeros(3), rel=MIN_REL, scale=np.abs(B).max())
 
 
 def test_welded_rods_move_as_one_body():
@@ -221,19 +249,19 @@ def test_welded_rods_move_as_one_body():
     scene = scene_from_text(welded(), "welded")
     tm, td = scene.textbook, scene.textbook_data
     q, qd = assemble(scene, np.array([0.3, 0.2]), np.array([1.0, 0.0]), keep=["ja"])
-    np.testing.assert_allclose(q, [0.3, 0.3], atol=1e-12)
-    np.testing.assert_allclose(qd, [1.0, 1.0], atol=1e-12)
+    assert_close(q, [0.3, 0.3], rel=1e-12)
+    assert_close(qd, [1.0, 1.0], rel=1e-12)
     qdd, _ = tl.constrained_forward_dynamics(tm, td, q, qd)
     A = dynamics.mass_matrix(tm, td, q)
     torque = dynamics.gravity_force(tm, td, q).sum()
-    np.testing.assert_allclose(qdd, torque / A.sum() * np.ones(2), rtol=1e-12)
+    assert_close(qdd, torque / A.sum() * np.ones(2), rel=1e-12)
 
 
 def test_bad_gains_are_refused():
     for omega, zeta in ((0.0, 1.0), (10.0, -1.0), (np.nan, 1.0)):
         with pytest.raises(Rt70Error, match="Baumgarte"):
             Baumgarte(omega, zeta)
-    assert Baumgarte(20.0, 1.0).gains() == (400.0, 40.0)
+    assert_close(Baumgarte(20.0, 1.0).gains(), (400.0, 40.0), rel=MIN_REL)
 
 
 # --- assembly --------------------------------------------------------------------
@@ -245,11 +273,12 @@ def test_assemble_keeps_the_crank():
         scene, np.array([0.7, 0.0, 0.0]), np.array([10.0, 0.0, 0.0]), keep=["crank_joint"]
     )
     tm, td = scene.textbook, scene.textbook_data
-    assert q[0] == 0.7 and qd[0] == 10.0
-    assert np.abs(tl.loop_residual(tm, td, q)).max() <= 1e-13
-    assert np.abs(tl.loop_jacobian(tm, td, q) @ qd).max() <= 1e-12
+    assert q[0] == 0.7 and qd[0] == 10.0  # kept: not touched
+    phi, B = tl.loop_residual(tm, td, q), tl.loop_jacobian(tm, td, q)
+    assert_close(phi, np.zeros_like(phi), rel=1e-13, scale=reach(scene, q))
+    assert_close(B @ qd, np.zeros(len(B)), rel=1e-13, scale=np.abs(B) @ np.abs(qd))
     x = 0.1 * np.cos(0.7) + np.sqrt(0.4**2 - (0.1 * np.sin(0.7)) ** 2)  # the slider's position
-    assert q[2] == pytest.approx(x, abs=1e-13)
+    assert_close(q[2], x, rel=1e-13)
 
 
 def test_assemble_refuses_what_cannot_close():
@@ -277,9 +306,13 @@ def test_crank_slider_ten_seconds_stays_closed(crank_slider_start):
     held = simulate(scene, (0.0, 10.0), x0, **kw)
     drifting = simulate(scene, (0.0, 10.0), x0, stabilization=None, **kw)
     assert held.success and drifting.success
-    assert held.constraint_residual.max() <= 1e-10
+    length = reach(scene, x0[0])
+    residual = held.constraint_residual
+    assert_close(residual, np.zeros_like(residual), rel=1e-10, scale=length)
     assert drifting.constraint_residual.max() > 10 * held.constraint_residual.max()
-    assert held.relative_drift <= 1e-8 and not held.drift_flagged  # reactions do no work
+    # reactions do no work: a relative drift, whose own scale is 1
+    assert_close(held.relative_drift, 0.0, rel=1e-8, scale=1.0)
+    assert not held.drift_flagged
     speed = held.qd[:, 0]
     assert speed[0] == 10.0 and speed.min() > 5.0  # gravity normal to the plane: it runs on
     turns = (held.q[-1, 0] - held.q[0, 0]) / (2 * np.pi)
@@ -291,8 +324,9 @@ def test_textbook_backend_follows_pinocchio(crank_slider_start):
     kw = dict(method="DOP853", rtol=1e-10, atol=1e-12, t_eval=np.linspace(0.0, 0.2, 5))
     tb = simulate(scene, (0.0, 0.2), x0, backend="textbook", **kw)
     pin_ = simulate(scene, (0.0, 0.2), x0, backend="pinocchio", **kw)
-    np.testing.assert_allclose(tb.q, pin_.q, atol=1e-8)
-    assert tb.constraint_residual.max() <= 1e-10
+    assert_close(tb.q, pin_.q, rel=1e-8)
+    residual = tb.constraint_residual
+    assert_close(residual, np.zeros_like(residual), rel=1e-10, scale=reach(scene, x0[0]))
 
 
 def test_open_start_is_refused_and_rest_is_assembled():
@@ -301,9 +335,13 @@ def test_open_start_is_refused_and_rest_is_assembled():
         simulate(scene, (0.0, 0.1), (np.zeros(3), np.zeros(3)))
     with pytest.raises(Rt70Error, match="did not close"):  # q = 0: all links on one line
         simulate(scene, (0.0, 0.1))
-    result = simulate(load_scene("crank_slider"), (0.0, 0.1), method="DOP853", rtol=1e-8)
-    np.testing.assert_allclose(result.q[0], [0.0, 0.0, 0.5], atol=1e-15)  # slider moved
-    assert np.abs(result.constraint_residual).max() <= 1e-8
+    crank_slider = load_scene("crank_slider")
+    result = simulate(crank_slider, (0.0, 0.1), method="DOP853", rtol=1e-8)
+    assert_close(result.q[0], [0.0, 0.0, 0.5], rel=MIN_REL)  # slider moved
+    residual = result.constraint_residual
+    assert_close(
+        residual, np.zeros_like(residual), rel=1e-8, scale=reach(crank_slider, result.q[0])
+    )
 
 
 def test_scenes_without_loops_report_no_residual():
@@ -331,8 +369,10 @@ def test_kkt_matrix_is_indefinite_and_plain_cg_breaks_down(crank_slider_start):
     x, info = scipy.sparse.linalg.cg(K, rhs, maxiter=50, rtol=1e-12)
     assert info != 0 and np.linalg.norm(K @ x - rhs) > 1e6 * np.linalg.norm(rhs)
     sol = solve_kkt(A, B, f, g)  # the range-space method
-    assert np.linalg.norm(A @ sol.x - f - B.T @ sol.lam) <= 1e-12 * np.linalg.norm(f)
-    assert np.linalg.norm(B @ sol.x - g) <= 1e-12 * np.linalg.norm(g)
+    # the equations on the scale of their terms
+    terms = np.abs(A) @ np.abs(sol.x) + np.abs(B.T) @ np.abs(sol.lam)
+    assert_close(A @ sol.x - B.T @ sol.lam, f, rel=1e-12, scale=terms)
+    assert_close(B @ sol.x, g, rel=1e-12, scale=np.abs(B) @ np.abs(sol.x))
 
 
 def test_modes_of_the_crank_slider_on_its_table_is_one_rigid_mode(capsys):
@@ -366,6 +406,7 @@ def test_rt70_modes_of_the_four_bar_match_its_simulated_small_oscillation():
         q_start=start_state(scene)[0],
         descend=True,
     )
+    # the command runs this very computation: bit for bit
     assert constrained_modes(model)["modes"][0]["freq_hz"] == f_cli
     qe = model.equilibrium.q
     assert np.linalg.eigvalsh(model.reduced.K_r).min() > 0  # the stable equilibrium
@@ -377,4 +418,4 @@ def test_rt70_modes_of_the_four_bar_match_its_simulated_small_oscillation():
     crossings = t[up] - x[up] * (t[up + 1] - t[up]) / (x[up + 1] - x[up])
     assert len(crossings) >= 2
     f_sim = (len(crossings) - 1) / (crossings[-1] - crossings[0])
-    assert abs(f_sim / f_cli - 1) < 1e-7
+    assert_close(f_sim, f_cli, rel=1e-7)

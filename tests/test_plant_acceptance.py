@@ -14,6 +14,7 @@ from rt70.linear.responses import frequency_response
 from rt70.scene import load_scene
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
 from rt70.simulate import simulate
+from rt70.testing import assert_close
 
 F0 = 0.75  # Hz: between the 0.47 Hz and 1.03 Hz modes, on neither
 RAMP = 3.0  # s: the sinusoid's raised-cosine ramp-in (few transients)
@@ -85,9 +86,11 @@ def test_python_control_model_matches_the_nonlinear_small_signal_response(servo,
     keep = t >= FIT_FROM
     measured, residual = _fit(t[keep], run.q[keep, iaz] - q0[iaz], w)
     G_nl = measured / amplitude
-    assert residual <= 5e-3 * abs(amplitude * G)  # the transients have decayed
-    assert abs(abs(G_nl) / abs(G) - 1.0) <= 1e-3
-    assert abs(np.degrees(np.angle(G_nl / G))) <= 0.05
+    # the transients have decayed: the fit's residual on the response amplitude
+    assert_close(residual, 0.0, rel=5e-3, scale=abs(amplitude * G))
+    assert_close(abs(G_nl), abs(G), rel=1e-3)
+    # the phase on the scale of 1 rad: 0.05°, the same relative error of G
+    assert_close(np.angle(G_nl / G), 0.0, rel=np.radians(0.05), scale=1.0)
 
 
 def test_transfer_function_conversion_loses_the_rt70_plant(servo):
@@ -106,7 +109,8 @@ def test_transfer_function_conversion_loses_the_rt70_plant(servo):
     f = 1.0
     H = frequency_response(ss, np.array([f])).H[0]
     H_ctl = np.asarray(pl.to_control(ss)(2j * np.pi * f))
-    assert np.allclose(H_ctl, H, rtol=1e-8, atol=0)
+    error = np.abs(H_ctl - H)  # complex: the modulus of the difference, on each |H|
+    assert_close(error, np.zeros(error.shape), rel=1e-8, scale=np.abs(H))
     for i in range(2):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # ss2tf's badly conditioned polynomials

@@ -27,6 +27,7 @@ from rt70.reports.stress.edits import free_floating_text
 from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.synthetic import serial_chain
 from rt70.simulate import simulate
+from rt70.testing import MIN_REL, assert_close, close
 from rt70.textbook import points as tb_points
 from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure
 from rt70.urdf import read_urdf_string
@@ -77,34 +78,29 @@ def _moving_links(scene) -> list[str]:
     return [name for name, (body, _, _) in scene.textbook.link_frames.items() if body >= 0]
 
 
-def _rel(a: np.ndarray, b: np.ndarray) -> float:
-    scale = float(np.max(np.abs(b)))
-    return float(np.max(np.abs(a - b))) / scale if scale else float(np.max(np.abs(a)))
-
-
 def test_sides_agree_on_positions_jacobians_and_loads(scene):
     (tm, td), (rm, rd) = _sides(scene)
     rng = np.random.default_rng(3)
-    worst = {"position": 0.0, "Jv": 0.0, "Jw": 0.0, "load": 0.0}
     for _ in range(3):
         q = rng.uniform(-0.5, 0.5, tm.nv)
         links = list(tm.link_frames)
         located = [(link, rng.uniform(-1.0, 1.0, 3)) for link in links]
         p_tb = tb_points.point_positions(tm, td, q, located)
         p_ref = ref_points.point_positions(rm, rd, q, located)
-        size = max(float(np.max(np.linalg.norm(p_ref, axis=1))), 1.0)
-        worst["position"] = max(worst["position"], float(np.max(np.abs(p_tb - p_ref))) / size)
+        # positions are sums of the bodies' offsets: the largest distance from the origin
+        reach = float(np.max(np.linalg.norm(p_ref, axis=1)))
+        assert_close(p_tb, p_ref, rel=TOL, scale=reach, what="position")
         for link, xyz in located:
             Jv_tb, Jw_tb = tb_points.point_jacobian(tm, td, q, link, xyz)
             Jv_ref, Jw_ref = ref_points.point_jacobian(rm, rd, q, link, xyz)
             assert Jv_tb.shape == Jv_ref.shape == Jw_ref.shape == (3, tm.nv)
-            worst["Jv"] = max(worst["Jv"], _rel(Jv_tb, Jv_ref))
-            worst["Jw"] = max(worst["Jw"], _rel(Jw_tb, Jw_ref))
+            # a link on the ground has no Jacobian and no load: both sides exactly 0
+            assert_close(Jv_tb, Jv_ref, rel=TOL, what=f"Jv {link}")
+            assert_close(Jw_tb, Jw_ref, rel=TOL, what=f"Jw {link}")
             wrench = Wrench(link, xyz, *rng.uniform(-1.0, 1.0, (2, 3)))
             Q_tb = tb_points.generalized_force(tm, td, q, wrench)
             Q_ref = ref_points.generalized_force(rm, rd, q, wrench)
-            worst["load"] = max(worst["load"], _rel(Q_tb, Q_ref))
-    assert all(v <= TOL for v in worst.values()), worst
+            assert_close(Q_tb, Q_ref, rel=TOL, what=f"load {link}")
 
 
 def test_point_position_is_one_of_point_positions(scene):
@@ -115,6 +111,7 @@ def test_point_position_is_one_of_point_positions(scene):
         module = tb_points if side == "tb" else ref_points
         one = module.point_position(m, d, q, link, [0.1, 0.2, 0.3])
         both = module.point_positions(m, d, q, [(link, [0, 0, 0]), (link, [0.1, 0.2, 0.3])])
+        # point_position is point_positions of one point, a loop over points: bit for bit
         assert np.array_equal(one, both[1]) and both.shape == (2, 3)
 
 
@@ -146,15 +143,16 @@ def test_jacobian_is_the_derivative_of_the_position(scene, side):
         xyz = rng.uniform(-1.0, 1.0, 3)
         Jv, Jw = module.point_jacobian(model, data, q, link, xyz)
         fd = _fd_position(module, model, data, q, link, xyz)
-        scale = max(float(np.max(np.abs(Jv))), 1.0)
-        assert np.max(np.abs(Jv - fd)) <= 1e-7 * scale, link
+        # the central difference rounds by ε |p| / h: the scale is |J_v| or the point's |p|
+        p = module.point_position(model, data, q, link, xyz)
+        scale = max(float(np.max(np.abs(Jv))), float(np.linalg.norm(p)))
+        assert_close(Jv, fd, rel=1e-7, scale=scale, what=link)
         for axis in np.eye(3):
             Jv_b, Jw_b = module.point_jacobian(model, data, q, link, xyz + axis)
-            r = module.point_position(model, data, q, link, xyz + axis) - module.point_position(
-                model, data, q, link, xyz
-            )
-            assert np.allclose(Jv_b - Jv, np.cross(Jw.T, r).T, rtol=0, atol=1e-12 * scale)
-            assert np.array_equal(Jw_b, Jw)  # ω is the link's, wherever the point
+            r = module.point_position(model, data, q, link, xyz + axis) - p
+            assert_close(Jv_b - Jv, np.cross(Jw.T, r).T, rel=1e-12, scale=scale, what=link)
+            # ω is the link's, wherever the point: its rows never involve the point
+            assert np.array_equal(Jw_b, Jw)
 
 
 @pytest.mark.parametrize("side", ["textbook", "reference"])
@@ -178,9 +176,13 @@ def test_load_does_the_virtual_work_of_its_wrench(scene, side):
         # rigid body: d(p_k − p_0) = ω × r_k with r_k orthonormal, so ω = ½ Σ r_k × d_k
         r = here[1:] - here[0]
         omega = 0.5 * np.sum(np.cross(r, dp[1:] - dp[0]), axis=0)
-        work = float(np.asarray(wrench.force) @ dp[0] + np.asarray(wrench.torque) @ omega)
-        scale = float(np.abs(Q) @ np.abs(dq)) + 1.0
-        assert abs(Q @ dq - work) <= 1e-7 * scale, (link, Q @ dq, work)
+        force, torque = np.asarray(wrench.force), np.asarray(wrench.torque)
+        work = float(force @ dp[0] + torque @ omega)
+        # on the scale of the work's terms, both sides
+        scale = (
+            np.abs(Q) @ np.abs(dq) + np.abs(force) @ np.abs(dp[0]) + np.abs(torque) @ np.abs(omega)
+        )
+        assert_close(Q @ dq, work, rel=1e-7, scale=scale, what=link)
 
 
 # --- force_input and the linear outputs are unchanged by the seam ------------------------
@@ -210,14 +212,14 @@ def test_force_input_and_outputs_unchanged(rt70):
         xyz = rng.uniform(-2.0, 2.0, 3)
         Jv, Jw = _old_point_jacobian(rt70, q0, link, xyz)
         unit = direction / np.linalg.norm(direction)
-        assert np.array_equal(
-            lin.force_input(lm, rt70, link, direction, xyz=xyz), (Jv.T @ unit)[idx]
-        )
+        # two code paths: unchanged to their rounding
+        force = lin.force_input(lm, rt70, link, direction, xyz=xyz)
+        assert_close(force, (Jv.T @ unit)[idx], rel=MIN_REL)
         torque = lin.force_input(lm, rt70, link, direction, torque=True, xyz=xyz)
-        assert np.array_equal(torque, (Jw.T @ unit)[idx])
-        assert np.array_equal(lin.point_output(lm, rt70, link, xyz), Jv[:, idx])
+        assert_close(torque, (Jw.T @ unit)[idx], rel=MIN_REL)
+        assert_close(lin.point_output(lm, rt70, link, xyz), Jv[:, idx], rel=MIN_REL)
         _, Jw0 = _old_point_jacobian(rt70, q0, link, np.zeros(3))
-        assert np.array_equal(lin.rotation_output(lm, rt70, link), Jw0[:, idx])
+        assert_close(lin.rotation_output(lm, rt70, link), Jw0[:, idx], rel=MIN_REL)
 
 
 # --- bad requests -----------------------------------------------------------------------
@@ -271,16 +273,20 @@ def test_rt70_optical_points_are_outputs(rt70):
     tb = outputs.evaluate(rt70, q, outs, "textbook")
     ref = outputs.evaluate(rt70, q, outs, "reference")
     assert list(tb) == list(OPTICAL)
+    # positions on the scale of their distance from the ground origin (up to 89 m)
+    reach = max(float(np.linalg.norm(ref[name])) for name in OPTICAL)
     for name in OPTICAL:
         assert tb[name].shape == (3,)
-        assert np.max(np.abs(tb[name] - ref[name])) <= TOL * 100.0
-    # focus and vertex are points of one rigid body: 13 − 8 = 5 m apart, 1.2 − 0.8 = 0.4 m
-    assert np.linalg.norm(tb["main_mirror_focus"] - tb["main_mirror_vertex"]) == pytest.approx(5.0)
+        assert_close(tb[name], ref[name], rel=TOL, scale=reach, what=name)
+    # focus and vertex are points of one rigid body: 13 − 8 = 5 m apart, 1.2 − 0.8 = 0.4 m;
+    # differences of positions, so on the positions' scale
+    span = np.linalg.norm(tb["main_mirror_focus"] - tb["main_mirror_vertex"])
+    assert_close(span, 5.0, rel=TOL, scale=reach)
     gap = np.linalg.norm(ref["counterreflector_focus"] - ref["counterreflector_vertex"])
-    assert gap == pytest.approx(0.4)
+    assert_close(gap, 0.4, rel=TOL, scale=reach)
     # at q = 0 the foci sit above the ground origin at the file's heights
     rest = outputs.evaluate(rt70, np.zeros(rt70.textbook.nv), outs)
-    assert np.allclose(rest["main_mirror_focus"], [0.0, 0.0, 89.0], atol=1e-12)
+    assert_close(rest["main_mirror_focus"], [0.0, 0.0, 89.0], rel=1e-14)
 
 
 def test_an_output_is_a_formula_of_points(rt70):
@@ -294,10 +300,10 @@ def test_an_output_is_a_formula_of_points(rt70):
     axis = outputs.Output("main_mirror_axis", "1", 3, focus.points + vertex.points, direction)
     q = np.random.default_rng(4).uniform(-0.05, 0.05, rt70.textbook.nv)
     values = outputs.evaluate(rt70, q, [focus, axis, vertex], "reference")
-    assert np.linalg.norm(values["main_mirror_axis"]) == pytest.approx(1.0)
-    assert np.allclose(
-        values["main_mirror_axis"] * 5.0, values["main_mirror_focus"] - values["main_mirror_vertex"]
-    )
+    assert_close(np.linalg.norm(values["main_mirror_axis"]), 1.0, rel=1e-14)
+    reach = float(np.linalg.norm(values["main_mirror_focus"]))  # the points' scale
+    span = values["main_mirror_focus"] - values["main_mirror_vertex"]
+    assert_close(values["main_mirror_axis"] * 5.0, span, rel=TOL, scale=reach)
     assert outputs.column_labels("a", 3) == ["a:x", "a:y", "a:z"]
     assert outputs.column_labels("b", 2) == ["b:0", "b:1"]
 
@@ -326,8 +332,8 @@ def test_simulation_carries_outputs(tmp_path, backend):
     assert result.outputs["tip"].shape == (6, 3)
     side = "reference" if backend == "pinocchio" else "textbook"
     expected = outputs.evaluate_trajectory(scene, result.q, [tip], side)["tip"]
-    assert np.array_equal(result.outputs["tip"], expected)
-    assert not np.allclose(result.outputs["tip"][0], result.outputs["tip"][-1])  # it moved
+    assert np.array_equal(result.outputs["tip"], expected)  # the same function: bit for bit
+    assert not close(result.outputs["tip"][0], result.outputs["tip"][-1], rel=1e-5)  # it moved
     with np.load(result.save(tmp_path / "run.npz")) as saved:
         assert np.array_equal(saved["output:tip"], result.outputs["tip"])
     text = result.save(tmp_path / "run.csv").read_text(encoding="utf-8").splitlines()
@@ -361,10 +367,9 @@ def test_root_link_not_named_world():
     (tm, td), (rm, rd) = _sides(scene)
     q = np.array([0.4])
     for module, m, d in ((tb_points, tm, td), (ref_points, rm, rd)):
-        assert np.allclose(module.point_position(m, d, q, "base", [1, 2, 3]), [1, 2, 3])
+        assert_close(module.point_position(m, d, q, "base", [1, 2, 3]), [1, 2, 3], rel=MIN_REL)
         Jv, Jw = module.point_jacobian(m, d, q, "base", [1, 2, 3])
-        assert not Jv.any() and not Jw.any()
+        assert not Jv.any() and not Jw.any()  # the ground: no Jacobian at all
         Jv, Jw = module.point_jacobian(m, d, q, "arm", [1, 0, 0])
-        assert np.allclose(Jw[:, 0], [0, 0, 1]) and np.allclose(
-            Jv[:, 0], [-np.sin(0.4), np.cos(0.4), 0]
-        )
+        assert_close(Jw[:, 0], [0, 0, 1], rel=MIN_REL)
+        assert_close(Jv[:, 0], [-np.sin(0.4), np.cos(0.4), 0], rel=1e-14)
