@@ -1,6 +1,7 @@
 """Impacts (companion source 004 (15)): rt70.impact, rt70.locks, both sides, the audit."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ from rt70.simulate import simulate
 from rt70.testing import EPS, assert_close
 from rt70.textbook import dynamics, points
 from rt70.validate import random_state
+
+ALL_JOINT_TYPES = Path(__file__).parent / "data" / "all_joint_types.urdf"
 
 #: An impact solves with a well-conditioned (6 × 6, A ≥ 6·1) mass matrix: its results
 #: hold to this relative error of their terms, two orders above their rounding.
@@ -147,7 +150,7 @@ def test_textbook_impact_equals_pinocchio_impulse_dynamics(name):
 
 def test_general_joints_mimic_and_known_impulses_agree():
     """Continuous, floating, planar and mimic joints (Pinocchio's v ≠ q̇), with Γ ≠ 0."""
-    scene = load_scene("tests/data/all_joint_types.urdf")
+    scene = load_scene(ALL_JOINT_TYPES)
     rng = np.random.default_rng(5)
     for _ in range(5):
         q, qd = random_state(scene.textbook.nv, rng)
@@ -171,7 +174,7 @@ def test_bad_locks_are_refused_naming_the_file():
         check_locks(scene, [StowPin("world")])
     with pytest.raises(Rt70Error, match="no lock"):
         check_locks(scene, [])
-    fixed = load_scene("tests/data/all_joint_types.urdf")
+    fixed = load_scene(ALL_JOINT_TYPES)
     with pytest.raises(Rt70Error, match="'fx': it is fixed"):
         check_locks(fixed, [Brake("fx")])
     with pytest.raises(Rt70Error, match="it is floating"):
