@@ -21,7 +21,9 @@ so ``rejected = (nfev − 2)/s − steps``. Other methods: not counted ("—").
 **Time cap.** Each simulation is given :data:`TIME_CAP_S` seconds of wall time: the
 same hook raises when the cap is passed, the run is reported as ``over cap`` with the
 time it reached, and the report goes on. One right-hand-side evaluation is the
-granularity, so no run can hang the report.
+granularity, so no run can hang the report. The cap is a benchmark's: where a run stops
+depends on the machine, so tests give :func:`run_capped` a clock that counts evaluations
+(or a cap of ``math.inf``) and their verdicts do not.
 """
 
 from __future__ import annotations
