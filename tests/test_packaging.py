@@ -31,7 +31,12 @@ def test_every_package_is_listed_in_pyproject():
     assert config["tool"]["setuptools"]["package-dir"]["rt70.scene_files"] == "urdf"
 
 
-def _run(cmd: list[str], cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess:
+#: A guard against a hang only: the slowest command, the wheel's install into a fresh
+#: venv, took 96 s on a loaded 2-core machine (load average 5).
+HANG_GUARD_S = 1800.0
+
+
+def _run(cmd: list[str], cwd: Path, timeout: float = HANG_GUARD_S) -> subprocess.CompletedProcess:
     proc = subprocess.run(
         cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, check=False
     )

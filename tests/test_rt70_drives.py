@@ -15,6 +15,7 @@ from scipy.linalg import eigh
 from rt70.errors import Rt70Error
 from rt70.scenes import rt70_data as data
 from rt70.scenes import rt70_drives as drv
+from rt70.testing import MIN_REL, close
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "drives.md"
 AXES = {"az": drv.AZIMUTH_DRIVE, "el": drv.ELEVATION_DRIVE}
@@ -38,43 +39,45 @@ def _table() -> dict[str, dict]:
 
 TABLE = _table()
 
-#: key suffix → (value of a drive, relative tolerance). Stored fields are compared
-#: exactly (to float parsing); computed properties to the table's 6 printed digits.
-EXACT, PRINTED = 1e-15, 1e-5
+#: key suffix → (value of a drive, relative tolerance). Stored fields are compared to
+#: rounding (float parsing of the page's number); computed properties to the table's 6
+#: printed digits.
+ROUNDING, PRINTED = MIN_REL, 1e-5
 FIELDS = {
-    "nominal_torque": (lambda d: d.nominal_torque, EXACT),
-    "wind_torque": (lambda d: d.wind_torque, EXACT),
-    "friction.static_torque": (lambda d: d.friction.static_torque, EXACT),
-    "friction.top_speed_torque": (lambda d: d.friction.top_speed_torque, EXACT),
+    "nominal_torque": (lambda d: d.nominal_torque, ROUNDING),
+    "wind_torque": (lambda d: d.wind_torque, ROUNDING),
+    "friction.static_torque": (lambda d: d.friction.static_torque, ROUNDING),
+    "friction.top_speed_torque": (lambda d: d.friction.top_speed_torque, ROUNDING),
     "friction.slope": (lambda d: d.friction.slope, PRINTED),
-    "reducer.ratio": (lambda d: d.reducer.ratio, EXACT),
-    "reducer.stiffness": (lambda d: d.reducer.stiffness, EXACT),
-    "reducer.damping": (lambda d: d.reducer.damping, EXACT),
-    "motors_per_axis": (lambda d: d.motors_per_axis, EXACT),
-    "trains.count": (lambda d: d.trains.count, EXACT),
-    "trains.backlash": (lambda d: d.trains.backlash_half_width, EXACT),
-    "trains.bias_torque": (lambda d: d.trains.bias_torque, EXACT),
-    "axis.top_speed": (lambda d: d.friction.top_speed, EXACT),
+    "reducer.ratio": (lambda d: d.reducer.ratio, ROUNDING),
+    "reducer.stiffness": (lambda d: d.reducer.stiffness, ROUNDING),
+    "reducer.damping": (lambda d: d.reducer.damping, ROUNDING),
+    "motors_per_axis": (lambda d: d.motors_per_axis, ROUNDING),
+    "trains.count": (lambda d: d.trains.count, ROUNDING),
+    "trains.backlash": (lambda d: d.trains.backlash_half_width, ROUNDING),
+    "trains.bias_torque": (lambda d: d.trains.bias_torque, ROUNDING),
+    "axis.top_speed": (lambda d: d.friction.top_speed, ROUNDING),
     "reflected_inertia": (lambda d: d.reflected_motor_inertia, PRINTED),
-    "reference_inertia": (lambda d: d.reference_inertia, EXACT),
-    "clamped": (lambda d: d.clamped_hz, EXACT),
-    "locked_rotor": (lambda d: d.locked_rotor_hz, EXACT),
-    "sector_radius": (lambda d: d.sector_radius, EXACT),
-    "servo.position_bandwidth": (lambda d: d.servo.position_bandwidth_hz, EXACT),
-    "servo.rate_bandwidth": (lambda d: d.servo.rate_bandwidth_hz, EXACT),
-    "servo.current_bandwidth": (lambda d: d.servo.current_bandwidth_hz, EXACT),
-    "servo.rate_limit": (lambda d: d.servo.rate_limit, EXACT),
-    "servo.acceleration_limit": (lambda d: d.servo.acceleration_limit, EXACT),
+    "reference_inertia": (lambda d: d.reference_inertia, ROUNDING),
+    "clamped": (lambda d: d.clamped_hz, ROUNDING),
+    "locked_rotor": (lambda d: d.locked_rotor_hz, ROUNDING),
+    "sector_radius": (lambda d: d.sector_radius, ROUNDING),
+    "servo.position_bandwidth": (lambda d: d.servo.position_bandwidth_hz, ROUNDING),
+    "servo.rate_bandwidth": (lambda d: d.servo.rate_bandwidth_hz, ROUNDING),
+    "servo.current_bandwidth": (lambda d: d.servo.current_bandwidth_hz, ROUNDING),
+    "servo.rate_limit": (lambda d: d.servo.rate_limit, ROUNDING),
+    "servo.acceleration_limit": (lambda d: d.servo.acceleration_limit, ROUNDING),
 }
 FIELDS |= {
-    f"motor.{f.name}": ((lambda d, n=f.name: getattr(d.motor, n)), EXACT)
+    f"motor.{f.name}": ((lambda d, n=f.name: getattr(d.motor, n)), ROUNDING)
     for f in dataclasses.fields(drv.DcMotor)
 }
 CONSTANTS = {"*.kgf_m": drv.KGF_M, "*.arcsec": drv.ARCSEC}
 
 
 def _close(a: float, b: float, rel: float) -> bool:
-    return math.isclose(a, b, rel_tol=rel, abs_tol=0.0)
+    """``a`` is ``b`` to ``rel`` of ``|b|`` (:func:`rt70.testing.close`)."""
+    return close(a, b, rel=rel)
 
 
 # --- the page and the module agree ----------------------------------------------------
@@ -93,7 +96,7 @@ def test_table_rows_are_well_formed():
 def test_module_holds_the_table_value(key):
     si = TABLE[key]["si"]
     if key in CONSTANTS:
-        assert _close(CONSTANTS[key], si, EXACT)
+        assert _close(CONSTANTS[key], si, ROUNDING)
         return
     scope, suffix = key.split(".", 1)
     if si is None:  # a prose row: where the drive acts
@@ -178,7 +181,7 @@ def test_reference_inertias_from_the_listing():
         b["offset"][:2] == (0.0, 0.0) and b["com"] == (0.0, 0.0, 0.0) for b in bodies.values()
     )
     assert all(on_axis)
-    assert _close(drv.AZIMUTH_DRIVE.reference_inertia, j_az, EXACT)
+    assert _close(drv.AZIMUTH_DRIVE.reference_inertia, j_az, ROUNDING)
 
     def height_over_base(name: str) -> float:
         z = 0.0
@@ -191,8 +194,8 @@ def test_reference_inertias_from_the_listing():
     j_el = sum(
         bodies[n]["moments"][0] + bodies[n]["mass"] * height_over_base(n) ** 2 for n in swinging
     )
-    assert _close(drv.ELEVATION_DRIVE.reference_inertia, j_el, EXACT)
-    assert height_over_base("counterweight") == drv.ELEVATION_DRIVE.sector_radius
+    assert _close(drv.ELEVATION_DRIVE.reference_inertia, j_el, ROUNDING)
+    assert _close(height_over_base("counterweight"), drv.ELEVATION_DRIVE.sector_radius, ROUNDING)
 
 
 def _chapter2(axis: str) -> tuple[np.ndarray, np.ndarray, float]:
@@ -230,9 +233,9 @@ def test_reducer_from_the_locked_rotor_target(axis):
     print(f"{axis}: clamped {clamped:.6g} Hz, locked rotor {locked:.6g} Hz")
     assert _close(d.clamped_hz, clamped, PRINTED)
     assert _close(d.locked_rotor_hz, locked, PRINTED)
-    assert locked / clamped == pytest.approx(0.95, abs=2e-4)  # C_r rounded to 4 digits
+    assert _close(locked / clamped, 0.95, 2e-4)  # C_r rounded to 4 digits
     # rounding C_r is what moves the ratio off 0.95: a 1 % stiffer reducer moves it more
-    assert abs(_locked_rotor_hz(axis, 1.01 * d.reducer.stiffness) / clamped - 0.95) > 2e-4
+    assert not _close(_locked_rotor_hz(axis, 1.01 * d.reducer.stiffness) / clamped, 0.95, 2e-4)
     # D_r from the §2.3 hypothesis δ = 0.1/Ω₁ at the locked-rotor frequency
     assert _close(d.reducer.damping, 0.1 * d.reducer.stiffness / (2 * np.pi * locked), PRINTED)
 
@@ -243,7 +246,7 @@ def test_locked_rotor_is_below_the_first_free_elastic_frequency(axis):
     _, _, first_free = _chapter2(axis)
     assert AXES[axis].clamped_hz < first_free
     if axis == "az":
-        assert first_free == pytest.approx(1.265, abs=1e-3)  # rt70-data.md §A
+        assert _close(first_free, 1.265, 8e-4)  # rt70-data.md §A: ±1 in the last digit
         assert AXES[axis].locked_rotor_hz < AXES[axis].servo.position_bandwidth_hz
 
 
@@ -255,8 +258,8 @@ def test_acceleration_limit(axis):
     expected = available / (d.reference_inertia + d.reflected_motor_inertia)
     assert _close(d.servo.acceleration_limit, expected, PRINTED)
     assert d.servo.rate_limit == d.friction.top_speed
-    assert d.servo.rate_bandwidth_hz == 5 * d.servo.position_bandwidth_hz
-    assert d.servo.current_bandwidth_hz == 5 * d.servo.rate_bandwidth_hz
+    assert _close(d.servo.rate_bandwidth_hz, 5 * d.servo.position_bandwidth_hz, ROUNDING)
+    assert _close(d.servo.current_bandwidth_hz, 5 * d.servo.rate_bandwidth_hz, ROUNDING)
     assert d.servo.current_bandwidth_hz > 1 / (2 * np.pi * d.motor.electrical_time_constant)
 
 
@@ -267,10 +270,11 @@ def test_gravity_unbalance_of_the_listing():
     arms["counterreflector"] = 44.0
     moment = sum(bodies[n]["mass"] * arm for n, arm in arms.items())
     torque = 9.81 * moment
-    assert torque == pytest.approx(1.30e8, rel=5e-3)
-    assert torque / drv.ELEVATION_DRIVE.nominal_torque == pytest.approx(2.66, abs=0.01)
+    # the page's numbers, to ±1 in their last printed digit
+    assert _close(torque, 1.30e8, 5e-3)
+    assert _close(torque / drv.ELEVATION_DRIVE.nominal_torque, 2.66, 4e-3)
     mirrored = 9.81 * abs(moment - 2 * bodies["counterweight"]["mass"] * 16.0)
-    assert mirrored == pytest.approx(2.03e7, rel=5e-3)
+    assert _close(mirrored, 2.03e7, 5e-3)
 
 
 # --- the dataclasses ------------------------------------------------------------------
@@ -301,9 +305,10 @@ def test_ratio_choice_numbers_of_the_page():
     """docs/drives.md §2: why 10⁵, and how much the rotors dominate the axis inertia."""
     m = drv.MOTOR
     slow = m.rated_speed / 1e6  # the book's upper ratio
-    assert math.degrees(slow) == pytest.approx(0.018, rel=PRINTED)
-    assert math.pi / slow / 3600 == pytest.approx(2.78, abs=0.01)  # hours for 180°
+    # the page's numbers, to ±1 in their last printed digit
+    assert _close(math.degrees(slow), 0.018, PRINTED)
+    assert _close(math.pi / slow / 3600, 2.78, 4e-3)  # hours for 180°
     refl = drv.AZIMUTH_DRIVE.reflected_motor_inertia
-    assert refl / drv.AZIMUTH_DRIVE.reference_inertia == pytest.approx(178.0, abs=0.1)
-    assert refl / drv.ELEVATION_DRIVE.reference_inertia == pytest.approx(24.9, abs=0.1)
-    assert m.rated_torque * m.rated_speed == pytest.approx(77.0e3, abs=50.0)
+    assert _close(refl / drv.AZIMUTH_DRIVE.reference_inertia, 178.0, 6e-4)
+    assert _close(refl / drv.ELEVATION_DRIVE.reference_inertia, 24.9, 4e-3)
+    assert _close(m.rated_torque * m.rated_speed, 77.0e3, 7e-4)

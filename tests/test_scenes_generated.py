@@ -13,6 +13,7 @@ from rt70.scenes import mechanisms, rt70_data
 from rt70.scenes.generate import SCENES, write_all
 from rt70.scenes.pairs import pair_joint_names
 from rt70.scenes.urdf_writer import RT70_NS
+from rt70.testing import assert_close
 
 URDF_DIR = Path(__file__).resolve().parents[1] / "urdf"
 NS = {"rt70": RT70_NS}
@@ -151,9 +152,10 @@ def test_double_pendulum_reference_values():
     a = np.triu(a) + np.triu(a, 1).T
     g = pin.computeGeneralizedGravity(model, data, q)
     b = pin.nonLinearEffects(model, data, q, v) - g
-    np.testing.assert_allclose(a, ref["A"], rtol=0, atol=1e-7)
-    np.testing.assert_allclose(b, ref["B"], rtol=0, atol=1e-7)
-    np.testing.assert_allclose(g, ref["G"], rtol=0, atol=1e-7)
+    # the reference's 8 printed significant digits (18.865003: ±5e-7 of 18.9, 2.7e-8)
+    assert_close(a, ref["A"], rel=3e-8, what="A")
+    assert_close(b, ref["B"], rel=3e-8, what="B q̇")
+    assert_close(g, ref["G"], rel=3e-8, what="G")
 
 
 def _torsional_spectrum_hz(name: str) -> np.ndarray:
@@ -178,7 +180,8 @@ def _torsional_spectrum_hz(name: str) -> np.ndarray:
 
 def test_elevation_scene_reproduces_printed_spectrum():
     hz = _torsional_spectrum_hz("rt70_elevation")
-    np.testing.assert_allclose(hz, rt70_data.ELEVATION_SPECTRUM_HZ, rtol=0, atol=1e-3)
+    # printed to 4 decimals: ±1 in the last of them, on the spectrum's size (19.6 Hz)
+    assert_close(hz, rt70_data.ELEVATION_SPECTRUM_HZ, rel=5e-6)
 
 
 def test_write_all_writes_every_scene(tmp_path):

@@ -19,6 +19,7 @@ from rt70.errors import Rt70Error
 from rt70.scene import load_scene, scene_from_text
 from rt70.servo import ServoDrive, cascade_gains
 from rt70.states import MechanicsForces
+from rt70.testing import assert_close
 
 
 @pytest.fixture(scope="module")
@@ -36,11 +37,14 @@ def test_hold_has_no_start_up_transient(servo_scene):
     """
     run = S.run_scenario(servo_scene, S.scenario("hold", 30.0, 0.0, 1.0))
     m = run.metrics
-    assert m["pointing_drift_arcsec"] < run.result.atol / S.ARCSEC
+    # within the solver's absolute tolerance on angles, in arc seconds
+    assert_close(m["pointing_drift_arcsec"], 0.0, rel=1.0, scale=run.result.atol / S.ARCSEC)
     hold = m["holding_torque_elevation_Nm"]
     assert 1.0e7 < hold < S.ELEVATION_DRIVE.nominal_torque  # gravity torque, within the drive
-    assert np.abs(run.axis_torque["elevation"] / hold - 1.0).max() < 1e-6
-    assert run.result.relative_drift < run.result.rtol  # the audit balances (measured 1.0e-8)
+    torque = run.axis_torque["elevation"]
+    assert_close(torque, np.full_like(torque, hold), rel=1e-6)
+    # the audit balances (measured 1.0e-8): a relative drift, scale 1
+    assert_close(run.result.relative_drift, 0.0, rel=run.result.rtol, scale=1.0)
 
 
 def test_small_elevation_step_settles_as_derived(servo_scene):
@@ -61,10 +65,12 @@ def test_small_elevation_step_settles_as_derived(servo_scene):
     predicted = S.predicted_settling(
         step, S.axis_gains(S.ELEVATION_DRIVE, *S.AXIS_TUNING["elevation"])
     )
-    assert m["predicted_settle_s"] == pytest.approx(predicted)
-    assert m["axis_settle_s"] == pytest.approx(predicted, rel=0.1)
-    assert m["final_pointing_arcsec"] < 0.1
-    assert abs(run.axis_error["azimuth"]).max() < 0.01  # the other axis holds
+    assert_close(m["predicted_settle_s"], predicted, rel=1e-12)  # the step is 20/3600·3600
+    assert_close(m["axis_settle_s"], predicted, rel=0.1)
+    # on the step's size: settled, and the other axis holds
+    assert_close(m["final_pointing_arcsec"], 0.0, rel=5e-3, scale=step)
+    azimuth = run.axis_error["azimuth"]
+    assert_close(azimuth, np.zeros_like(azimuth), rel=5e-4, scale=step)
 
 
 def test_tracking_error_is_bounded(servo_scene):
@@ -81,15 +87,15 @@ def test_tracking_error_is_bounded(servo_scene):
     # the pointing error is the encoder error seen on the sky (cross-elevation: × cos E),
     # up to the structure's deflection (measured: 4.05″ against 4.02″)
     cross = run.pointing_error[:, 0]
-    assert abs(abs(cross[-1]) - abs(error[-1]) * np.cos(np.radians(45))) < 0.1
+    assert_close(abs(cross[-1]), abs(error[-1]) * np.cos(np.radians(45)), rel=0.025)
 
 
 def test_predicted_settling_slews_at_the_rate_limit():
     """Past the linear range, one more degree of step costs exactly 1°/Ω of slewing."""
     g = S.axis_gains(S.AZIMUTH_DRIVE, *S.AXIS_TUNING["azimuth"])
     t1, t2 = S.predicted_settling(3600.0, g), S.predicted_settling(7200.0, g)
-    assert t2 - t1 == pytest.approx(3600.0 * S.ARCSEC / g.rate_limit, rel=1e-9)
-    assert S.predicted_settling(0.5, g) == 0.0  # already inside the band
+    assert_close(t2 - t1, 3600.0 * S.ARCSEC / g.rate_limit, rel=1e-9)
+    assert S.predicted_settling(0.5, g) == 0.0  # already inside the band: the branch's 0
 
 
 def test_back_calculation_is_the_servo_until_a_loop_clamps():
@@ -101,8 +107,10 @@ def test_back_calculation_is_the_servo_until_a_loop_clamps():
     plain, smooth = ServoDrive(*args), BackCalculationServo(*args)
     q, qd, forces = np.zeros(1), np.zeros(1), MechanicsForces(np.zeros(1), None)
     quiet = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    np.testing.assert_allclose(
-        smooth.derivative(0.0, q, qd, quiet, forces), plain.derivative(0.0, q, qd, quiet, forces)
+    assert_close(
+        smooth.derivative(0.0, q, qd, quiet, forces),
+        plain.derivative(0.0, q, qd, quiet, forces),
+        rel=1e-14,  # the same formulas in two classes: rounding of the largest rate
     )
     clamped = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1e3])  # the current integral drives u > 5 V
     assert smooth.voltage_of(0.0, q, clamped) == 5.0

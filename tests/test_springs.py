@@ -4,8 +4,22 @@ import numpy as np
 import pytest
 
 from rt70.scene import load_scene
+from rt70.testing import assert_close
 from rt70.textbook import forces
+from rt70.textbook.kinematics import frame_pose
 from rt70.textbook.spatial import placement, rpy_matrix
+
+
+def _deformation_scale(td, bm) -> np.ndarray:
+    """The size of the terms of each entry of δ (and row of ∂δ/∂q): for the translation,
+    the two frames' distance from the ground origin (δ is a difference of positions);
+    for the angles, 1 (a rotation's entries)."""
+    size = max(np.linalg.norm(frame_pose(td, b, r, c)[1]) for b, r, c in _frames(bm))
+    return np.r_[np.full(3, size), np.ones(3)]
+
+
+def _frames(bm):
+    return ((bm.body1, bm.r1, bm.c1), (bm.body2, bm.r2, bm.c2))
 
 
 @pytest.fixture(scope="module")
@@ -39,13 +53,14 @@ def test_strut_package_linearises_to_book_matrix(rt70_scene, package, body):
     for bm in tm.bushings:
         if bm.name.startswith(package + "/"):
             d = forces.bushing_deformation(td, bm)
-            assert np.allclose(d.delta, 0.0, atol=1e-15)
+            scale = _deformation_scale(td, bm)
+            assert_close(d.delta, np.zeros(6), rel=1e-14, scale=scale)  # at rest
             J = d.jacobian[:, cols]
             K += J.T @ np.diag(bm.stiffness) @ J
             Dm += J.T @ np.diag(bm.damping) @ J
     for mine, attr in ((K, "stiffness"), (Dm, "damping")):
         book = package_matrix(struts, attr)
-        assert np.allclose(mine, book, rtol=1e-14, atol=1e-14 * np.abs(book).max())
+        assert_close(mine, book, rel=1e-14, what=attr)
     # and the force itself has that slope (central differences, only the package's pair moves)
     h = 1e-7
     slope = np.zeros((6, 6))
@@ -62,7 +77,7 @@ def test_strut_package_linearises_to_book_matrix(rt70_scene, package, body):
             J = d.jacobian[:, cols]
             other += J.T @ np.diag(bm.stiffness) @ J
     book = package_matrix(struts, "stiffness")
-    assert np.allclose(-slope - other, book, rtol=1e-6, atol=1e-6 * np.abs(book).max())
+    assert_close(-slope - other, book, rel=1e-6)
 
 
 @pytest.mark.parametrize("name", ["rt70", "two_body_gravity", "rt70_elevation", "three_masses"])
@@ -81,8 +96,7 @@ def test_spring_force_is_minus_gradient_of_potential(name):
         grad[i] = (
             forces.spring_potential(tm, td, q + e) - forces.spring_potential(tm, td, q - e)
         ) / (2 * h)
-    scale = np.abs(Qc).max()
-    assert np.abs(Qc + grad).max() <= 1e-6 * scale
+    assert_close(-grad, Qc, rel=1e-6)
 
 
 def test_damper_power_is_dissipative():
@@ -109,10 +123,11 @@ def test_direct_pair_bushing_deformation_is_pair_coordinates(rt70_scene):
             continue
         d = forces.bushing_deformation(td, bm)
         j = bm.body2
-        assert np.allclose(d.delta, q[tm.coords(j)], atol=1e-13)
+        scale = _deformation_scale(td, bm)
+        assert_close(d.delta, q[tm.coords(j)], rel=1e-14, scale=scale, what=bm.name)
         expected = np.zeros((6, tm.nv))
         expected[:, tm.coords(j)] = np.eye(6)
-        assert np.allclose(d.jacobian, expected, atol=1e-12)
+        assert_close(d.jacobian, expected, rel=1e-14, scale=scale[:, None], what=bm.name)
 
 
 def test_reference_rpy_formulas_are_pinocchios():
@@ -130,7 +145,9 @@ def test_reference_rpy_formulas_are_pinocchios():
     for k, ((i1, P1), (i2, P2)) in enumerate(zip(ref.frames1, ref.frames2, strict=True)):
         M12 = (d.oMi[i1] * P1).actInv(d.oMi[i2] * P2)
         rho = pin.rpy.matrixToRpy(M12.rotation.T)
-        assert np.allclose(delta[k], np.r_[M12.translation, -rho], atol=1e-12)
+        size = max(np.linalg.norm((d.oMi[i] * P).translation) for i, P in ((i1, P1), (i2, P2)))
+        scale = np.r_[np.full(3, size), np.ones(3)]  # as _deformation_scale, Pinocchio's frames
+        assert_close(delta[k], np.r_[M12.translation, -rho], rel=1e-14, scale=scale)
         J1 = pin.getFrameJacobian(ref.pin_model, d, i1, P1, pin.LOCAL)
         J2 = pin.getFrameJacobian(ref.pin_model, d, i2, P2, pin.LOCAL)
         J_rel = J2 - M12.inverse().toActionMatrix() @ J1
@@ -138,4 +155,4 @@ def test_reference_rpy_formulas_are_pinocchios():
             M12.rotation @ J_rel[:3],
             pin.rpy.computeRpyJacobianInverse(rho, pin.WORLD) @ J_rel[3:],
         ]
-        assert np.allclose(jac[k], expected, atol=1e-9 * np.abs(expected).max())
+        assert_close(jac[k], expected, rel=1e-9)
