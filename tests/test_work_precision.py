@@ -133,6 +133,8 @@ def test_worker_abandons_a_run_over_a_zero_cap():
         assert got.status == "over cap" and got.x is None
         again = worker.run(QUICK_PROBLEMS[1], "DOP853", 1e-3, None, HANG_GUARD_S)
         assert again.status == "ok" and again.x.shape == (QUICK_PROBLEMS[1].t_eval.size, 4)
+        uncapped = worker.run(QUICK_PROBLEMS[1], "DOP853", 1e-3, None, math.inf)
+        assert uncapped.status == "ok" and np.array_equal(uncapped.x, again.x)
     finally:
         worker.close()
 

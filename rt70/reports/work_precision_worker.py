@@ -172,7 +172,7 @@ class Worker:
 
     def _receive(self, timeout: float):
         assert self.conn is not None
-        if not self.conn.poll(timeout):
+        if not self.conn.poll(None if math.isinf(timeout) else timeout):  # inf: no cap
             return None
         try:
             return self.conn.recv()
