@@ -662,7 +662,11 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
-    with options.sigterm_exits(EXIT_TERMINATED), warnings.catch_warnings():
+    with (
+        options.sigterm_exits(EXIT_TERMINATED),
+        options.checked_stdout(),  # '> file' on a full disk: one line, exit 2
+        warnings.catch_warnings(),
+    ):
         warnings.simplefilter("always", Rt70Warning)
         warnings.showwarning = _show_warning
         try:

@@ -17,7 +17,7 @@ import sys
 import tempfile
 import threading
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import NoReturn
 
@@ -190,6 +190,60 @@ def check_writable_directory(directory: Path) -> None:
         ) from None
     os.close(fd)
     os.unlink(name)
+
+
+class _CheckedOutput:
+    """Standard output whose write errors are one :class:`OutputError` (a closed pipe aside).
+
+    ``rt70 ... > file`` on a full disk fails inside ``print``; the error names standard
+    output, and what is still buffered goes to ``os.devnull`` so that the interpreter's
+    last flush at exit does not fail a second time.
+    """
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        with self._errors():
+            return self._stream.write(text)
+
+    def flush(self) -> None:
+        with self._errors():
+            self._stream.flush()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+    @contextmanager
+    def _errors(self) -> Iterator[None]:
+        try:
+            yield
+        except BrokenPipeError:  # the reader went away: the command line's exit 141
+            raise
+        except OSError as exc:
+            with suppress(OSError, ValueError):  # no file descriptor (a StringIO): nothing to do
+                _point_at_devnull(self._stream.fileno())
+            raise OutputError(f"standard output: cannot write ({exc.strerror or exc})") from None
+
+
+def _point_at_devnull(fd: int) -> None:
+    """Make file descriptor ``fd`` write to ``os.devnull``."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, fd)
+    finally:
+        os.close(devnull)
+
+
+@contextmanager
+def checked_stdout() -> Iterator[None]:
+    """Inside the block, a failed write to standard output raises :class:`OutputError`."""
+    stream = sys.stdout
+    sys.stdout = _CheckedOutput(stream)
+    try:
+        yield
+    finally:
+        sys.stdout = stream
 
 
 # --- signals -----------------------------------------------------------------------------
