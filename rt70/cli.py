@@ -188,19 +188,17 @@ def _modes(args: argparse.Namespace) -> int:
 def _loop_modes(args: argparse.Namespace, scene, held: dict) -> tuple:
     """Modes of a closed-chain scene on its manifold (textbook side; docs/constrained-modes.md).
 
-    From the mechanism's closed start, or the zero state closed by
-    :func:`rt70.closed_chains.assemble`; the stable equilibrium (Newton descending where
+    From the mechanism's closed start, or a closed state at rest
+    (:func:`rt70.closed_chains.closed_rest`); the stable equilibrium (Newton descending where
     the stiffness is negative). Returns modes, shapes, model, damped modes, constraints.
     """
-    import numpy as np
-
-    from rt70.closed_chains import assemble
+    from rt70.closed_chains import closed_rest
     from rt70.linear import constrained_scene as cs
     from rt70.scenes.loop_scenes import start_state
     from rt70.textbook import loops
 
     start = start_state(scene)
-    q = start[0] if start is not None else assemble(scene, np.zeros(scene.textbook.nv))[0]
+    q = start[0] if start is not None else closed_rest(scene)[0]
     for name, value in held.items():
         q[scene.textbook.coordinate_names.index(name)] = value
     model = cs.constrained_linearize(
@@ -308,11 +306,12 @@ def _plant(args: argparse.Namespace) -> int:
         from rt70.linear import reduce as rd
 
         full = ss
-        red = (
-            rd.modal_truncation(ss, args.reduce // 2)
-            if method == "modal"
-            else rd.balanced_truncation(ss, args.reduce)
-        )
+        with options.option_at_fault(f"{scene.name}: --reduce {args.reduce}"):
+            red = (
+                rd.modal_truncation(ss, args.reduce // 2)
+                if method == "modal"
+                else rd.balanced_truncation(ss, args.reduce)
+            )
         ss, err = red.ss, rd.hinf_error(full, red.ss)
         info["states"] = list(ss.state_names)
         info["reduced"] = {

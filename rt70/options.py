@@ -21,7 +21,7 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import NoReturn
 
-from rt70.errors import OutputError
+from rt70.errors import OutputError, Rt70Error
 
 #: Range of the RT-70's elevation axis, degrees: horizon to zenith (the book's tables
 #: are given at 0° and 90°; :func:`rt70.scenes.rt70_state.rt70_pointing`).
@@ -129,6 +129,29 @@ def elevation(text: str) -> float:
             f"the RT-70 points from {low:g}° (horizon) to {high:g}° (zenith), got {text}"
         )
     return value
+
+
+# --- values checked where they are used ------------------------------------------------
+@contextmanager
+def option_at_fault(option: str) -> Iterator[None]:
+    """Name the command-line option behind a value the library refuses inside the block.
+
+    Some values can only be judged once the model is built (``plant --reduce`` against
+    the plant's order, ``impact --brake`` against the scene's joints). The library's
+    message knows no options; the command line passes the value in inside this block,
+    and an :class:`~rt70.errors.Rt70Error` comes out as the same class with
+    ``"<option>: "`` in front: ``--reduce 10000: order must be between 3 and 84 …``.
+
+    Parameters
+    ----------
+    option
+        The option and its value as the user wrote them (``"--reduce 10000"``), with the
+        scene in front where the limit is the scene's (``"rt70: --reduce 10000"``).
+    """
+    try:
+        yield
+    except Rt70Error as exc:
+        raise type(exc)(f"{option}: {exc}") from None
 
 
 # --- output paths ------------------------------------------------------------------------

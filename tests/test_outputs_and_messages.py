@@ -337,3 +337,182 @@ def test_standard_output_redirected_to_dev_full():
     assert one_error_line(proc.stderr) == (
         "rt70: error: standard output: cannot write (No space left on device)"
     )
+
+
+# --- 4. messages name the option or file at fault -------------------------------------------
+
+
+def test_option_at_fault_keeps_the_class_and_prefixes_the_option():
+    from rt70.linear.topology import LinearModelError
+    from rt70.options import option_at_fault
+
+    with pytest.raises(LinearModelError) as info, option_at_fault("--reduce 7"):
+        raise LinearModelError("order must be between 1 and 6")
+    assert str(info.value) == "--reduce 7: order must be between 1 and 6"
+    with option_at_fault("--x 1"):  # nothing raised: nothing changes
+        pass
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (
+            ["plant", "three_masses", "--reduce", "10000"],
+            "rt70: error: three_masses: --reduce 10000: order must be between 1 and 6 (the "
+            "plant has 6 states, 0 of them rigid or unstable and always kept), got 10000",
+        ),
+        (
+            ["plant", "three_masses", "--reduce", "100", "--method", "modal"],
+            "rt70: error: three_masses: --reduce 100: n_modes must be between 1 and 3 (the "
+            "plant has 3 modes of 2 states each, 0 of them rigid or unstable and always "
+            "kept), got 50",
+        ),
+        (
+            ["cart", "--start", "0", "0"],
+            "rt70: error: --start 0 0: start (0, 0) is an equilibrium of the programmed "
+            "field (4.6): no heading is programmed there",
+        ),
+        (
+            ["impact", "three_masses", "--pin", "x1:1,2"],
+            "rt70: error: --pin x1:1,2: stow pin 'x1:1,2': the point must be three numbers x,y,z",
+        ),
+    ],
+)
+def test_a_refused_value_names_its_option(argv, expected, capsys):
+    assert main(argv) == 2
+    assert one_error_line(capsys.readouterr().err) == expected
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "fault"),
+    [
+        ("--brake", "nope", "brake on joint 'nope': no such joint"),
+        ("--brake", "x1", None),  # a good lock beside a bad one: the bad one is named
+        ("--pin", "nope:0,0,0", "stow pin on link 'nope': not a moving link"),
+    ],
+)
+def test_impact_names_the_lock_option_and_the_file(option, value, fault, capsys):
+    argv = ["impact", "three_masses", option, value]
+    if fault is None:
+        argv += ["--brake", "x9"]
+        option, value, fault = "--brake", "x9", "brake on joint 'x9': no such joint"
+    assert main(argv) == 2
+    err = one_error_line(capsys.readouterr().err)
+    assert err.startswith(f"rt70: error: {option} {value}: ")
+    assert f"three_masses.urdf: {fault}" in err
+
+
+# --- 5. loops that cannot close ---------------------------------------------------------------
+
+FOUR_BAR = (Path(__file__).resolve().parents[1] / "urdf" / "four_bar.urdf").read_text()
+LOOP = """  <rt70:loop name="coupler_rocker" type="point">
+    <rt70:frame1 link="coupler" xyz="0.5 0 0" rpy="0 0 0"/>
+    <rt70:frame2 link="rocker" xyz="0.45 0 0" rpy="0 0 0"/>
+  </rt70:loop>
+"""
+assert LOOP in FOUR_BAR
+
+
+def four_bar_with(loops: str) -> str:
+    """urdf/four_bar.urdf with its loop replaced by ``loops``."""
+    return FOUR_BAR.replace(LOOP, loops)
+
+
+#: Four-bars whose loops cannot close, and what the error says of them.
+CANNOT_CLOSE = {
+    # the rocker's end 5 m from its pivot: crank + coupler reach 0.7 m, the pivots are
+    # 0.4 m apart, so the two ends stay at least 5 − 0.4 − 0.7 = 3.9 m apart
+    "too_far": (
+        LOOP.replace('xyz="0.45 0 0"', 'xyz="5 0 0"'),
+        "loop 'coupler_rocker' cannot close; the closest configuration found (13 starts, "
+        "the textbook and Pinocchio) leaves loop 'coupler_rocker' 3.9 m apart",
+    ),
+    # the coupler's end on the rocker at 0.45 m and at 0.2 m: each closes, not both
+    "contradictory": (
+        LOOP + LOOP.replace("coupler_rocker", "second").replace("0.45 0 0", "0.2 0 0"),
+        "loops 'coupler_rocker', 'second' contradict each other: each closes alone",
+    ),
+    # a planar loop's z row is redundant (identically zero) — here identically 0.1 m
+    "out_of_plane": (
+        LOOP.replace('xyz="0.45 0 0"', 'xyz="0.45 0 0.1"'),
+        "loop 'coupler_rocker' cannot close; the closest configuration found (13 starts, "
+        "the textbook and Pinocchio) leaves loop 'coupler_rocker' 0.1 m apart",
+    ),
+    # a weld whose frames differ by a turn about x that no z-axis joint can take up
+    "weld_turned": (
+        LOOP.replace('type="point"', 'type="frame"').replace(
+            'xyz="0.45 0 0" rpy="0 0 0"', 'xyz="0.45 0 0" rpy="0.3 0 0"'
+        ),
+        "rad turned",
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def loop_files(tmp_path_factory) -> dict[str, Path]:
+    directory = tmp_path_factory.mktemp("loops")
+    files = {}
+    for name, (loops, _) in CANNOT_CLOSE.items():
+        files[name] = directory / f"{name}.urdf"
+        files[name].write_text(four_bar_with(loops))
+    files["duplicate"] = directory / "duplicate.urdf"  # redundant, consistent
+    files["duplicate"].write_text(four_bar_with(LOOP + LOOP.replace("coupler_rocker", "again")))
+    return files
+
+
+@pytest.mark.parametrize("name", list(CANNOT_CLOSE))
+def test_validate_refuses_loops_that_cannot_close_before_comparing(
+    name, loop_files, monkeypatch, capsys
+):
+    import rt70.validate as validate
+
+    def no_comparison(*args):
+        raise AssertionError("compared a model whose loops cannot close")
+
+    monkeypatch.setattr(validate, "loop_pairs", no_comparison)
+    assert main(["validate", "--samples", "2", str(loop_files[name])]) == 2
+    err = one_error_line(capsys.readouterr().err)
+    assert err.startswith(f"rt70: error: {loop_files[name]}: ")
+    assert CANNOT_CLOSE[name][1] in err
+    assert err.endswith(
+        "the model contradicts itself (check the link lengths and the loops' xyz/rpy)"
+    )
+
+
+@pytest.mark.parametrize("command", [["simulate", "--t-end", "0.01"], ["modes"]])
+def test_every_command_gives_the_same_loop_error(command, loop_files, capsys):
+    assert main(["validate", "--samples", "1", str(loop_files["too_far"])]) == 2
+    expected = one_error_line(capsys.readouterr().err)
+    assert main([command[0], str(loop_files["too_far"]), *command[1:]]) == 2
+    assert one_error_line(capsys.readouterr().err) == expected
+
+
+def test_both_sides_find_the_same_closest_configuration(loop_files):
+    from rt70.closed_chains import closure_search
+    from rt70.scene import load_scene
+    from rt70.testing import assert_close
+
+    scene = load_scene(str(loop_files["too_far"]))
+    for side in ("textbook", "reference"):
+        found = closure_search(scene, side)
+        assert not found.closed
+        # the least-squares descent stops at a relative change of ½|Φ|² below 1e-8
+        assert_close(np.linalg.norm(found.phi), 3.9, rel=1e-6)
+
+
+def test_redundant_consistent_loops_keep_working(loop_files, capsys):
+    path = str(loop_files["duplicate"])
+    assert main(["validate", "--samples", "2", path]) == 0
+    assert main(["simulate", path, "--t-end", "0.05"]) == 0  # closed from rest elsewhere than q = 0
+    assert "constraints: max |Φ|" in capsys.readouterr().out
+
+
+def test_newton_does_not_call_a_diverged_iteration_closed(loop_files):
+    """The contradictory loops once 'converged' at q ~ 1e13 rad, |Φ| ~ 1 m (tol · |q|)."""
+    from rt70.closed_chains import assemble
+    from rt70.errors import LoopClosureError
+    from rt70.scene import load_scene
+
+    scene = load_scene(str(loop_files["contradictory"]))
+    with pytest.raises(LoopClosureError, match="contradict each other"):
+        assemble(scene, np.zeros(3))
