@@ -1,9 +1,12 @@
 """The ``rt70`` command line.
 
-Exit codes: 0 success, 1 a check disagreed (or a robot failed with an unexpected
-exception, a bug in rt70), 2 bad input (one readable line on stderr), 130 interrupted
-(Ctrl-C), 141 standard output closed early (``rt70 ... | head``: the exit status of a
-process killed by SIGPIPE), 143 stopped by SIGTERM. Input that is read with a caveat
+Exit codes (:data:`EXIT_CODES`, printed by ``rt70 --help``): 0 success, 1 a check
+disagreed (or a robot failed with an unexpected exception, a bug in rt70; or
+``simulate``'s integration stopped before the end time), 2 bad input (one readable line
+on stderr), 130 interrupted (Ctrl-C), 141 standard output closed early (``rt70 ... |
+head``: the exit status of a process killed by SIGPIPE), 143 stopped by SIGTERM.
+``bench`` prints each target as met or not and exits 0 either way (timings are the
+machine's, not a verdict). Input that is read with a caveat
 (:class:`~rt70.errors.Rt70Warning`) prints one ``rt70: warning: ...`` line on stderr
 each. Robots of example-robot-data that rt70 cannot load are listed as
 ``not loaded: <name>: <reason>`` lines and are no error by themselves.
@@ -28,6 +31,17 @@ from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigura
 EXIT_TERMINATED = 128 + signal.SIGTERM
 EXIT_INTERRUPTED = 128 + signal.SIGINT
 EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+
+#: What each exit code means (the epilog of ``rt70 --help``).
+EXIT_CODES = {
+    0: "success",
+    1: "a check disagreed (validate), a robot failed unexpectedly (a bug in rt70), or "
+    "simulate's integration stopped before the end time",
+    2: "bad input: one line 'rt70: error: ...' naming the option or the file",
+    int(EXIT_INTERRUPTED): "interrupted (Ctrl-C)",
+    int(EXIT_BROKEN_PIPE): "standard output closed early ('rt70 ... | head')",
+    int(EXIT_TERMINATED): "stopped by SIGTERM (temporary files removed)",
+}
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -493,7 +507,9 @@ def build_parser() -> argparse.ArgumentParser:
     from rt70.integrators import METHODS  # not rt70.simulate: --help stays light
 
     parser = options.Parser(
-        prog="rt70", description="Models of flexible structures, cross-checked against Pinocchio."
+        prog="rt70",
+        description="Models of flexible structures, cross-checked against Pinocchio.",
+        epilog="exit codes: " + "; ".join(f"{code} {what}" for code, what in EXIT_CODES.items()),
     )
     sub = parser.add_subparsers(dest="command", required=True)
     val = sub.add_parser(
