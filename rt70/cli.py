@@ -1,15 +1,10 @@
 """The ``rt70`` command line.
 
-Exit codes (:data:`EXIT_CODES`, printed by ``rt70 --help``): 0 success, 1 a check
-disagreed (or a robot failed with an unexpected exception, a bug in rt70; or
-``simulate``'s integration stopped before the end time), 2 bad input (one readable line
-on stderr), 130 interrupted (Ctrl-C), 141 standard output closed early (``rt70 ... |
-head``: the exit status of a process killed by SIGPIPE), 143 stopped by SIGTERM.
-``bench`` prints each target as met or not and exits 0 either way (timings are the
-machine's, not a verdict). Input that is read with a caveat
-(:class:`~rt70.errors.Rt70Warning`) prints one ``rt70: warning: ...`` line on stderr
-each. Robots of example-robot-data that rt70 cannot load are listed as
-``not loaded: <name>: <reason>`` lines and are no error by themselves.
+Exit codes: :data:`rt70.options.EXIT_CODES` (the epilog of ``rt70 --help``); ``bench``
+prints each target as met or not and exits 0 either way (timings are the machine's, not
+a verdict). Input read with a caveat (:class:`~rt70.errors.Rt70Warning`) prints one
+``rt70: warning: ...`` line on stderr each. Robots of example-robot-data that rt70
+cannot load are listed as ``not loaded: <name>: <reason>`` lines, no error by themselves.
 
 Every option is checked before any work starts (:mod:`rt70.options`); SIGTERM becomes a
 normal exit, so outputs being written are cleaned up (:mod:`rt70.atomic`).
@@ -20,28 +15,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import signal
 import sys
 import warnings
 
 from rt70 import cli_cart, cli_impact, cli_pointing, cli_reactions, cli_sweep, options
 from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
-
-#: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
-EXIT_TERMINATED = 128 + signal.SIGTERM
-EXIT_INTERRUPTED = 128 + signal.SIGINT
-EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
-
-#: What each exit code means (the epilog of ``rt70 --help``).
-EXIT_CODES = {
-    0: "success",
-    1: "a check disagreed (validate), a robot failed unexpectedly (a bug in rt70), or "
-    "simulate's integration stopped before the end time",
-    2: "bad input: one line 'rt70: error: ...' naming the option or the file",
-    int(EXIT_INTERRUPTED): "interrupted (Ctrl-C)",
-    int(EXIT_BROKEN_PIPE): "standard output closed early ('rt70 ... | head')",
-    int(EXIT_TERMINATED): "stopped by SIGTERM (temporary files removed)",
-}
+from rt70.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 
 def _validate(args: argparse.Namespace) -> int:

@@ -29,7 +29,7 @@ the tree still closes; the residual ``max |Φ|`` is reported with the result.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +40,7 @@ from rt70.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
 from rt70.errors import LoopClosureError, Rt70Error, SimulationError
 from rt70.kkt import solve_kkt
 from rt70.scene import Scene
+from rt70.urdf.description import Loop
 
 #: Newton iterations of :func:`assemble` before it gives up.
 MAX_NEWTON = 50
@@ -298,7 +299,7 @@ class Closure:
     Attributes
     ----------
     q : numpy.ndarray
-        A closed configuration, or the one with the smallest ``max |Φ|`` found.
+        A closed configuration, or the least-squares minimum with the smallest ``|Φ|``.
     phi : numpy.ndarray
         Φ there (the rows searched).
     closed : bool
@@ -314,7 +315,10 @@ class Closure:
 
 
 def closure_search(
-    scene: Scene, side: str = "textbook", loops: Sequence[str] | None = None, tol=CLOSURE_TOL
+    scene: Scene,
+    side: str = "textbook",
+    loops: Sequence[str] | None = None,
+    tol: float = CLOSURE_TOL,
 ) -> Closure:
     """Look for a configuration that closes the scene's loops (all, or those named).
 
@@ -334,6 +338,11 @@ def closure_search(
         Names of the loops to close (default all).
     tol : float
         Closure tolerance (:data:`CLOSURE_TOL`).
+
+    Raises
+    ------
+    Rt70Error
+        If Φ or B_c is not finite at every start.
     """
     constraints = scene_constraints(scene, side)
     n = scene.textbook.nv
@@ -351,9 +360,10 @@ def closure_search(
         if ok:
             return Closure(q, phi, True, k)
         if best is None or np.linalg.norm(descent[1]) < np.linalg.norm(best.phi):
-            best = Closure(*descent, False, len(starts))  # the least-squares minimum
-    assert best is not None
-    return Closure(best.q, best.phi, False, len(starts))
+            best = Closure(*descent, False, len(starts))  # a least-squares minimum
+    if best is None:
+        raise Rt70Error(f"{scene.path}: the loops' Φ is not finite at any start of the search")
+    return best
 
 
 def _rows_of(scene: Scene, names: Sequence[str] | None) -> np.ndarray | slice:
@@ -462,11 +472,12 @@ def _phi(scene: Scene, side: str, q: np.ndarray) -> np.ndarray:
 
 
 def _names(names: Sequence[str]) -> str:
+    """``loop 'a'`` or ``loops 'a', 'b'``."""
     quoted = ", ".join(f"'{n}'" for n in names)
     return f"loop {quoted}" if len(names) == 1 else f"loops {quoted}"
 
 
-def _per_loop(scene: Scene, phi: np.ndarray):
+def _per_loop(scene: Scene, phi: np.ndarray) -> Iterator[tuple[Loop, np.ndarray]]:
     """``(loop, its rows of Φ)`` for every loop."""
     at = 0
     for loop in scene.description.loops:
@@ -474,7 +485,7 @@ def _per_loop(scene: Scene, phi: np.ndarray):
         at += loop.rows
 
 
-def _apart(loop, phi: np.ndarray) -> str:
+def _apart(loop: Loop, phi: np.ndarray) -> str:
     """``loop 'a' 0.15 m apart`` (and the angle for a ``frame`` loop)."""
     text = f"loop '{loop.name}' {np.linalg.norm(phi[:3]):.3g} m apart"
     if loop.rows == 6:

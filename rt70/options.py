@@ -23,6 +23,22 @@ from typing import NoReturn
 
 from rt70.errors import OutputError, Rt70Error
 
+#: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
+EXIT_TERMINATED = 128 + signal.SIGTERM
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+
+#: What each exit code of the command line means (the epilog of ``rt70 --help``).
+EXIT_CODES = {
+    0: "success",
+    1: "a check disagreed (validate), a robot failed unexpectedly (a bug in rt70), or "
+    "simulate's integration stopped before the end time",
+    2: "bad input: one line 'rt70: error: ...' naming the option or the file",
+    int(EXIT_INTERRUPTED): "interrupted (Ctrl-C)",
+    int(EXIT_BROKEN_PIPE): "standard output closed early ('rt70 ... | head')",
+    int(EXIT_TERMINATED): "stopped by SIGTERM (temporary files removed)",
+}
+
 #: Range of the RT-70's elevation axis, degrees: horizon to zenith (the book's tables
 #: are given at 0° and 90°; :func:`rt70.scenes.rt70_state.rt70_pointing`).
 ELEVATION_RANGE = (0.0, 90.0)

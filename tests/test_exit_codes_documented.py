@@ -33,7 +33,8 @@ import threading
 import numpy as np
 import pytest
 
-from rt70.cli import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED, main
+from rt70.cli import main
+from rt70.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 NO_DOF = """<robot name="still">
   <link name="world"/>
