@@ -1,12 +1,10 @@
 """The ``rt70`` command line.
 
-Exit codes: 0 success, 1 a check disagreed (or a robot failed with an unexpected
-exception, a bug in rt70), 2 bad input (one readable line on stderr), 130 interrupted
-(Ctrl-C), 141 standard output closed early (``rt70 ... | head``: the exit status of a
-process killed by SIGPIPE), 143 stopped by SIGTERM. Input that is read with a caveat
-(:class:`~rt70.errors.Rt70Warning`) prints one ``rt70: warning: ...`` line on stderr
-each. Robots of example-robot-data that rt70 cannot load are listed as
-``not loaded: <name>: <reason>`` lines and are no error by themselves.
+Exit codes: :data:`rt70.options.EXIT_CODES` (the epilog of ``rt70 --help``); ``bench``
+prints each target as met or not and exits 0 either way (timings are the machine's, not
+a verdict). Input read with a caveat (:class:`~rt70.errors.Rt70Warning`) prints one
+``rt70: warning: ...`` line on stderr each. Robots of example-robot-data that rt70
+cannot load are listed as ``not loaded: <name>: <reason>`` lines, no error by themselves.
 
 Every option is checked before any work starts (:mod:`rt70.options`); SIGTERM becomes a
 normal exit, so outputs being written are cleaned up (:mod:`rt70.atomic`).
@@ -17,17 +15,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import signal
 import sys
 import warnings
 
 from rt70 import cli_cart, cli_impact, cli_pointing, cli_reactions, cli_sweep, options
 from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
-
-#: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
-EXIT_TERMINATED = 128 + signal.SIGTERM
-EXIT_INTERRUPTED = 128 + signal.SIGINT
-EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+from rt70.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -188,19 +181,17 @@ def _modes(args: argparse.Namespace) -> int:
 def _loop_modes(args: argparse.Namespace, scene, held: dict) -> tuple:
     """Modes of a closed-chain scene on its manifold (textbook side; docs/constrained-modes.md).
 
-    From the mechanism's closed start, or the zero state closed by
-    :func:`rt70.closed_chains.assemble`; the stable equilibrium (Newton descending where
+    From the mechanism's closed start, or a closed state at rest
+    (:func:`rt70.closed_chains.closed_rest`); the stable equilibrium (Newton descending where
     the stiffness is negative). Returns modes, shapes, model, damped modes, constraints.
     """
-    import numpy as np
-
-    from rt70.closed_chains import assemble
+    from rt70.closed_chains import closed_rest
     from rt70.linear import constrained_scene as cs
     from rt70.scenes.loop_scenes import start_state
     from rt70.textbook import loops
 
     start = start_state(scene)
-    q = start[0] if start is not None else assemble(scene, np.zeros(scene.textbook.nv))[0]
+    q = start[0] if start is not None else closed_rest(scene)[0]
     for name, value in held.items():
         q[scene.textbook.coordinate_names.index(name)] = value
     model = cs.constrained_linearize(
@@ -308,11 +299,12 @@ def _plant(args: argparse.Namespace) -> int:
         from rt70.linear import reduce as rd
 
         full = ss
-        red = (
-            rd.modal_truncation(ss, args.reduce // 2)
-            if method == "modal"
-            else rd.balanced_truncation(ss, args.reduce)
-        )
+        with options.option_at_fault(f"{scene.name}: --reduce {args.reduce}"):
+            red = (
+                rd.modal_truncation(ss, args.reduce // 2)
+                if method == "modal"
+                else rd.balanced_truncation(ss, args.reduce)
+            )
         ss, err = red.ss, rd.hinf_error(full, red.ss)
         info["states"] = list(ss.state_names)
         info["reduced"] = {
@@ -494,7 +486,9 @@ def build_parser() -> argparse.ArgumentParser:
     from rt70.integrators import METHODS  # not rt70.simulate: --help stays light
 
     parser = options.Parser(
-        prog="rt70", description="Models of flexible structures, cross-checked against Pinocchio."
+        prog="rt70",
+        description="Models of flexible structures, cross-checked against Pinocchio.",
+        epilog="exit codes: " + "; ".join(f"{code} {what}" for code, what in EXIT_CODES.items()),
     )
     sub = parser.add_subparsers(dest="command", required=True)
     val = sub.add_parser(
@@ -662,7 +656,11 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
-    with options.sigterm_exits(EXIT_TERMINATED), warnings.catch_warnings():
+    with (
+        options.sigterm_exits(EXIT_TERMINATED),
+        options.checked_stdout(),  # '> file' on a full disk: one line, exit 2
+        warnings.catch_warnings(),
+    ):
         warnings.simplefilter("always", Rt70Warning)
         warnings.showwarning = _show_warning
         try:

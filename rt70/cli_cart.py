@@ -85,11 +85,13 @@ def run(args: argparse.Namespace) -> int:
         raise Rt70Error(f"--speed-error {args.speed_error:g}: the speed must stay positive")
     scene = load_scene(args.scene)
     cart.check_scene(scene)
-    q, qd = cart.on_manifold_start(*args.start)
+    with options.option_at_fault(f"--start {args.start[0]:g} {args.start[1]:g}"):
+        q, qd = cart.on_manifold_start(*args.start)
     q[2] += args.heading_error
     speed = (1.0 + args.speed_error) * float(np.hypot(qd[0], qd[1]))
     qd[:2] = speed * np.cos(q[2]), speed * np.sin(q[2])  # along the heading: (4.3) holds
-    first = cart.servo(scene, q, qd, side=args.side)
+    with options.option_at_fault("the start state (--start, --heading-error, --speed-error)"):
+        first = cart.servo(scene, q, qd, side=args.side)
     n = int(np.floor(args.duration / args.step + 1e-9))
     shown = np.unique(np.round(np.append(np.arange(n + 1) * args.step, args.duration), 12))
     grid = np.linspace(0.0, args.duration, int(np.ceil(args.duration / 0.01)) + 1)

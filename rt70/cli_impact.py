@@ -90,14 +90,31 @@ def add_parser(sub) -> argparse.ArgumentParser:
     return imp
 
 
-def _locks(args: argparse.Namespace) -> list:
+def _locks(args: argparse.Namespace) -> list[tuple[str, object]]:
+    """The locks asked for, each with the option that asked for it (``--pin b:0,0,1``)."""
     from rt70.locks import Brake, parse_pin
 
     if not args.brake and not args.pin:
         raise Rt70Error("impact: give at least one --brake JOINT or --pin LINK:x,y,z")
     if args.restitution > 1.0:
         raise Rt70Error(f"--restitution {args.restitution:g}: must lie in [0, 1]")
-    return [Brake(j) for j in args.brake] + [parse_pin(p) for p in args.pin]
+    locks: list[tuple[str, object]] = [(f"--brake {j}", Brake(j)) for j in args.brake]
+    for text in args.pin:
+        with options.option_at_fault(f"--pin {text}"):
+            locks.append((f"--pin {text}", parse_pin(text)))
+    return locks
+
+
+def _check_locks(scene, locks: list[tuple[str, object]]) -> list:
+    """Check each lock against the scene, naming its option; return the locks."""
+    from rt70.locks import check_locks
+    from rt70.scene import require_coordinates
+
+    require_coordinates(scene)
+    for option, lock in locks:
+        with options.option_at_fault(option):
+            check_locks(scene, [lock])
+    return [lock for _, lock in locks]
 
 
 def _state(scene, args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray]:
@@ -124,12 +141,12 @@ def _state(scene, args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray]:
 
 def run(args: argparse.Namespace) -> int:
     """Check the options, the scene and the locks; solve on both sides; print."""
-    from rt70.locks import check_locks, engage, joint_impulses, labels
+    from rt70.locks import engage, joint_impulses, labels
     from rt70.scene import load_scene
 
-    locks = _locks(args)  # options first
+    asked = _locks(args)  # options first
     scene = load_scene(args.scene)
-    check_locks(scene, locks)
+    locks = _check_locks(scene, asked)
     q, qd = _state(scene, args)
     audit = None
     if args.after is not None:

@@ -52,6 +52,14 @@ class ExtensionError(UrdfError):
     """An rt70 extension element (spring, bushing, strut package, ...) is malformed."""
 
 
+class LoopClosureError(ExtensionError):
+    """The ``<rt70:loop>`` elements cannot close: no configuration satisfies ``Φ(q) = 0``.
+
+    A loop whose frames cannot meet (lengths that do not reach, an offset no joint can
+    take up), or loops that each close alone but contradict each other.
+    """
+
+
 class SingularConfigurationError(Rt70Error):
     """The configuration is singular for the chosen coordinates (Euler gimbal lock)."""
 

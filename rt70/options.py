@@ -17,11 +17,27 @@ import sys
 import tempfile
 import threading
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import NoReturn
 
-from rt70.errors import OutputError
+from rt70.errors import OutputError, Rt70Error
+
+#: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
+EXIT_TERMINATED = 128 + signal.SIGTERM
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+
+#: What each exit code of the command line means (the epilog of ``rt70 --help``).
+EXIT_CODES = {
+    0: "success",
+    1: "a check disagreed (validate), a robot failed unexpectedly (a bug in rt70), or "
+    "simulate's integration stopped before the end time",
+    2: "bad input: one line 'rt70: error: ...' naming the option or the file",
+    int(EXIT_INTERRUPTED): "interrupted (Ctrl-C)",
+    int(EXIT_BROKEN_PIPE): "standard output closed early ('rt70 ... | head')",
+    int(EXIT_TERMINATED): "stopped by SIGTERM (temporary files removed)",
+}
 
 #: Range of the RT-70's elevation axis, degrees: horizon to zenith (the book's tables
 #: are given at 0° and 90°; :func:`rt70.scenes.rt70_state.rt70_pointing`).
@@ -131,6 +147,29 @@ def elevation(text: str) -> float:
     return value
 
 
+# --- values checked where they are used ------------------------------------------------
+@contextmanager
+def option_at_fault(option: str) -> Iterator[None]:
+    """Name the command-line option behind a value the library refuses inside the block.
+
+    Some values can only be judged once the model is built (``plant --reduce`` against
+    the plant's order, ``impact --brake`` against the scene's joints). The library's
+    message knows no options; the command line passes the value in inside this block,
+    and an :class:`~rt70.errors.Rt70Error` comes out as the same class with
+    ``"<option>: "`` in front: ``--reduce 10000: order must be between 3 and 84 …``.
+
+    Parameters
+    ----------
+    option
+        The option and its value as the user wrote them (``"--reduce 10000"``), with the
+        scene in front where the limit is the scene's (``"rt70: --reduce 10000"``).
+    """
+    try:
+        yield
+    except Rt70Error as exc:
+        raise type(exc)(f"{option}: {exc}") from None
+
+
 # --- output paths ------------------------------------------------------------------------
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse output paths the command could not write, before it starts.
@@ -190,6 +229,60 @@ def check_writable_directory(directory: Path) -> None:
         ) from None
     os.close(fd)
     os.unlink(name)
+
+
+class _CheckedOutput:
+    """Standard output whose write errors are one :class:`OutputError` (a closed pipe aside).
+
+    ``rt70 ... > file`` on a full disk fails inside ``print``; the error names standard
+    output, and what is still buffered goes to ``os.devnull`` so that the interpreter's
+    last flush at exit does not fail a second time.
+    """
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        with self._errors():
+            return self._stream.write(text)
+
+    def flush(self) -> None:
+        with self._errors():
+            self._stream.flush()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+    @contextmanager
+    def _errors(self) -> Iterator[None]:
+        try:
+            yield
+        except BrokenPipeError:  # the reader went away: the command line's exit 141
+            raise
+        except OSError as exc:
+            with suppress(OSError, ValueError):  # no file descriptor (a StringIO): nothing to do
+                _point_at_devnull(self._stream.fileno())
+            raise OutputError(f"standard output: cannot write ({exc.strerror or exc})") from None
+
+
+def _point_at_devnull(fd: int) -> None:
+    """Make file descriptor ``fd`` write to ``os.devnull``."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, fd)
+    finally:
+        os.close(devnull)
+
+
+@contextmanager
+def checked_stdout() -> Iterator[None]:
+    """Inside the block, a failed write to standard output raises :class:`OutputError`."""
+    stream = sys.stdout
+    sys.stdout = _CheckedOutput(stream)
+    try:
+        yield
+    finally:
+        sys.stdout = stream
 
 
 # --- signals -----------------------------------------------------------------------------

@@ -21,6 +21,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from rt70.closed_chains import require_closable
 from rt70.errors import Rt70Error
 from rt70.impact_check import impact_pairs, impact_scales
 from rt70.loads import Wrench
@@ -436,10 +437,14 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
     Rt70Error
         If the scene has no degree of freedom, ``samples`` < 1, or the mass matrix is
         numerically singular at a sampled state.
+    LoopClosureError
+        If the scene's loops cannot close (:func:`rt70.closed_chains.require_closable`),
+        before anything is compared.
     """
     require_coordinates(scene)
     if samples < 1:
         raise Rt70Error(f"samples must be at least 1, got {samples}")
+    require_closable(scene)  # loops that cannot close: a model error, not a disagreement
     rng = np.random.default_rng(seed)
     nv = scene.textbook.nv
     rows = quantities(scene)

@@ -170,8 +170,9 @@ def modal_truncation(ss: StateSpace, n_modes: int) -> Reduction:
     n_marginal = int(np.sum(md.rigid | md.negative))
     if not max(1, n_marginal) <= n_modes <= md.n:
         raise Rt70Error(
-            f"n_modes must be between {max(1, n_marginal)} and {md.n} (the plant has "
-            f"{n_marginal} rigid or unstable mode(s), always kept), got {n_modes}"
+            f"n_modes must be between {max(1, n_marginal)} and {md.n} (the plant has {md.n} "
+            f"modes of 2 states each, {n_marginal} of them rigid or unstable and always "
+            f"kept), got {n_modes}"
         )
     Vr, Vd = md.shapes[:, :n_modes], md.shapes[:, n_modes:]
     flexibility = (Vd / md.omega2[n_modes:]) @ Vd.T
@@ -320,8 +321,9 @@ def balanced_truncation(ss: StateSpace, order: int, offset: float = 0.0) -> Redu
     n_u, n_s = split.A_u.shape[0], split.A_s.shape[0]
     if not max(1, n_u) <= order <= n_u + n_s:
         raise Rt70Error(
-            f"order must be between {max(1, n_u)} and {n_u + n_s} (the plant has {n_u} "
-            f"rigid or unstable state(s), always kept), got {order}"
+            f"order must be between {max(1, n_u)} and {n_u + n_s} (the plant has "
+            f"{n_u + n_s} states, {n_u} of them rigid or unstable and always kept), "
+            f"got {order}"
         )
     k = order - n_u
     if n_s:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write, atomic_write_text
+from rt70.atomic import atomic_write_all
 from rt70.reports.targets import TargetCheck
 from rt70.reports.threads import single_threaded
 from rt70.scene import Scene, load_scene, scene_from_text
@@ -301,7 +301,14 @@ def format_report(rows: list[Row]) -> str:
 
 
 def write_results(rows: list[Row], directory: Path) -> list[Path]:
-    """Write ``mass_matrix_bench.csv`` and the log–log plot ``mass_matrix_bench.png``."""
+    """Write ``mass_matrix_bench.csv`` and the log–log plot ``mass_matrix_bench.png`` together.
+
+    Raises
+    ------
+    OutputError
+        The directory cannot take them (:func:`rt70.atomic.atomic_write_all`); neither
+        file is changed.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -312,7 +319,7 @@ def write_results(rows: list[Row], directory: Path) -> list[Path]:
     writer.writeheader()
     for r in rows:
         writer.writerow(asdict(r))
-    csv_path = atomic_write_text(directory / "mass_matrix_bench.csv", buf.getvalue())
+    text = buf.getvalue()
 
     fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
     styles = {"chain": "o", "tree": "s"}
@@ -337,8 +344,14 @@ def write_results(rows: list[Row], directory: Path) -> list[Path]:
     ax.grid(True, which="both", alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=8)
-    png_path = atomic_write(
-        directory / "mass_matrix_bench.png", lambda tmp: fig.savefig(tmp, dpi=120)
-    )
-    plt.close(fig)
-    return [csv_path, png_path]
+    try:  # the table and its plot appear together, or neither changes
+        return atomic_write_all(
+            {
+                directory / "mass_matrix_bench.csv": lambda tmp: tmp.write_text(
+                    text, encoding="utf-8", newline="\n"
+                ),
+                directory / "mass_matrix_bench.png": lambda tmp: fig.savefig(tmp, dpi=120),
+            }
+        )
+    finally:
+        plt.close(fig)

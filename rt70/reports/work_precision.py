@@ -86,7 +86,7 @@ from pathlib import Path
 import numpy as np
 
 from rt70 import simulate as _simulate
-from rt70.atomic import atomic_write, atomic_write_text
+from rt70.atomic import atomic_write_all
 from rt70.errors import Rt70Error
 from rt70.reports import simulation_targets
 from rt70.reports.targets import TargetCheck
@@ -482,7 +482,7 @@ def write_results(rows: list[Row], directory: str | Path) -> list[Path]:
     writer.writeheader()
     for r in rows:
         writer.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in asdict(r).items()})
-    csv_path = atomic_write_text(directory / "work_precision.csv", buf.getvalue())
+    text = buf.getvalue()
 
     names = list(dict.fromkeys(r.problem for r in rows))
     ncols = 2 if len(names) > 1 else 1
@@ -539,6 +539,14 @@ def write_results(rows: list[Row], directory: str | Path) -> list[Path]:
         f"(references: another method at rtol {REFERENCE_RTOL:g})",
         fontsize=11,
     )
-    png_path = atomic_write(directory / "work_precision.png", lambda tmp: fig.savefig(tmp, dpi=110))
-    plt.close(fig)
-    return [csv_path, png_path]
+    try:  # the table and its plot appear together, or neither changes
+        return atomic_write_all(
+            {
+                directory / "work_precision.csv": lambda tmp: tmp.write_text(
+                    text, encoding="utf-8", newline="\n"
+                ),
+                directory / "work_precision.png": lambda tmp: fig.savefig(tmp, dpi=110),
+            }
+        )
+    finally:
+        plt.close(fig)
