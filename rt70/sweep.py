@@ -81,22 +81,22 @@ FORMAT = 2
 #: holds every pointing; beyond it a float's spacing grows until the angle means nothing.
 MAX_TURN_DEG = 360.0
 
-#: Memory the sweep holds per number of a result (bytes): the chunk's row, kept until
-#: the end, and the assembled array (two float64). Fitted with the others below by
-#: ``python validation/sweep_memory.py``.
-BYTES_PER_NUMBER = 16
+#: Memory a sweep holds per number of its results, bytes: the grid's float64 arrays,
+#: filled as the chunks arrive. The four constants below are rounded up from
+#: ``python validation/sweep_memory.py --points 9000`` (tracemalloc, output written):
+#: 7.8 B per number, 2645 B per error record, 662 B per chunk, 90 B per axis value.
+BYTES_PER_NUMBER = 10
 
-#: Memory per failed point and quantity (bytes): its error record and its share of the
+#: Memory per failed point and quantity, bytes: its error record and its share of the
 #: JSON sidecar — counted for every point, as if every point failed.
-BYTES_PER_ERROR = 2_000
+BYTES_PER_ERROR = 3_000
 
-#: Memory per chunk (bytes): its :class:`Chunk`, :class:`ChunkResult` and dicts, the
-#: Dask future and bookkeeping of the client.
-BYTES_PER_CHUNK = 3_000
+#: Memory per chunk, bytes: its :class:`Chunk` and its share of the bookkeeping.
+BYTES_PER_CHUNK = 1_000
 
-#: Memory per value of an axis (bytes): the Python float, the tuple slot, the grid's
+#: Memory per value of an axis, bytes: the Python float, the tuple slot, the grid's
 #: JSON (key, metadata) and numpy's transient ``linspace``.
-BYTES_PER_AXIS_VALUE = 100
+BYTES_PER_AXIS_VALUE = 150
 
 
 class SweepError(Rt70Error):

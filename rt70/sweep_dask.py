@@ -78,10 +78,11 @@ class PinBlasThreads(WorkerPlugin):
 PRELOAD = ("rt70.sweep", "rt70.reference", "rt70.linear.linearize", "rt70.linear.modal")
 
 
-#: Memory of one local worker process and its nanny after a chunk of ``rt70_servo``
-#: (numpy, scipy, Pinocchio, rt70, the scene on both sides), bytes, rounded up:
-#: ``python validation/sweep_memory.py``.
-WORKER_BYTES = 500_000_000
+#: Memory of one local worker process, bytes: its resident set after a chunk of
+#: ``rt70_servo`` (numpy, scipy, Pinocchio, rt70, the scene on both sides) is 185 MB
+#: (``python validation/sweep_memory.py``), rounded up for larger scenes and the
+#: scaled scenes a worker keeps (:data:`rt70.sweep.SCENES_KEPT`).
+WORKER_BYTES = 300_000_000
 
 
 def default_workers() -> int:
