@@ -616,6 +616,8 @@ class PartialResults:
             path = self._path(chunk.number)
             if not os.path.lexists(path):
                 continue
+            if path.is_dir():
+                raise OutputError(f"{path}: a directory where a chunk file belongs; remove it")
             try:
                 if not path.is_file():
                     raise sweep_store.UntrustedChunk("not a regular file")
@@ -797,10 +799,11 @@ def run(
     ResourceError
         The sweep is larger than this machine can hold (:func:`check_size`).
     SweepError
-        ``out.partial/`` holds another sweep's chunks or is locked by another process
-        (:class:`rt70.sweep_store.LockedError`); a chunk from the executor is not what
+        ``out.partial/`` holds another sweep's chunks; a chunk from the executor is not what
         the sweep computes (:func:`check_result`); the cluster fails
         (:class:`ClusterError`, the finished chunks kept).
+    LockedError
+        Another process writes ``out.partial/`` (:class:`rt70.sweep_store.DirectoryLock`).
     OutputError
         A file cannot be written (a full disk): the previous output files and the
         finished chunks are kept.

@@ -232,9 +232,10 @@ def _result(future, chunk: Chunk) -> ChunkResult:
     try:
         return future.result()
     except KilledWorker as exc:
+        deaths = exc.allowed_failures + 1
         raise ClusterError(
-            f"chunk {chunk.number}: the worker computing it died {exc.allowed_failures + 1} "
-            "times (a worker memory limit, a crash or killed workers)"
+            f"chunk {chunk.number}: the worker computing it died {deaths} time(s) (a worker "
+            "memory limit, a crash or killed workers)"
         ) from None
     except Exception as exc:
         if future.status == "error":

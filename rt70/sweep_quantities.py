@@ -418,12 +418,13 @@ def check_factors(scene: Scene, name: str, factors: Sequence[float]) -> None:
     numbers = [abs(v) for v in PARAMETERS[name].values(scene.description)]
     if not numbers or not factors:
         return
-    largest = max(numbers) * max(factors)
-    if largest > MAX_MAGNITUDE:
+    with np.errstate(over="ignore"):
+        largest = np.float64(max(numbers)) * max(factors)
+    if not largest <= MAX_MAGNITUDE:
         raise Rt70Error(
-            f"--scale {name}: factor {max(factors):g} makes a {name.replace('_', ' ')} of "
-            f"{largest:.3g}, beyond {MAX_MAGNITUDE:g} (the largest number rt70 reads in a "
-            "model)"
+            f"--scale {name}: factor {max(factors):g} times the largest "
+            f"{name.replace('_', ' ')} {max(numbers):g} of {scene.name} is {largest:.3g}, beyond "
+            f"{MAX_MAGNITUDE:g} (the largest number rt70 reads in a model)"
         )
 
 
