@@ -633,14 +633,11 @@ class PartialResults:
         return done
 
     def _recompute_message(self) -> str:
-        reasons: dict[str, list[str]] = {}
-        for name, reason in self.recomputed.items():
-            reasons.setdefault(reason.split(" (")[0], []).append(name)
-        parts = [f"{len(v)} {k} ({sweep_store.first(v)})" for k, v in reasons.items()]
-        first_name, first_reason = next(iter(self.recomputed.items()))
+        shown = [f"{name}: {why}" for name, why in list(self.recomputed.items())[:3]]
+        more = len(self.recomputed) - len(shown)
         return (
             f"{self.directory}: {len(self.recomputed)} chunk file(s) cannot be trusted and "
-            f"are recomputed: {'; '.join(parts)} [{first_name}: {first_reason}]"
+            f"are recomputed: {'; '.join(shown)}{f'; and {more} more' if more else ''}"
         )
 
     def _meta(self, chunk: Chunk) -> dict[str, Any]:
@@ -699,7 +696,7 @@ def check_result(sweep: Sweep, chunk: Chunk, result: ChunkResult) -> None:
     expected = {f.name: (rows, *f.shape) for q in sweep.quantities for f in q.fields}
     got = {k: np.shape(v) for k, v in result.arrays.items()}
     if got != expected:
-        raise SweepError(f"chunk {chunk.number}: fields {got}, expected {expected}")
+        raise SweepError(f"fields {got}, not the chunk's {expected}")
     indices = {tuple(i): row for row, i in enumerate(chunk.indices())}
     names = {q.name for q in sweep.quantities}
     failed = set()
@@ -710,23 +707,19 @@ def check_result(sweep: Sweep, chunk: Chunk, result: ChunkResult) -> None:
         except (KeyError, TypeError):
             ok = False
         if not ok or where in failed:
-            raise SweepError(f"chunk {chunk.number}: an error record is not one of its points")
+            raise SweepError("an error record that is not one of its points' or is repeated")
         failed.add(where)
     for q in sweep.quantities:
         for row in range(rows):
             values = [(f, np.asarray(result.arrays[f.name][row])) for f in q.fields]
+            where = f"{q.name} at grid index {list(chunk.indices()[row])}"
             if (row, q.name) in failed:
-                ok = all(np.isnan(v).all() for _, v in values)
-            else:
-                ok = all(
-                    not np.isinf(v).any() and (f.nan or not np.isnan(v).any()) for f, v in values
-                )
-            if not ok:
-                index = chunk.indices()[row]
-                raise SweepError(
-                    f"chunk {chunk.number}: {q.name} at grid index {list(index)} is NaN "
-                    "without an error record, or has a record and values"
-                )
+                if not all(np.isnan(v).all() for _, v in values):
+                    raise SweepError(f"{where} has an error record and values")
+            elif not all(
+                not np.isinf(v).any() and (f.nan or not np.isnan(v).any()) for f, v in values
+            ):
+                raise SweepError(f"{where} is not finite and has no error record")
 
 
 def _cannot_write(path: Path, exc: BaseException) -> str:
@@ -854,7 +847,10 @@ def _compute(
                         raise SweepError(
                             f"the executor returned chunk {got.number} twice or unasked"
                         )
-                    check_result(sweep, chunk, got)
+                    try:
+                        check_result(sweep, chunk, got)
+                    except SweepError as exc:
+                        raise SweepError(f"chunk {got.number} as computed: {exc}") from None
                     if store is not None:
                         store.save(got)
                     errors[got.number] = _place(arrays, chunk, got)

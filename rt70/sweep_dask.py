@@ -105,11 +105,13 @@ def check_workers(workers: int) -> None:
     )
 
 
-def local_cluster(workers: int | None = None) -> LocalCluster:
+def local_cluster(workers: int | None = None, **options) -> LocalCluster:
     """A local cluster of ``workers`` single-threaded processes (default: one per core).
 
-    The workers listen on 127.0.0.1 only, serve no dashboard, and import
-    :data:`PRELOAD` as they start.
+    The workers listen on 127.0.0.1 only, serve no dashboard, log nothing below
+    CRITICAL (a worker restarted, a task failed: what stops the sweep is one
+    :class:`~rt70.sweep.ClusterError`), and import :data:`PRELOAD` as they start;
+    ``options`` go to ``LocalCluster`` as well (e.g. ``memory_limit``).
 
     Raises
     ------
@@ -124,8 +126,9 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
-        silence_logs=logging.ERROR,
+        silence_logs=logging.CRITICAL,  # a fault that stops the sweep is a ClusterError
         preload=list(PRELOAD),
+        **options,
     )
 
 
@@ -234,8 +237,8 @@ def _result(future, chunk: Chunk) -> ChunkResult:
     except KilledWorker as exc:
         deaths = exc.allowed_failures + 1
         raise ClusterError(
-            f"chunk {chunk.number}: the worker computing it died {deaths} time(s) (a worker "
-            "memory limit, a crash or killed workers)"
+            f"chunk {chunk.number}: the worker it was given to died {deaths} time(s) (a "
+            "worker memory limit, a crash or killed workers)"
         ) from None
     except Exception as exc:
         if future.status == "error":
