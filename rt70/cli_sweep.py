@@ -62,7 +62,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     )
     swp.add_argument(
         "--timeout",
-        type=options.positive_float,
+        type=_timeout,
         default=10.0,
         help="seconds to wait for --scheduler, and for a worker when the cluster has none "
         "left (default 10)",
@@ -172,10 +172,7 @@ def _sweep_on_dask(args: argparse.Namespace, plan, out, progress: bool):
             client = stack.enter_context(sweep_dask.connect(args.scheduler, args.timeout))
             where = f"on the cluster at {args.scheduler}"
         else:
-            from distributed import Client
-
-            cluster = stack.enter_context(sweep_dask.local_cluster(args.workers))
-            client = stack.enter_context(Client(cluster))
+            client = sweep_dask.start_local(stack, args.workers)
             where = "on a local Dask cluster"
         n = sweep_dask.workers_of(client)
         where += f" ({n} worker{'s' if n != 1 else ''})"
@@ -216,6 +213,19 @@ def _sweep_quantities(text: str) -> tuple[str, ...]:
         return quantity_names(text)
     except Rt70Error as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+#: Longest ``--timeout``, seconds: a scheduler or a worker not there within an hour is
+#: not coming (a larger number only turns a dead cluster into a hang).
+MAX_TIMEOUT = 3600.0
+
+
+def _timeout(text: str) -> float:
+    """Seconds to wait for a scheduler or a worker: 0 < T ≤ :data:`MAX_TIMEOUT`."""
+    value = options.positive_float(text)
+    if value > MAX_TIMEOUT:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_TIMEOUT:g} s (an hour), got {text}")
+    return value
 
 
 def _non_negative_int(text: str) -> int:

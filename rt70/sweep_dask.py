@@ -21,7 +21,7 @@ import queue
 import time
 from collections.abc import Generator, Iterator
 from concurrent.futures import CancelledError
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 
 from distributed import Client, LocalCluster
 from distributed.client import FutureCancelledError
@@ -130,6 +130,24 @@ def local_cluster(workers: int | None = None, **options) -> LocalCluster:
         preload=list(PRELOAD),
         **options,
     )
+
+
+def start_local(stack: ExitStack, workers: int | None = None) -> Client:
+    """Start a :func:`local_cluster` and a client of it, both closed by ``stack``.
+
+    Raises
+    ------
+    ClusterError
+        The cluster did not start (a worker process that cannot start, no free port).
+    ResourceError
+        More workers than this machine's memory holds (:func:`check_workers`).
+    """
+    try:
+        cluster = stack.enter_context(local_cluster(workers))
+        return stack.enter_context(Client(cluster))
+    except (OSError, RuntimeError, TimeoutError) as exc:
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise ClusterError(f"could not start a local Dask cluster ({reason})") from None
 
 
 def connect(address: str, timeout: float = CONNECT_TIMEOUT) -> Client:

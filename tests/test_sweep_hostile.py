@@ -193,10 +193,12 @@ def test_run_checks_the_size_itself(monkeypatch, tmp_path):
     [
         (["--azimuth", "1e300"], "--azimuth: angles from -360° to 360°"),
         (["--direction", "-400"], "--direction: angles from -360° to 360°"),
+        (["--timeout", "1e300"], "argument --timeout: must be at most 3600 s (an hour)"),
     ],
 )
-def test_angles_beyond_a_turn_are_refused(extra, expected, no_work, tmp_path, capsys):
-    """--azimuth 1e300 gave a first frequency 'at' an angle no float can place."""
+def test_options_out_of_range_are_refused(extra, expected, no_work, tmp_path, capsys):
+    """--azimuth 1e300 gave a first frequency 'at' an angle no float can place; --timeout
+    1e300 waited for an unreachable scheduler for ever."""
     assert cli(["sweep", SCENE, "--out", str(tmp_path / "s.npz"), *extra]) == 2
     assert expected in one_error_line(capsys.readouterr().err)
 
