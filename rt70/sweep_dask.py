@@ -323,7 +323,10 @@ def _fault(exc: BaseException) -> str:
     if isinstance(exc, FutureCancelledError) and exc.reason == "scheduler-connection-lost":
         return "lost the connection to the Dask scheduler"
     if isinstance(exc, CancelledError):
-        reason = getattr(exc, "reason", "")
-        return f"cancelled by the Dask cluster ({reason or 'no reason given'})"
+        reason = getattr(exc, "reason", "") or "no reason given"
+        if reason == "lost dependencies":  # the inputs' task could not be loaded or kept
+            reason += ": the sweep's inputs; can the scheduler and workers import rt70 and "
+            reason += "the quantities' modules?"
+        return f"cancelled by the Dask cluster ({reason})"
     text = " ".join(str(exc).split())
     return f"lost the Dask scheduler ({type(exc).__name__}{': ' + text if text else ''})"

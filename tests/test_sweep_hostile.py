@@ -18,12 +18,10 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 import zipfile
 from pathlib import Path
 
-import cloudpickle
 import numpy as np
 import pytest
 
@@ -32,9 +30,6 @@ from rt70 import sweep_store
 from rt70.cli import main
 from rt70.errors import OutputError, ResourceError, Rt70Warning
 from rt70.sweep_quantities import QUANTITIES, Field, Quantity
-
-# the test quantities travel to Dask workers by value (the workers need not import this file)
-cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
 SCENE = "rt70_servo"
 URDF = Path(__file__).resolve().parents[1] / "urdf" / "rt70_servo.urdf"
@@ -764,41 +759,71 @@ def test_no_worker_left_stops_with_one_error_and_the_rerun_resumes(tmp_path):
     np.testing.assert_array_equal(resumed.arrays["gated"][:, 0, 0, 0], [10.0, 20.0, 30.0, 40.0])
 
 
+@pytest.fixture
+def external_cluster():
+    """``dask scheduler`` and ``dask worker --nworkers 2`` as processes of their own (their
+    output to /dev/null, as a cluster's is not the command's); killed at the end."""
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    here = Path(__file__).resolve().parent  # the scheduler unpickles this file's quantities
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(here.parent), str(here)]))
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    dask = [sys.executable, "-m", "dask"]
+    scheduler = subprocess.Popen(
+        [*dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+        start_new_session=True,
+        **quiet,
+    )
+    worker = subprocess.Popen(
+        [*dask, "worker", address, "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
+        start_new_session=True,
+        **quiet,
+    )
+    yield address, scheduler
+    for proc in (worker, scheduler):  # each in its own process group, with its children
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.wait()
+
+
 @pytest.mark.slow
-def test_the_scheduler_gone_mid_sweep_is_one_line_of_the_cli(tmp_path, capfd, monkeypatch):
-    """`rt70 sweep --scheduler`: the cluster closed from a second thread after the first
+def test_the_scheduler_killed_mid_sweep_is_one_line_of_the_cli(
+    external_cluster, tmp_path, capfd, monkeypatch
+):
+    """`rt70 sweep --scheduler`: the scheduler process killed (SIGKILL) once the first
     chunk is saved: exit 2, one line on stderr (no traceback, no Dask log line), the
-    chunk kept for the rerun."""
+    chunk kept for the rerun, which finishes in this process."""
+    address, scheduler = external_cluster
     gate = tmp_path / "gate"
     monkeypatch.setitem(QUANTITIES, "gated", gated(gate))
     out = tmp_path / "s.npz"
     real_save = sw.PartialResults.save
-    cluster = _cluster()
-    closer = threading.Thread(target=cluster.close)
 
     def save(self, result):
         real_save(self, result)
-        if closer.ident is None:
-            closer.start()
+        scheduler.kill()
 
     monkeypatch.setattr(sw.PartialResults, "save", save)
-    argv = ["sweep", SCENE, "--elevation", "10,20,30", "--chunk", "1", "--quantity", "gated"]
-    argv += ["--scheduler", cluster.scheduler_address, "--timeout", "2"]
-    try:
-        code = cli([*argv, "--out", str(out), "--no-progress"])
-        err = capfd.readouterr().err
-    finally:
-        gate.touch()  # the blocked tasks end, so the cluster's workers close promptly
-        if closer.ident is not None:
-            closer.join()
-        else:
-            cluster.close()
+    base = ["sweep", SCENE, "--elevation", "10,20,30", "--chunk", "1", "--quantity", "gated"]
+    base += ["--out", str(out), "--no-progress"]
+    code = cli([*base, "--scheduler", address, "--timeout", "60"])
+    err = capfd.readouterr().err
     assert code == 2
     line = one_error_line(err)
-    assert "Dask" in line and line.endswith(
-        f"1 finished chunk(s) kept in {out}.partial: rerun to resume"
-    )
-    assert len(list(Path(f"{out}.partial").glob("chunk-*.npz"))) == 1
+    assert ": lost the connection to the Dask scheduler; 1 finished chunk(s) kept in " in line
+    assert line.endswith(f"{out}.partial: rerun to resume")
+
+    monkeypatch.setattr(sw.PartialResults, "save", real_save)
+    gate.touch()
+    assert cli([*base, "--workers", "0", "--json"]) == 0
+    chunks = json.loads(capfd.readouterr().out)["chunks"]
+    assert chunks["resumed"] == 1 and chunks["computed"] == 2
 
 
 @pytest.mark.slow
