@@ -6,7 +6,9 @@
   tcp://…``), refused with :class:`~rt70.sweep.SweepError` when it cannot be reached
   within a timeout;
 - :func:`on_dask`: the executor of :func:`rt70.sweep.run` that submits one task per
-  chunk and yields the results as they finish (``distributed.as_completed``).
+  chunk and yields the results as they finish; a cluster that cannot finish (scheduler
+  gone, no worker left, a chunk whose workers keep dying) ends it with one
+  :class:`~rt70.sweep.ClusterError` (docs/sweeps.md, "Faults of the cluster").
 
 Every worker pins its BLAS to one thread (:class:`PinBlasThreads`, threadpoolctl) and
 builds each scene once (:func:`rt70.sweep.build_scene` caches it in the worker process).
