@@ -62,9 +62,10 @@ def add_parser(sub) -> argparse.ArgumentParser:
     )
     swp.add_argument(
         "--timeout",
-        type=options.positive_float,
+        type=_timeout,
         default=10.0,
-        help="seconds to wait for --scheduler (default 10)",
+        help="seconds to wait for --scheduler, and for a worker when the cluster has none "
+        "left (default 10)",
     )
     swp.add_argument(
         "--workers",
@@ -99,20 +100,28 @@ def run(args: argparse.Namespace) -> int:
     values = {k: getattr(args, k) for k in ("elevation", "azimuth", "wind", "direction")}
     grid = sw.make_grid({k: v for k, v in values.items() if v is not None}, dict(args.scale or []))
     quantities = args.quantity or sw.DEFAULT_QUANTITIES
-    plan = sw.plan(args.scene, grid, quantities, chunk=args.chunk)
     out = Path(args.out)
-    sw.PartialResults(out, plan).check()  # a foreign partial directory: refused up front
+    sw.check_output(out)
+    if args.scheduler is None and args.workers != 0:
+        from rt70.sweep_dask import check_workers, default_workers
+
+        check_workers(args.workers or default_workers())
+    plan = sw.plan(args.scene, grid, quantities, chunk=args.chunk)
+    store = sw.PartialResults(out, plan)
+    store.check()  # a foreign partial directory: refused up front
     progress = not args.no_progress
-    try:
-        if args.scheduler is None and args.workers == 0:
-            result = sw.run(plan, sw.serial, out, workers=0, progress=progress)
-            where = "in this process"
-        else:
-            result, where = _sweep_on_dask(args, plan, out, progress)
-    except KeyboardInterrupt:
-        partial = sw.PartialResults(out, plan).directory
-        print(f"rt70: finished chunks kept in {partial}; rerun to resume", file=sys.stderr)
-        raise
+    with store.locked():  # a second sweep on this --out: refused here, before a cluster starts
+        try:
+            if args.scheduler is None and args.workers == 0:
+                result = sw.run(plan, sw.serial, out, workers=0, progress=progress)
+                where = "in this process"
+            else:
+                result, where = _sweep_on_dask(args, plan, out, progress)
+        except KeyboardInterrupt:
+            print(
+                f"rt70: finished chunks kept in {store.directory}; rerun to resume", file=sys.stderr
+            )
+            raise
     meta = result.metadata
     if args.json:
         print(json.dumps(meta, indent=2))
@@ -120,9 +129,10 @@ def run(args: argparse.Namespace) -> int:
     axes = " × ".join(f"{len(a.values)} {a.name}" for a in grid.axes)
     chunks = meta["chunks"]
     print(f"{plan.source.name}: sweep of {grid.size} point(s) ({axes})")
+    again = f" ({chunks['recomputed']} of them untrusted files)" if chunks["recomputed"] else ""
     print(
         f"  {chunks['total']} chunk(s) of ≤ {plan.chunk}: {chunks['computed']} computed "
-        f"{where}, {chunks['resumed']} resumed; {meta['wall_time_s']:.2f} s wall"
+        f"{where}{again}, {chunks['resumed']} resumed; {meta['wall_time_s']:.2f} s wall"
     )
     for q in plan.quantities:
         for f in q.fields:
@@ -143,25 +153,31 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _sweep_on_dask(args: argparse.Namespace, plan, out, progress: bool):
-    """Run the sweep on the scheduler asked for, or on a local cluster started here."""
+    """Run the sweep on the scheduler asked for, or on a local cluster started here.
+
+    Dask's own log lines (a worker restarted, a connection lost) are silenced: a fault
+    that stops the sweep is one :class:`rt70.sweep.ClusterError` line.
+    """
+    import logging
     from contextlib import ExitStack
+
+    from distributed.utils import silence_logging_cmgr
 
     from rt70 import sweep as sw
     from rt70 import sweep_dask
 
     with ExitStack() as stack:
+        stack.enter_context(silence_logging_cmgr(logging.CRITICAL))
         if args.scheduler is not None:
             client = stack.enter_context(sweep_dask.connect(args.scheduler, args.timeout))
             where = f"on the cluster at {args.scheduler}"
         else:
-            from distributed import Client
-
-            cluster = stack.enter_context(sweep_dask.local_cluster(args.workers))
-            client = stack.enter_context(Client(cluster))
+            client = sweep_dask.start_local(stack, args.workers)
             where = "on a local Dask cluster"
         n = sweep_dask.workers_of(client)
         where += f" ({n} worker{'s' if n != 1 else ''})"
-        result = sw.run(plan, sweep_dask.on_dask(client), out, workers=n, progress=progress)
+        executor = sweep_dask.on_dask(client, worker_timeout=args.timeout)
+        result = sw.run(plan, executor, out, workers=n, progress=progress)
     return result, where
 
 
@@ -197,6 +213,19 @@ def _sweep_quantities(text: str) -> tuple[str, ...]:
         return quantity_names(text)
     except Rt70Error as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+#: Longest ``--timeout``, seconds: a scheduler or a worker not there within an hour is
+#: not coming (a larger number only turns a dead cluster into a hang).
+MAX_TIMEOUT = 3600.0
+
+
+def _timeout(text: str) -> float:
+    """Seconds to wait for a scheduler or a worker: 0 < T ≤ :data:`MAX_TIMEOUT`."""
+    value = options.positive_float(text)
+    if value > MAX_TIMEOUT:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_TIMEOUT:g} s (an hour), got {text}")
+    return value
 
 
 def _non_negative_int(text: str) -> int:

@@ -17,7 +17,7 @@ Two small registries, each cheap to extend (docs/sweeps.md):
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -96,12 +96,21 @@ class SweepPoint:
 
 @dataclass(frozen=True)
 class Field:
-    """One array a quantity fills: its name (a key of the NPZ file), shape per point, unit."""
+    """One array a quantity fills: its name (a key of the NPZ file), shape per point, unit.
+
+    Attributes
+    ----------
+    nan : str
+        What a NaN in this field means where it is not a failure (``frequencies``: a
+        spectrum shorter than the field). Empty: every NaN is a failed point, with an
+        error record (:func:`rt70.sweep.compute_chunk` makes it one).
+    """
 
     name: str
     shape: tuple[int, ...]
     unit: str
     description: str
+    nan: str = ""
 
 
 @dataclass(frozen=True)
@@ -179,6 +188,8 @@ def _first_frequency(scene: Scene, point: SweepPoint) -> dict[str, Any]:
     if drives:
         model = lin.locked_rotor(scene, model)
     result = modal.modes(model.M, model.K)
+    if result.freq_hz.size == 0:
+        raise Rt70Error("no mode: every coordinate is held")
     for mask, what in ((result.negative, "unstable"), (result.rigid, "rigid")):
         if mask.any():
             raise Rt70Error(f"{int(mask.sum())} {what} mode(s): no first frequency")
@@ -209,9 +220,30 @@ def _sag(scene: Scene, point: SweepPoint) -> dict[str, Any]:
 
 
 def _check_mirror(scene: Scene) -> None:
-    from rt70.scenes.rt70_optics import rt70_mirror_system
+    """Refuse a mirror system whose sag is undefined, before any work.
 
-    rt70_mirror_system(scene)  # raises naming the missing optical points
+    A missing or repeated optical point, or a focus on its mirror's vertex (no focal
+    axis n5 or n7, (4.155)).
+    """
+    from rt70.scenes.rt70_optics import OPTICAL_POINTS, rt70_mirror_system
+
+    system = rt70_mirror_system(scene)  # raises naming the missing optical points
+    names = [p.name for p in scene.description.optical_points]
+    repeated = sorted({n for n in names if n in OPTICAL_POINTS and names.count(n) > 1})
+    if repeated:
+        raise Rt70Error(
+            f"{scene.name}: <rt70:optical_point name='{repeated[0]}'> is given "
+            f"{names.count(repeated[0])} times: which one is meant?"
+        )
+    for focus, vertex, what in (
+        (system.main_focus, system.main_vertex, "main mirror"),
+        (system.cr_focus, system.cr_vertex, "counterreflector"),
+    ):
+        if focus[0] == vertex[0] and np.array_equal(focus[1], vertex[1]):
+            raise Rt70Error(
+                f"{scene.name}: the {what}'s focus and vertex are the same point "
+                f"({focus[0]} {' '.join(f'{x:g}' for x in focus[1])}): its axis is undefined"
+            )
 
 
 register_quantity(
@@ -219,7 +251,13 @@ register_quantity(
         "first_frequency",
         (
             Field("first_frequency", (), "Hz", "lowest locked-rotor eigenfrequency"),
-            Field("frequencies", (N_FREQUENCIES,), "Hz", "lowest six, ascending"),
+            Field(
+                "frequencies",
+                (N_FREQUENCIES,),
+                "Hz",
+                "lowest six, ascending",
+                nan="the spectrum has fewer modes than six: the missing ones",
+            ),
         ),
         _first_frequency,
         description="the locked-rotor spectrum's first frequency and its lowest six (Hz)",
@@ -297,11 +335,16 @@ register_quantity(
 
 @dataclass(frozen=True)
 class SceneParameter:
-    """A number of the scene scaled by a factor: ``apply(description, factor)``."""
+    """Numbers of the scene scaled by a factor: ``apply(description, factor)``.
+
+    ``values(description)`` lists the numbers ``apply`` scales (so that a factor which
+    would take one beyond what rt70 reads in a model is refused up front).
+    """
 
     name: str
     apply: Callable[[RobotDescription, float], RobotDescription]
     description: str
+    values: Callable[[RobotDescription], list[float]]
 
 
 def _scale_stiffness(desc: RobotDescription, f: float) -> RobotDescription:
@@ -322,6 +365,12 @@ def _scale_damping(desc: RobotDescription, f: float) -> RobotDescription:
     )
 
 
+def _structural(desc: RobotDescription, attribute: str) -> list[float]:
+    """The ``stiffness`` or ``damping`` numbers of every bushing and joint spring."""
+    numbers = [float(x) for b in desc.bushings for x in np.ravel(getattr(b, attribute))]
+    return numbers + [float(getattr(s, attribute)) for s in desc.joint_springs]
+
+
 def _scale_reducers(desc: RobotDescription, f: float) -> RobotDescription:
     return dataclasses.replace(
         desc, drives=[dataclasses.replace(d, C_r=d.C_r * f) for d in desc.drives]
@@ -337,17 +386,46 @@ PARAMETERS: dict[str, SceneParameter] = {
             _scale_stiffness,
             "the stiffness of every structural elastic element (bushings, strut-package "
             "struts, joint springs); their damping unchanged; drives' reducers unchanged",
+            lambda desc: _structural(desc, "stiffness"),
         ),
         SceneParameter(
             "damping",
             _scale_damping,
             "the damping of every structural elastic element (bushings, struts, joint springs)",
+            lambda desc: _structural(desc, "damping"),
         ),
         SceneParameter(
-            "reducer_stiffness", _scale_reducers, "the reducer stiffness C_r of every drive"
+            "reducer_stiffness",
+            _scale_reducers,
+            "the reducer stiffness C_r of every drive",
+            lambda desc: [float(d.C_r) for d in desc.drives],
         ),
     )
 }
+
+
+def check_factors(scene: Scene, name: str, factors: Sequence[float]) -> None:
+    """Refuse factors that take a number of the scene beyond what rt70 reads in a model.
+
+    Raises
+    ------
+    Rt70Error
+        ``--scale NAME``: the largest factor times the largest number it scales exceeds
+        :data:`rt70.urdf.reader.MAX_MAGNITUDE`.
+    """
+    from rt70.urdf.reader import MAX_MAGNITUDE
+
+    numbers = [abs(v) for v in PARAMETERS[name].values(scene.description)]
+    if not numbers or not factors:
+        return
+    with np.errstate(over="ignore"):
+        largest = np.float64(max(numbers)) * max(factors)
+    if not largest <= MAX_MAGNITUDE:
+        raise Rt70Error(
+            f"--scale {name}: factor {max(factors):g} times the largest "
+            f"{name.replace('_', ' ')} {max(numbers):g} of {scene.name} is {largest:.3g}, beyond "
+            f"{MAX_MAGNITUDE:g} (the largest number rt70 reads in a model)"
+        )
 
 
 def scaled_scene(scene: Scene, scales: Mapping[str, float]) -> Scene:

@@ -152,9 +152,9 @@ def test_dask_cluster_equals_serial_bit_for_bit(small, serial_result, tmp_path):
         assert workers_of(client) == 2
         out = tmp_path / "dask.npz"
         result = sw.run(small, on_dask(client), out, workers=2)
-        # a second sweep of the same scene on the same client: its scattered inputs are
-        # its own (content-hashed keys were released by the first run as it ended, and
-        # the second run's tasks were cancelled for "lost dependencies")
+        # a second sweep of the same scene on the same client: its inputs' task is its
+        # own (content-hashed keys were released by the first run as it ended, and the
+        # second run's tasks were cancelled for "lost dependencies")
         again = sw.run(small, on_dask(client), workers=2)
         # each worker process built the scene once and computed some chunks
         pids = client.run(lambda: __import__("os").getpid())
@@ -168,7 +168,12 @@ def test_dask_cluster_equals_serial_bit_for_bit(small, serial_result, tmp_path):
         expected = serial_result.arrays["first_frequency"]
         np.testing.assert_array_equal(data["first_frequency"], expected)
     meta = json.loads(sw.sidecar(out).read_text())
-    assert meta["workers"] == 2 and meta["chunks"] == {"total": 4, "resumed": 0, "computed": 4}
+    assert meta["workers"] == 2 and meta["chunks"] == {
+        "total": 4,
+        "resumed": 0,
+        "computed": 4,
+        "recomputed": 0,
+    }
 
 
 def test_cli_sweep_on_a_local_cluster(tmp_path, capsys, serial_result):
@@ -217,7 +222,7 @@ def test_resume_computes_only_the_missing_chunks(tmp_path):
     again: list[int] = []
     resumed = sw.run(sweep, sw.serial, out, on_chunk=lambda r: again.append(r.number))
     assert sorted(again) == [2, 3, 4]
-    assert resumed.metadata["chunks"] == {"total": 5, "resumed": 2, "computed": 3}
+    assert resumed.metadata["chunks"] == {"total": 5, "resumed": 2, "computed": 3, "recomputed": 0}
     assert out.exists() and not partial.exists()
     fresh = sw.run(sweep, sw.serial)
     np.testing.assert_array_equal(resumed.arrays["frequencies"], fresh.arrays["frequencies"])
