@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 from rt70 import sweep as sw
-from rt70 import sweep_store
+from rt70 import sweep_plan, sweep_store
 from rt70.cli import main
 from rt70.errors import OutputError, ResourceError, Rt70Warning
 from rt70.sweep_quantities import QUANTITIES, Field, Quantity
@@ -165,7 +165,8 @@ def test_a_sweep_too_large_for_memory_is_refused_before_work(
 def test_the_estimate_counts_results_errors_and_chunks(monkeypatch):
     grid = sw.make_grid({"elevation": tuple(range(10)), "azimuth": (0.0, 1.0, 2.0)})
     q = (CHEAP,)  # 3 numbers per point, one quantity
-    expected = 30 * (3 * sw.BYTES_PER_NUMBER + sw.BYTES_PER_ERROR) + 3 * 3 * sw.BYTES_PER_CHUNK
+    per_point = 3 * sweep_plan.BYTES_PER_NUMBER + sweep_plan.BYTES_PER_ERROR
+    expected = 30 * per_point + 3 * 3 * sweep_plan.BYTES_PER_CHUNK
     assert sw.peak_bytes(grid, q, chunk=4) == expected  # ceil(10 / 4) = 3 chunks per azimuth
     monkeypatch.setattr("rt70.resources.available_memory", lambda: 2 * expected)
     sw.check_size(grid, q, 4)  # exactly the share a run may use: accepted
