@@ -31,6 +31,7 @@ EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
 
 
 def _validate(args: argparse.Namespace) -> int:
+    from rt70.resources import check_reference
     from rt70.robots import UNEXPECTED, survey
     from rt70.scene import URDF_DIR, load_scene, require_coordinates, scene_names
     from rt70.validate import cross_check, format_table
@@ -56,6 +57,7 @@ def _validate(args: argparse.Namespace) -> int:
             return 1
         raise Rt70Error(f"no target could be checked ({reasons})")
     for scene in scenes:  # build both sides first: a model rt70 refuses exits 2
+        check_reference(scene.description)  # cheap: before the textbook's O(n³) mass check
         scene.textbook  # noqa: B018
         require_coordinates(scene)
         scene.reference  # noqa: B018  (Pinocchio must load it too)

@@ -63,6 +63,8 @@ class ReferenceModel:
     ----------
     pin_model, pin_model_no_gravity : pinocchio.Model
         Pinocchio's model with the scene's gravity, and a copy without gravity.
+    body_frames : dict of str to int
+        Index in ``pin_model.frames`` of each link's body frame (by link name).
     coords : list of Coordinate
         Every Pinocchio joint's book coordinates, in Pinocchio's joint order.
     coordinate_names : list of str
@@ -87,7 +89,11 @@ class ReferenceModel:
         self.pin_model = model
         self.pin_model_no_gravity = model.copy()
         self.pin_model_no_gravity.gravity.setZero()
-        bodies = {f.name: f for f in model.frames if f.type == pin.BODY}
+        self.body_frames = {}  # Pinocchio's getBodyId, without its scan of every frame
+        for index, frame in enumerate(model.frames):
+            if frame.type == pin.BODY:
+                self.body_frames.setdefault(frame.name, index)
+        bodies = {name: model.frames[i] for name, i in self.body_frames.items()}
         self.bushings = [
             Bushing(
                 _attachment(bodies, b.frame1),
