@@ -184,18 +184,33 @@ def _stacked(values: dict[str, np.ndarray]) -> np.ndarray:
     return np.concatenate(list(values.values())) if values else np.zeros(0)
 
 
-def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
-    """Value of ``fn()`` and its mean wall time over ``repeat`` calls after one warm-up.
+#: Wall time the repeated calls of one timed evaluation may take: a call slower than this
+#: is timed by its value call alone (:func:`_timed`), so a model whose evaluations take
+#: seconds (20 000 bushings) is not evaluated ``repeat`` more times for its timing.
+REPEAT_BUDGET_S = 0.1
 
-    With ``repeat = 0`` only the value is computed and the time is reported as 0.
+
+def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
+    """Value of ``fn()`` and its mean wall time over up to ``repeat`` calls after one warm-up.
+
+    The repeats are as many as fit in :data:`REPEAT_BUDGET_S` at the warm-up call's pace
+    (at most ``repeat``); none when that call alone took longer, and then its own time
+    is the one reported. With ``repeat = 0`` only the value is computed and the time is
+    reported as 0. Only the timing depends on the machine's pace: the value is always
+    the first call's.
     """
+    start = time.perf_counter()
     out = fn()
+    first = time.perf_counter() - start
     if repeat < 1:
         return out, 0.0
+    repeats = min(repeat, int(REPEAT_BUDGET_S / first)) if first > 0.0 else repeat
+    if repeats < 1:
+        return out, first
     start = time.perf_counter()
-    for _ in range(repeat):
+    for _ in range(repeats):
         fn()
-    return out, (time.perf_counter() - start) / repeat
+    return out, (time.perf_counter() - start) / repeats
 
 
 def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
@@ -429,7 +444,8 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
     the state (:func:`natural_scales`). A NaN or infinite value on either side makes
     the row's errors infinite and names the side in :attr:`Record.nonfinite`: such a
     row never passes. Each evaluation is timed as the mean of ``repeat`` calls after a
-    warm-up call.
+    warm-up call (fewer when they would take longer than :data:`REPEAT_BUDGET_S`:
+    :func:`_timed`).
 
     Raises
     ------
