@@ -31,9 +31,9 @@ The system is the KKT system of :func:`rt70.kkt.solve_kkt` for the jump
 (x = Δq̇ = q̇⁺ − q̇⁻, f = Γ, g = −(1 + e) B_c q̇⁻, λ = Λ; the same equations less
 ``A q̇⁻`` on both sides, so q̇⁻ does not make a round trip through A⁻¹, which would cost
 ε·cond(A) and leave q̇ changed by rounding where no row holds): redundant constraint
-rows give the unique q̇⁺ and the least-norm Λ. Plain linear algebra, no side imported: the textbook side's A and B_c go in here; the
-reference side solves the same impact with Pinocchio's ``impulseDynamics``
-(:mod:`rt70.reference.impact`).
+rows give the unique q̇⁺ and the least-norm Λ. Plain linear algebra, no side imported:
+the textbook side's A and B_c go in here; the reference side solves the same impact with
+Pinocchio's ``impulseDynamics`` (:mod:`rt70.reference.impact`).
 """
 
 from __future__ import annotations

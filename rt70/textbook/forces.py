@@ -166,10 +166,11 @@ def joint_spring_elements(model: Model, data: Data) -> CoordinateElements | None
 def bushing_deformations(model: Model, data: Data) -> tuple[np.ndarray, np.ndarray]:
     """δ (n_b, 6) and ``∂δ/∂q`` (n_b, 6, nv) of every bushing, all at once.
 
-    :func:`bushing_deformation` on every bushing of the model: the same steps on stacks of bushings (numpy's batched products), so that a scene with
-    tens of thousands of bushings costs a few array operations rather than a Python call
-    each; :func:`bushing_deformation` is the readable form and the reference, and the
-    tests hold the two equal.
+    :func:`bushing_deformation` on every bushing of the model: the same steps on stacks
+    of bushings (numpy's batched products), so that a scene with tens of thousands of
+    bushings costs a few array operations rather than a Python call each;
+    :func:`bushing_deformation` is the readable form and the reference, and the tests
+    hold the two equal.
 
     Raises
     ------
