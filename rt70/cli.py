@@ -31,7 +31,6 @@ EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from rt70.resources import check_reference
     from rt70.robots import UNEXPECTED, survey
     from rt70.scene import URDF_DIR, load_scene, require_coordinates, scene_names
     from rt70.validate import cross_check, format_table
@@ -57,10 +56,9 @@ def _validate(args: argparse.Namespace) -> int:
             return 1
         raise Rt70Error(f"no target could be checked ({reasons})")
     for scene in scenes:  # build both sides first: a model rt70 refuses exits 2
-        check_reference(scene.description)  # cheap: before the textbook's O(n³) mass check
+        scene.reference  # noqa: B018  Pinocchio's guards first: cheaper than the mass check
         scene.textbook  # noqa: B018
         require_coordinates(scene)
-        scene.reference  # noqa: B018  (Pinocchio must load it too)
     records = [r for scene in scenes for r in cross_check(scene, args.samples, args.seed)]
     if args.json:
         print(json.dumps([r.as_dict() for r in records], indent=2))
