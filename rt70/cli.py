@@ -49,9 +49,9 @@ def _validate(args: argparse.Namespace) -> int:
             return 1
         raise Rt70Error(f"no target could be checked ({reasons})")
     for scene in scenes:  # build both sides first: a model rt70 refuses exits 2
+        scene.reference  # noqa: B018  Pinocchio's guards first: cheaper than the mass check
         scene.textbook  # noqa: B018
         require_coordinates(scene)
-        scene.reference  # noqa: B018  (Pinocchio must load it too)
     records = [r for scene in scenes for r in cross_check(scene, args.samples, args.seed)]
     if args.json:
         print(json.dumps([r.as_dict() for r in records], indent=2))

@@ -27,11 +27,13 @@ the work of the known impulses ``W_Γ = ½ Γᵀ (q̇⁻ + q̇⁺)`` and of the 
 ``−W_Λ``. For a plastic impact without Γ it is Carnot's theorem,
 ``T⁻ − T⁺ = ½ (q̇⁻ − q̇⁺)ᵀ A (q̇⁻ − q̇⁺)`` (the kinetic energy of the lost velocities).
 
-The system is the KKT system of :func:`rt70.kkt.solve_kkt` (x = q̇⁺, f = A q̇⁻ + Γ,
-g = −e B_c q̇⁻, λ = Λ): redundant constraint rows give the unique q̇⁺ and the least-norm
-Λ. Plain linear algebra, no side imported: the textbook side's A and B_c go in here; the
-reference side solves the same impact with Pinocchio's ``impulseDynamics``
-(:mod:`rt70.reference.impact`).
+The system is the KKT system of :func:`rt70.kkt.solve_kkt` for the jump
+(x = Δq̇ = q̇⁺ − q̇⁻, f = Γ, g = −(1 + e) B_c q̇⁻, λ = Λ; the same equations less
+``A q̇⁻`` on both sides, so q̇⁻ does not make a round trip through A⁻¹, which would cost
+ε·cond(A) and leave q̇ changed by rounding where no row holds): redundant constraint
+rows give the unique q̇⁺ and the least-norm Λ. Plain linear algebra, no side imported:
+the textbook side's A and B_c go in here; the reference side solves the same impact with
+Pinocchio's ``impulseDynamics`` (:mod:`rt70.reference.impact`).
 """
 
 from __future__ import annotations
@@ -138,8 +140,8 @@ def solve_impact(
     qd0 = check_vector("qd_before", qd_before, n)
     e = check_restitution(restitution)
     gam = np.zeros(n) if gamma is None else check_vector("gamma", gamma, n)
-    sol = solve_kkt(A, B_c, A @ qd0 + gam, -e * (B_c @ qd0))
-    return impact_energies(A, B_c, qd0, sol.x, sol.lam, sol.rank, e, gam)
+    jump = solve_kkt(A, B_c, gam, -(1.0 + e) * (B_c @ qd0))  # x = Δq̇ = q̇⁺ − q̇⁻
+    return impact_energies(A, B_c, qd0, qd0 + jump.x, jump.lam, jump.rank, e, gam)
 
 
 def impact_energies(

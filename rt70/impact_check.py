@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rt70.kkt import schur_pinv
 from rt70.locks import BRAKE_JOINT_TYPES, Brake, Lock, StowPin, constraint_rows, engage
 from rt70.scene import Scene
 
@@ -116,7 +117,7 @@ def impact_scales(
         at_v, at_l = at_v + q.size, at_l + B.shape[0]
         dv = np.abs(qd_after - qd)
         speeds.append(np.abs(A_inv) @ (absA @ (absq + np.abs(qd_after)) + np.abs(B).T @ lam))
-        W_pinv = np.linalg.pinv(B @ A_inv @ B.T, rcond=1e-10)
+        W_pinv = schur_pinv(A, B)
         through_A = np.abs(W_pinv @ B @ A_inv) @ (absA @ dv + np.abs(B).T @ lam)
         impulses.append(through_A + np.abs(W_pinv) @ (np.abs(B) @ ((1.0 + e) * absq + dv)))
     return {"impact": np.concatenate(speeds), "impulse": np.concatenate(impulses)}

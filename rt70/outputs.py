@@ -17,6 +17,7 @@ points on both sides.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -98,8 +99,8 @@ def _check(outputs: Sequence[Output], side: str) -> None:
     """Refuse an unknown side or two outputs of one name."""
     if side not in SIDES:
         raise Rt70Error(f"unknown side '{side}' (choose from {', '.join(SIDES)})")
-    names = [o.name for o in outputs]
-    repeated = sorted({n for n in names if names.count(n) > 1})
+    counts = Counter(o.name for o in outputs)
+    repeated = sorted(n for n, k in counts.items() if k > 1)
     if repeated:
         raise Rt70Error(f"outputs named more than once: {', '.join(repeated)}")
 

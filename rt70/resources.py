@@ -20,8 +20,16 @@ Parser depth
     Pinocchio's URDF parser recurses once per level of the kinematic tree, about
     2.2 KiB of stack per level: with the usual 8 MiB stack it segfaults at a depth of
     about 3770 links (any joint type; a wide tree is harmless). It is therefore run in a
-    thread with a :data:`PARSER_STACK_BYTES` stack (room for about 30 000 levels) and a
-    tree deeper than :data:`PARSER_MAX_DEPTH` is refused before the parser sees it.
+    thread with a :data:`PARSER_STACK_BYTES` stack (256 MiB: room for about 120 000
+    levels; a chain of 40 000 fixed joints parses on 128 MiB, and segfaults on 64 MiB)
+    and a tree deeper than :data:`PARSER_MAX_DEPTH` is refused before the parser sees it.
+The textbook's mass check
+    Building the textbook model checks that every coordinate moves mass
+    (:mod:`rt70.textbook.massless`) with the structured mass matrix: its ancestor matrix
+    (``nb × nb``) and about eight ``n × n`` arrays (the coordinates' weights, A, its
+    scaled form, the Cholesky factor, and the eigenvectors when A is singular) —
+    :func:`massless_peak_bytes`. A 20 000-link revolute chain would need 35 GB; it is
+    refused before the check starts (:func:`check_massless`).
 
 Nothing here imports Pinocchio.
 """
@@ -41,12 +49,12 @@ from rt70.urdf.description import RobotDescription
 MEMORY_FRACTION = 0.5
 
 #: Stack of the thread that runs Pinocchio's URDF parser (virtual; only the pages the
-#: recursion touches become resident).
-PARSER_STACK_BYTES = 64 * 2**20
+#: recursion touches become resident: about 45 MB for 20 000 levels).
+PARSER_STACK_BYTES = 256 * 2**20
 
 #: Deepest kinematic tree (links from the root, the root included) handed to the
 #: parser: a third of what the measured 2.2 KiB per level allows on its stack.
-PARSER_MAX_DEPTH = 10_000
+PARSER_MAX_DEPTH = 40_000
 
 _MEMINFO = Path("/proc/meminfo")
 _DOFS = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
@@ -88,6 +96,18 @@ def textbook_peak_bytes(nb: int, n_full: int) -> int:
     (nb = 100 … 800) and floating joints.
     """
     return 8 * (144 * nb**2 + 24 * nb * n_full + 4 * n_full**2)
+
+
+def massless_peak_bytes(nb: int, n_full: int) -> int:
+    """Peak memory of the textbook's check that every coordinate moves mass, bytes.
+
+    ``8 (nb² + 10 n²)``: the ancestor matrix and ten ``n × n`` arrays of the structured
+    mass matrix, its factor and (when A is singular) ``eigh``. It lies 28–64 % above the
+    measured peaks of :func:`rt70.textbook.massless.check_moves_mass` on chains of
+    revolute (n = 500 … 3000), planar and floating joints, and on a chain whose last two
+    coaxial joints move no mass (the ``eigh`` path; ``validation/resource_limits.py``).
+    """
+    return 8 * (nb**2 + 10 * n_full**2)
 
 
 def pinocchio_size(desc: RobotDescription) -> tuple[int, int]:
@@ -154,6 +174,16 @@ def check_textbook(nb: int, n_full: int, source: str) -> None:
     check_memory(
         textbook_peak_bytes(nb, n_full),
         f"the textbook side's dense matrices for {nb} bodies ({6 * nb} × {6 * nb})",
+        source,
+    )
+
+
+def check_massless(nb: int, n_full: int, source: str) -> None:
+    """Refuse a textbook model whose mass check (:func:`massless_peak_bytes`) cannot fit."""
+    check_memory(
+        massless_peak_bytes(nb, n_full),
+        f"the textbook side's check that every coordinate moves mass ({n_full} × {n_full} "
+        f"mass matrix and its factor, {nb} bodies)",
         source,
     )
 

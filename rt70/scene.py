@@ -10,7 +10,7 @@ from functools import cached_property
 from pathlib import Path
 
 from rt70.errors import Rt70Warning, SceneError
-from rt70.resources import check_textbook
+from rt70.resources import check_massless, check_textbook
 from rt70.textbook.data import Data
 from rt70.textbook.massless import check_moves_mass
 from rt70.textbook.model import Model, build_model
@@ -94,8 +94,12 @@ class Scene:
         MasslessCoordinateError
             If a coordinate, or a combination of coordinates, moves no mass
             (:mod:`rt70.textbook.massless`).
+        ResourceError
+            If that check would not fit in this machine's memory
+            (:func:`rt70.resources.check_massless`).
         """
         model = build_model(self.description)
+        check_massless(model.nb, model.n_full, self.description.source)
         check_moves_mass(model, self.description.source)
         return model
 

@@ -185,18 +185,33 @@ def _stacked(values: dict[str, np.ndarray]) -> np.ndarray:
     return np.concatenate(list(values.values())) if values else np.zeros(0)
 
 
-def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
-    """Value of ``fn()`` and its mean wall time over ``repeat`` calls after one warm-up.
+#: Wall time the repeated calls of one timed evaluation may take: a call slower than this
+#: is timed by its value call alone (:func:`_timed`), so a model whose evaluations take
+#: seconds (20 000 bushings) is not evaluated ``repeat`` more times for its timing.
+REPEAT_BUDGET_S = 0.1
 
-    With ``repeat = 0`` only the value is computed and the time is reported as 0.
+
+def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
+    """Value of ``fn()`` and its mean wall time over up to ``repeat`` calls after one warm-up.
+
+    The repeats are as many as fit in :data:`REPEAT_BUDGET_S` at the warm-up call's pace
+    (at most ``repeat``); none when that call alone took longer, and then its own time
+    is the one reported. With ``repeat = 0`` only the value is computed and the time is
+    reported as 0. Only the timing depends on the machine's pace: the value is always
+    the first call's.
     """
+    start = time.perf_counter()
     out = fn()
+    first = time.perf_counter() - start
     if repeat < 1:
         return out, 0.0
+    repeats = min(repeat, int(REPEAT_BUDGET_S / first)) if first > 0.0 else repeat
+    if repeats < 1:
+        return out, first
     start = time.perf_counter()
-    for _ in range(repeat):
+    for _ in range(repeats):
         fn()
-    return out, (time.perf_counter() - start) / repeat
+    return out, (time.perf_counter() - start) / repeats
 
 
 def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
@@ -327,6 +342,9 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
       the ground origin (a position is a sum of the bodies' offsets);
     - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
       ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel;
+    - drives (``[θ_d, Q]`` of the scene's drives and :func:`state_drive`), per entry: the
+      positions θ_d is computed from over the mesh radius, and the mesh forces' terms
+      ``|J_v|ᵀ|F|`` (:func:`_drive_scale`);
     - impact, impulse (q̇⁺ and Λ of a random brake and stow pin): their first-order
       rounding bounds, entry by entry (:func:`rt70.impact_check.impact_scales`);
     - the loop rows of a scene with ``<rt70:loop>``: :func:`rt70.loop_check.loop_scales`.
@@ -375,7 +393,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         "potential_energy": g0 + reference.spring_potential(ref, rd, q),
         "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
         "load_force": _load_scale(scene, q),
-        "drives": norm("drives"),
+        "drives": _drive_scale(scene, q),
         "reactions": reaction_scale(scene, q, qd, state_wrench(scene, q)),
         **impact_scales(scene, q, qd, {k: values[k][1] for k in ("impact", "impulse")}),
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
@@ -392,6 +410,43 @@ def _load_scale(scene: Scene, q: np.ndarray) -> float:
     Jv, Jw = ref_points.point_jacobian(scene.reference, scene.reference_data, q, w.link, w.xyz)
     terms = np.abs(Jv).T @ np.abs(w.force) + np.abs(Jw).T @ np.abs(w.torque)
     return float(np.max(terms, initial=0.0))
+
+
+def _drive_scale(scene: Scene, q: np.ndarray) -> np.ndarray:
+    """Per entry of the ``drives`` row (``[θ_d, Q]`` per drive): the size of its terms.
+
+    A gear sector's ``θ_d = atan2(v·d, u·d)`` with ``d = P − centre`` and P the mesh
+    point in the stator's axes, ``R_sᵀ (p_l + R_l xyz − p_s)``: a rounding of those
+    positions moves θ_d by ε times ``(|p_l| + |xyz| + |p_s| + |centre|) / |d|``. Its
+    ``Q = Σ J_vᵀ F`` of the mesh force on the link and its reaction on the stator:
+    ``Σ |J_v|ᵀ |F|``, the terms before they cancel — which they do exactly when the
+    link and the stator move as one (a mimic joint with multiplier 0 between them, say:
+    then θ_d and Q are zero and both sides compute rounding). A torque drive's θ_d and
+    Q (the coordinate and a unit vector) are exact on both sides: 0, their own size.
+    Pinocchio's poses and Jacobians.
+    """
+    from rt70.reference import drives as ref_drives
+    from rt70.reference import points as ref_points
+
+    ref, rd = scene.reference, scene.reference_data
+    scales = []
+    for drive in [*scene.description.drives, state_drive(scene, q)]:
+        if drive.sector is None:
+            scales.append(np.zeros(1 + ref.nv))
+            continue
+        s = drive.sector
+        mesh = ref_drives.sector_mesh(ref, rd, drive)
+        link = ref_drives.link_pose(ref, rd, q, s.link)
+        stator = ref_drives.link_pose(ref, rd, q, s.stator)
+        _, _, P = mesh.angle(s.xyz, link, stator)
+        lengths = np.linalg.norm([link[1], s.xyz, stator[1], mesh.centre], axis=1).sum()
+        angle = lengths / float(np.linalg.norm(P - mesh.centre))
+        terms = np.zeros(ref.nv)
+        for w in mesh.wrenches(s.link, s.stator, s.xyz, 1.0, link, stator):
+            Jv, _ = ref_points.point_jacobian(ref, rd, q, w.link, w.xyz)
+            terms += np.abs(Jv).T @ np.abs(np.asarray(w.force))
+        scales.append(np.concatenate([[angle], terms]))
+    return np.concatenate(scales)
 
 
 def _wind_scale(scene: Scene, q: np.ndarray) -> float:
@@ -430,7 +485,8 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
     the state (:func:`natural_scales`). A NaN or infinite value on either side makes
     the row's errors infinite and names the side in :attr:`Record.nonfinite`: such a
     row never passes. Each evaluation is timed as the mean of ``repeat`` calls after a
-    warm-up call.
+    warm-up call (fewer when they would take longer than :data:`REPEAT_BUDGET_S`:
+    :func:`_timed`).
 
     Raises
     ------

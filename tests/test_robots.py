@@ -24,8 +24,6 @@ NOT_LOADED = {
     "finger_edu": "InertiaError",
     "hector": "SceneError",
     "hyq": "InertiaError",
-    "icub": "InertiaError",
-    "icub_reduced": "InertiaError",
     "iris": "SceneError",
     "pr2": "InertiaError",
     "romeo": "MasslessCoordinateError",

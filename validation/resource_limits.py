@@ -4,13 +4,16 @@ Every measurement runs in a fresh subprocess (a model that is too large, or a pa
 that segfaults, cannot take this script down):
 
 - memory: growth of the anonymous resident set at its peak (``VmHWM`` less the
-  file-backed pages) while building a ReferenceModel and its ReferenceData, and
-  of one call of every dense textbook function on a fresh Data, for serial chains of
+  file-backed pages) while building a ReferenceModel and its ReferenceData, of one
+  call of every dense textbook function on a fresh Data, and of the textbook's mass
+  check (``rt70.textbook.massless``), for serial chains of
   revolute, planar and floating joints; printed beside the estimates of
   ``rt70.resources`` with a least-squares fit ``a nv³ + b nv² + c`` of the reference side;
 - parser depth: the deepest chain of fixed joints Pinocchio's URDF parser survives, by
-  bisection, on the main thread (the process's stack limit, ``ulimit -s``) and in a
-  thread with ``rt70.resources.PARSER_STACK_BYTES``.
+  bisection, on the main thread (the process's stack limit, ``ulimit -s``); and that a
+  chain ``rt70.resources.PARSER_MAX_DEPTH`` deep parses in a thread with
+  ``rt70.resources.PARSER_STACK_BYTES`` (one run: the parser's time grows with the
+  square of the frames, about 4.5 minutes for 40 000 levels).
 
     python validation/resource_limits.py [--quick]
 
@@ -47,6 +50,13 @@ if side == "reference":
     ref = ReferenceModel(desc, scene.text)
     ReferenceData(ref)
     nv, nb = ref.pin_model.nv, ref.pin_model.njoints
+elif side == "massless":
+    from rt70.textbook.massless import check_moves_mass
+    from rt70.textbook.model import build_model
+    m = build_model(desc)
+    base = status()
+    check_moves_mass(m, "chain")
+    nv, nb = m.n_full, m.nb
 else:
     from rt70.textbook import dynamics, forces
     from rt70.textbook.data import Data
@@ -168,6 +178,20 @@ def main() -> int:
             flush=True,
         )
 
+    print("\ntextbook side's mass check (rt70.textbook.massless.check_moves_mass)")
+    print(f"{'joint':>9} {'nb':>5} {'n':>5} {'peak MB':>10} {'estimate MB':>12} {'est/peak':>9}")
+    massless_cases = [("revolute", 500), ("revolute", 1000), ("floating", 100)]
+    if not args.quick:
+        massless_cases += [("revolute", 2000), ("revolute", 3000), ("planar", 1000)]
+    for joint, n in massless_cases:
+        r = measure("massless", n, joint)
+        est = resources.massless_peak_bytes(r["nb"], r["nv"])
+        print(
+            f"{joint:>9} {r['nb']:>5} {r['nv']:>5} {r['peak'] / 1e6:>10.1f} "
+            f"{est / 1e6:>12.1f} {est / r['peak']:>9.3f}",
+            flush=True,
+        )
+
     stack = resource.getrlimit(resource.RLIMIT_STACK)[0]
     print("\nPinocchio URDF parser, chain of fixed joints")
     if stack != resource.RLIM_INFINITY:
@@ -177,12 +201,12 @@ def main() -> int:
             f"{hi} ({stack / hi:.0f} bytes per level)",
             flush=True,
         )
-    if not args.quick:
-        size = resources.PARSER_STACK_BYTES
-        lo, hi = parser_limit("thread", 1000, 8 * size // 2048)
+    if not args.quick:  # the parser is quadratic in the frames: minutes at this depth
+        size, depth = resources.PARSER_STACK_BYTES, resources.PARSER_MAX_DEPTH
+        ok = parses(depth, "thread")
         print(
-            f"parser thread, stack {size / 2**20:.0f} MiB: parses {lo} levels, segfaults at "
-            f"{hi}; rt70 refuses trees deeper than {resources.PARSER_MAX_DEPTH}"
+            f"parser thread, stack {size / 2**20:.0f} MiB: {depth} levels (the deepest tree "
+            f"rt70 hands to the parser) {'parse' if ok else 'CRASH'}"
         )
     return 0
 

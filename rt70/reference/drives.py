@@ -18,7 +18,6 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from rt70.errors import UnknownLinkError
 from rt70.loads import Pose, SectorMesh
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import ReferenceData, ReferenceModel
@@ -29,12 +28,10 @@ from rt70.urdf.description import Drive
 def link_pose(model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: str) -> Pose:
     """Rotation and origin of ``link``'s frame in ground axes at q (Pinocchio's placements)."""
     m, d = model.pin_model, data.pin_data
-    if not m.existBodyName(link):
-        raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
-    frame = m.frames[m.getBodyId(link)]
+    joint, placement = link_point(model, link, np.zeros(3))
     qp = to_pinocchio(model, q)[0]
     pin.forwardKinematics(m, d, qp)
-    placed = d.oMi[frame.parentJoint] * frame.placement
+    placed = d.oMi[joint] * placement
     return placed.rotation.copy(), placed.translation.copy()
 
 

@@ -27,7 +27,7 @@ import pinocchio as pin
 from rt70.arrays import check_vector
 from rt70.errors import SingularConfigurationError
 from rt70.reference.coordinates import to_pinocchio
-from rt70.reference.model import ReferenceData, ReferenceModel
+from rt70.reference.model import FrameStack, ReferenceData, ReferenceModel
 
 #: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
 GIMBAL_LOCK_COS = 1e-8
@@ -244,7 +244,9 @@ def deformations(model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jac
     """δ of every bushing (n_b, 6) and ∂δ/∂v (n_b, 6, nv), from Pinocchio's kinematics.
 
     Frame placements ``oMi · placement`` and local frame Jacobians (Pinocchio's
-    ``getFrameJacobian`` of a joint and a placement) come from Pinocchio; the relative
+    ``getFrameJacobian`` of a joint and a placement: the joint's ``LOCAL`` Jacobian moved
+    by the placement's ``toActionMatrixInverse``) come from Pinocchio, one call per
+    parent joint, applied to every frame at once (:class:`FrameStack`); the relative
     placement, Pinocchio's roll-pitch-yaw of its transpose and the inverse world rpy
     Jacobian are evaluated for all bushings at once (the formulas of
     ``pin.rpy.matrixToRpy`` / ``computeRpyJacobianInverse``, checked against them in
@@ -257,13 +259,9 @@ def deformations(model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jac
         pin.computeJointJacobians(m, d, qp)
     else:
         pin.forwardKinematics(m, d, qp)
-    f1, f2 = model.frames1, model.frames2
-    M1 = [d.oMi[joint] * placement for joint, placement in f1]
-    M2 = [d.oMi[joint] * placement for joint, placement in f2]
-    R1 = np.array([M.rotation for M in M1])
-    R2 = np.array([M.rotation for M in M2])
-    p1 = np.array([M.translation for M in M1])
-    p2 = np.array([M.translation for M in M2])
+    f1, f2 = model.stack1, model.stack2
+    R1, p1 = _placed(d, f1)
+    R2, p2 = _placed(d, f2)
     R1t = np.swapaxes(R1, -1, -2)
     c12 = R1t @ R2
     r12 = (R1t @ (p2 - p1)[..., None])[..., 0]
@@ -277,20 +275,35 @@ def deformations(model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jac
     delta = np.concatenate([r12, -np.stack([roll, pitch, yaw], axis=1)], axis=1)
     if not jacobian:
         return delta, None
-    J1 = np.array([pin.getFrameJacobian(m, d, *f, pin.LOCAL) for f in f1]).reshape(-1, 6, m.nv)
-    J2 = np.array([pin.getFrameJacobian(m, d, *f, pin.LOCAL) for f in f2]).reshape(-1, 6, m.nv)
+    joints = np.union1d(f1.joints, f2.joints)
+    joint_jac = np.zeros((m.njoints, 6, m.nv))  # each parent joint's LOCAL Jacobian, once
+    for joint in joints:
+        joint_jac[joint] = pin.getJointJacobian(m, d, int(joint), pin.LOCAL)
+    J1 = f1.act_inverse @ joint_jac[f1.joints]  # getFrameJacobian(…, LOCAL), all frames
+    J2 = f2.act_inverse @ joint_jac[f2.joints]
     # J_rel = J2 − Ad(M12⁻¹) J1; δ̇_trans = c12 v_rel, φ̇ = J_W(ρ)⁻¹ ω_rel
     lin1 = J1[:, :3] - _skew(r12) @ J1[:, 3:]
     jac = np.empty_like(J2)
     jac[:, :3] = c12 @ J2[:, :3] - lin1
     w_rel = J2[:, 3:] - ct @ J1[:, 3:]
     cy, sy, tp = np.cos(yaw), np.sin(yaw), np.tan(pitch)
-    inv = np.zeros((len(f1), 3, 3))
+    inv = np.zeros((len(R1), 3, 3))
     inv[:, 0, 0], inv[:, 0, 1] = cy / cp, sy / cp
     inv[:, 1, 0], inv[:, 1, 1] = -sy, cy
     inv[:, 2, 0], inv[:, 2, 1], inv[:, 2, 2] = cy * tp, sy * tp, 1.0
     jac[:, 3:] = inv @ w_rel
     return delta, jac
+
+
+def _placed(d: pin.Data, frames: FrameStack) -> tuple[np.ndarray, np.ndarray]:
+    """Rotations (n, 3, 3) and origins (n, 3) of the frames, ``oMi[joint] · placement``."""
+    joints = np.unique(frames.joints)
+    R_joint = np.zeros((int(joints.max(initial=0)) + 1, 3, 3))
+    p_joint = np.zeros((len(R_joint), 3))
+    for joint in joints:
+        R_joint[joint], p_joint[joint] = d.oMi[int(joint)].rotation, d.oMi[int(joint)].translation
+    R, p = R_joint[frames.joints], p_joint[frames.joints]
+    return R @ frames.rotations, p + (R @ frames.translations[..., None])[..., 0]
 
 
 def _joint_angles(model: ReferenceModel, qp: np.ndarray) -> np.ndarray:

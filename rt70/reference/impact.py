@@ -185,7 +185,9 @@ def _reduced_impact(
     (:func:`rt70.reference.dynamics.forward_dynamics`), the reduced equations
     ``A = Jᵀ crba J`` with the rows ``B_c = J_c J`` are solved instead — the KKT matrix
     of an orthonormal basis of the rows by LU (numpy), not by the textbook's
-    range-space method.
+    range-space method. They are solved for the jump ``Δq̇ = q̇⁺ − q̇⁻`` (not for q̇⁺
+    from ``A q̇⁻``, whose round trip through A⁻¹ costs ε·cond(A)), so rows that hold
+    nothing — a brake on a mimic joint of multiplier 0 — leave q̇ exactly unchanged.
     """
     n = model.nv
     A = mass_matrix(model, data, q)
@@ -193,6 +195,6 @@ def _reduced_impact(
     r = B_hat.shape[0]
     gam = np.zeros(n) if gamma is None else gamma
     K = np.block([[A, B_hat.T], [B_hat, np.zeros((r, r))]])
-    rhs = np.concatenate([A @ qd + gam, -restitution * (B_hat @ qd)])
-    sol = np.linalg.solve(K, rhs)
-    return sol[:n], U_r @ -sol[n:]  # A x + B̂ᵀ y = f: y = −Λ̂
+    rhs = np.concatenate([gam, -(1.0 + restitution) * (B_hat @ qd)])
+    sol = np.linalg.solve(K, rhs)  # the jump: A Δq̇ + B̂ᵀ y = Γ, B̂ Δq̇ = −(1 + e) B̂ q̇⁻
+    return qd + sol[:n], U_r @ -sol[n:]  # y = −Λ̂

@@ -36,6 +36,42 @@ class Bushing:
 
 
 @dataclass(frozen=True)
+class FrameStack:
+    """Frames fixed to links, as arrays: what Pinocchio's frame algorithms read, stacked.
+
+    Built once from ``(parent joint, placement)`` pairs so that the placements and
+    Jacobians of tens of thousands of frames (bushings) are a few array products of
+    Pinocchio's per-joint results rather than a Pinocchio call each
+    (:func:`rt70.reference.forces.deformations`).
+
+    Attributes
+    ----------
+    joints : numpy.ndarray
+        Parent joint of each frame, (n,).
+    rotations, translations : numpy.ndarray
+        Each placement in its joint, (n, 3, 3) and (n, 3).
+    act_inverse : numpy.ndarray
+        Pinocchio's ``placement.toActionMatrixInverse()`` of each, (n, 6, 6): a joint's
+        ``LOCAL`` Jacobian to the frame's (``getFrameJacobian``'s ``placement.actInv``).
+    """
+
+    joints: np.ndarray
+    rotations: np.ndarray
+    translations: np.ndarray
+    act_inverse: np.ndarray
+
+    @classmethod
+    def of(cls, frames: list[tuple[int, pin.SE3]]) -> FrameStack:
+        """The stack of ``frames`` (parent joint, placement), in order."""
+        return cls(
+            np.array([joint for joint, _ in frames], dtype=int),
+            np.array([placement.rotation for _, placement in frames]).reshape(-1, 3, 3),
+            np.array([placement.translation for _, placement in frames]).reshape(-1, 3),
+            np.array([p.toActionMatrixInverse() for _, p in frames]).reshape(-1, 6, 6),
+        )
+
+
+@dataclass(frozen=True)
 class Coordinate:
     """One Pinocchio joint seen in book coordinates."""
 
@@ -63,6 +99,8 @@ class ReferenceModel:
     ----------
     pin_model, pin_model_no_gravity : pinocchio.Model
         Pinocchio's model with the scene's gravity, and a copy without gravity.
+    body_frames : dict of str to int
+        Index in ``pin_model.frames`` of each link's body frame (by link name).
     coords : list of Coordinate
         Every Pinocchio joint's book coordinates, in Pinocchio's joint order.
     coordinate_names : list of str
@@ -75,6 +113,9 @@ class ReferenceModel:
         Velocity index, stiffness and damping of every joint spring.
     winds, air_density : tuple of rt70.urdf.Wind, float
         The scene's exposed bodies and air density (:mod:`rt70.reference.wind`).
+    frames1, frames2 : list of (int, pinocchio.SE3)
+        Each bushing's frames 1 and 2 (parent joint, placement); ``stack1``, ``stack2``
+        the same as :class:`FrameStack` arrays.
     loops : list of (int, (int, pinocchio.SE3), (int, pinocchio.SE3))
         Rows and the two frames (parent joint, placement) of every loop closure.
     """
@@ -87,7 +128,11 @@ class ReferenceModel:
         self.pin_model = model
         self.pin_model_no_gravity = model.copy()
         self.pin_model_no_gravity.gravity.setZero()
-        bodies = {f.name: f for f in model.frames if f.type == pin.BODY}
+        self.body_frames = {}  # Pinocchio's getBodyId, without its scan of every frame
+        for index, frame in enumerate(model.frames):
+            if frame.type == pin.BODY:
+                self.body_frames.setdefault(frame.name, index)
+        bodies = {name: model.frames[i] for name, i in self.body_frames.items()}
         self.bushings = [
             Bushing(
                 _attachment(bodies, b.frame1),
@@ -103,6 +148,7 @@ class ReferenceModel:
         ]
         self.frames1 = [b.frame1 for b in self.bushings]
         self.frames2 = [b.frame2 for b in self.bushings]
+        self.stack1, self.stack2 = FrameStack.of(self.frames1), FrameStack.of(self.frames2)
         self.stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6)
         self.damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6)
         self.coords, self.coordinate_names = _coordinates(model, desc)

@@ -34,9 +34,9 @@ def link_point(model: ReferenceModel, link: str, xyz) -> tuple[int, pin.SE3]:
         If Pinocchio has no body frame called ``link``.
     """
     m = model.pin_model
-    if not m.existBodyName(link):
+    if link not in model.body_frames:
         raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
-    frame = m.frames[m.getBodyId(link)]
+    frame = m.frames[model.body_frames[link]]
     offset = pin.SE3(np.eye(3), check_vector(f"point of link '{link}'", xyz, 3))
     return frame.parentJoint, frame.placement * offset
 

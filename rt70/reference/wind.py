@@ -65,7 +65,7 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
 
     from rt70.reference.element_kernels import RelativePoints
 
-    if not all(model.pin_model.existBodyName(w.link) for w in model.winds):
+    if not all(w.link in model.body_frames for w in model.winds):
         return slow  # its error names the link
     points = [link_point(model, w.link, w.xyz) for w in model.winds]
     ground = [(0, pin.SE3.Identity())] * len(points)

@@ -9,7 +9,8 @@ energy audit (1.73) closes. The book's direct pair (4.83) and strut package
 The element kinds are listed once, in :data:`ELEMENTS`: the ``RobotDescription`` list
 each is read into, and the function giving the deformations of all its elements
 (:class:`CoordinateElements` when each δ is a pair coordinate, :class:`GeneralElements`
-with one :class:`Deformation` per element otherwise). The sums over them —
+with a δ and a dense ∂δ/∂q per element otherwise — one :class:`Deformation` each, the
+readable form; bushings are computed all at once by its vectorised twin). The sums over them —
 :func:`spring_damper_force`, :func:`spring_potential` — are written once, for every kind.
 The reference side (:mod:`rt70.reference.forces`) lists the same kinds, computed
 independently from Pinocchio's kinematics.
@@ -31,7 +32,12 @@ from rt70.textbook.kinematics import (
     update_structure,
 )
 from rt70.textbook.model import BushingModel, Model
-from rt70.textbook.spatial import euler123_angles, euler_matrix_inverse, placement
+from rt70.textbook.spatial import (
+    GIMBAL_LOCK_COS,
+    euler123_angles,
+    euler_matrix_inverse,
+    placement,
+)
 
 
 @dataclass(frozen=True)
@@ -108,33 +114,42 @@ class GeneralElements:
 
     Attributes
     ----------
-    deformations : list of Deformation
-        δ and ``∂δ/∂q`` of each element.
+    delta : numpy.ndarray
+        δ of each element, shape (n_e, k).
+    jacobian : numpy.ndarray
+        ``∂δ/∂q`` of each element, shape (n_e, k, nv).
     stiffness, damping : numpy.ndarray
         Diagonals of C and D of each element, shape (n_e, k).
     """
 
-    deformations: list[Deformation]
+    delta: np.ndarray
+    jacobian: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
 
-    @property
-    def delta(self) -> np.ndarray:
-        """δ of each element, shape (n_e, k)."""
-        return np.array([d.delta for d in self.deformations])
+    @classmethod
+    def of(
+        cls, deformations: list[Deformation], stiffness: np.ndarray, damping: np.ndarray
+    ) -> GeneralElements:
+        """The elements of a list of :class:`Deformation` (one per element), stacked."""
+        return cls(
+            np.array([d.delta for d in deformations]),
+            np.array([d.jacobian for d in deformations]),
+            stiffness,
+            damping,
+        )
 
     def rate(self, model: Model, qd: np.ndarray) -> np.ndarray:
         """``δ̇ = (∂δ/∂q) q̇`` of each element, shape (n_e, k)."""
-        return np.array([d.jacobian @ qd for d in self.deformations])
+        return self.jacobian @ qd
 
     def subtract_jt(self, model: Model, Q: np.ndarray, f: np.ndarray) -> None:
-        """``Q −= (∂δ_e/∂q)ᵀ f_e`` in place, element by element (``f``: shape (n_e, k))."""
-        for d, fe in zip(self.deformations, f, strict=True):
-            Q -= d.jacobian.T @ fe
+        """``Q −= Σ_e (∂δ_e/∂q)ᵀ f_e`` in place (``f``: shape (n_e, k))."""
+        Q -= np.einsum("ekn,ek->n", self.jacobian, f)
 
     def squares(self, w: np.ndarray) -> list[float]:
         """``δ_eᵀ W_e δ_e`` of each element (``w``: the diagonal weights, (n_e, k))."""
-        return [float(d.delta @ (we * d.delta)) for d, we in zip(self.deformations, w, strict=True)]
+        return np.einsum("ek,ek->e", self.delta, w * self.delta).tolist()
 
 
 Elements = CoordinateElements | GeneralElements
@@ -148,12 +163,104 @@ def joint_spring_elements(model: Model, data: Data) -> CoordinateElements | None
     return CoordinateElements(idx, data.q_full[idx], model.spring_stiffness, model.spring_damping)
 
 
+def bushing_deformations(model: Model, data: Data) -> tuple[np.ndarray, np.ndarray]:
+    """δ (n_b, 6) and ``∂δ/∂q`` (n_b, 6, nv) of every bushing, all at once.
+
+    :func:`bushing_deformation` on every bushing of the model: the same steps on stacks
+    of bushings (numpy's batched products), so that a scene with tens of thousands of
+    bushings costs a few array operations rather than a Python call each;
+    :func:`bushing_deformation` is the readable form and the reference, and the tests
+    hold the two equal.
+
+    Raises
+    ------
+    SingularConfigurationError
+        If a bushing is at gimbal lock (the message of :func:`bushing_deformation`).
+    """
+    bs = model.bushings
+    body1, body2 = (np.array([getattr(b, k) for b in bs], dtype=int) for k in ("body1", "body2"))
+    r1, c1, r2, c2 = (np.array([getattr(b, k) for b in bs]) for k in ("r1", "c1", "r2", "c2"))
+    R1, p1 = _frame_poses(data, body1, r1, c1)
+    R2, p2 = _frame_poses(data, body2, r2, c2)
+    R1t = np.swapaxes(R1, -1, -2)
+    r12 = (R1t @ (p2 - p1)[..., None])[..., 0]
+    c12 = R1t @ R2
+    cos_theta = np.hypot(c12[:, 0, 0], c12[:, 0, 1])
+    locked = np.flatnonzero(cos_theta < GIMBAL_LOCK_COS)
+    if locked.size:
+        bushing_deformation(data, bs[int(locked[0])])  # raises, naming the bushing
+    sin_theta = np.clip(c12[:, 0, 2], -1.0, 1.0)
+    beta = np.arctan2(-c12[:, 1, 2], c12[:, 2, 2])
+    theta = np.arctan2(sin_theta, cos_theta)
+    alpha = np.arctan2(-c12[:, 0, 1], c12[:, 0, 0])
+    J1 = _frame_jacobians(data, body1, r1, c1)
+    J2 = _frame_jacobians(data, body2, r2, c2)
+    J_rel = J2 - np.swapaxes(_placements(r12, c12), -1, -2) @ J1
+    jac = np.empty_like(J_rel)
+    jac[:, :3] = c12 @ J_rel[:, :3]
+    jac[:, 3:] = _euler_matrix_inverses(theta, alpha) @ J_rel[:, 3:]
+    return np.column_stack([r12, beta, theta, alpha]), jac
+
+
+def _frame_poses(
+    data: Data, body: np.ndarray, r: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~rt70.textbook.kinematics.frame_pose` of a stack of frames (body −1: ground)."""
+    on_ground = body < 0
+    R_body = np.where(on_ground[:, None, None], np.eye(3), data.R[body])
+    p_body = np.where(on_ground[:, None], 0.0, data.p[body])
+    return R_body @ c, p_body + (R_body @ r[..., None])[..., 0]
+
+
+def _frame_jacobians(data: Data, body: np.ndarray, r: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """:func:`~rt70.textbook.kinematics.frame_jacobian` of a stack of frames, (n, 6, nv)."""
+    nv = data.S.shape[0]
+    S_body = data.S.reshape(nv, -1, 6)[:, np.maximum(body, 0)]  # (nv, n, 6)
+    S_body = np.where((body < 0)[None, :, None], 0.0, S_body)
+    return np.swapaxes(_placements(r, c), -1, -2) @ np.transpose(S_body, (1, 2, 0))
+
+
+def _placements(r: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """:func:`~rt70.textbook.spatial.placement` ``T(r) [c]`` of a stack, (n, 6, 6)."""
+    out = np.zeros((len(r), 6, 6))
+    out[:, :3, :3] = c
+    out[:, 3:, 3:] = c
+    out[:, 3:, :3] = _skews(r) @ c
+    return out
+
+
+def _skews(x: np.ndarray) -> np.ndarray:
+    """:func:`~rt70.textbook.spatial.skew` of a stack of vectors, (n, 3, 3)."""
+    out = np.zeros((len(x), 3, 3))
+    out[:, 0, 1], out[:, 0, 2] = -x[:, 2], x[:, 1]
+    out[:, 1, 0], out[:, 1, 2] = x[:, 2], -x[:, 0]
+    out[:, 2, 0], out[:, 2, 1] = -x[:, 1], x[:, 0]
+    return out
+
+
+def _euler_matrix_inverses(theta: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """:func:`~rt70.textbook.spatial.euler_matrix_inverse` of a stack of angles, (n, 3, 3)."""
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    out = np.zeros((len(theta), 3, 3))
+    out[:, 0, 0], out[:, 0, 1] = ca / ct, -sa / ct
+    out[:, 1, 0], out[:, 1, 1] = sa, ca
+    out[:, 2, 0], out[:, 2, 1], out[:, 2, 2] = -st * ca / ct, st * sa / ct, 1.0
+    return out
+
+
 def bushing_elements(model: Model, data: Data) -> GeneralElements | None:
-    """Bushings and struts (``<rt70:bushing>``, ``<rt70:strut_package>``), (4.85)–(4.110)."""
+    """Bushings and struts (``<rt70:bushing>``, ``<rt70:strut_package>``), (4.85)–(4.110).
+
+    Their deformations all at once (:func:`bushing_deformations`, the vectorised form of
+    :func:`bushing_deformation`).
+    """
     if not model.bushings:
         return None
+    delta, jac = bushing_deformations(model, data)
     return GeneralElements(
-        [bushing_deformation(data, b) for b in model.bushings],
+        delta,
+        jac,
         np.array([b.stiffness for b in model.bushings]),
         np.array([b.damping for b in model.bushings]),
     )

@@ -15,8 +15,15 @@ import numpy as np
 from rt70.urdf.description import InertiaRepair
 from rt70.urdf.text import RT70_NS
 
-#: Principal moments are checked to this fraction of the largest one (rounding of eigvalsh).
+#: The triangle inequality is checked to this fraction of the largest principal moment:
+#: a flat plate (``I₁ + I₂ = I₃`` exactly) written with ten significant digits passes.
 INERTIA_RTOL = 1e-9
+
+#: A principal moment within this many units in the last place of the inertia's scale
+#: (:func:`inertia_scale`) of zero is zero to rounding: reading decimals (½ ulp per
+#: entry), turning the tensor by ``<origin rpy>`` (a few ulps) and ``eigvalsh`` (a few
+#: ulps of the largest moment) stay well inside it.
+ZERO_ULPS = 32
 
 
 def principal_moments(tensor: np.ndarray) -> np.ndarray:
@@ -24,18 +31,85 @@ def principal_moments(tensor: np.ndarray) -> np.ndarray:
     return np.linalg.eigvalsh(tensor)
 
 
-def inertia_defect(tensor: np.ndarray) -> str | None:
-    """Why a non-zero rotational inertia is impossible, or None if it is a rigid body's.
+def inertia_scale(tensor: np.ndarray, mass: float = 0.0, com=(0.0, 0.0, 0.0)) -> float:
+    """The size of the terms a link's rotational inertia is used with: ``λ_max + m |c|²``.
 
-    It must be positive definite and its principal moments must satisfy the triangle
-    inequality ``I₁ + I₂ ≥ I₃`` (to :data:`INERTIA_RTOL` of the largest moment).
+    Both sides use the inertia about the link frame's origin,
+    ``I_o = I_c + m (|c|² 1 − c cᵀ)`` (the textbook's Θ (4.77), the rotational block of
+    Pinocchio's spatial inertia at the joint), so a principal moment of ``I_c`` below the
+    rounding of these terms is indistinguishable from zero: ``λ_max`` the largest
+    principal moment in magnitude, m the mass and c the centre of mass in the link frame
+    (``<inertial><origin xyz>``).
+
+    Parameters
+    ----------
+    tensor : numpy.ndarray
+        Rotational inertia about the centre of mass, (3, 3), kg·m².
+    mass : float
+        The link's mass, kg.
+    com : array_like
+        The centre of mass in the link frame, m.
+
+    Returns
+    -------
+    float
+        The scale, kg·m².
     """
     moments = principal_moments(tensor)
-    scale = max(float(np.max(np.abs(moments))), np.finfo(float).tiny)
-    if moments[0] <= 0.0:
+    lever = float(np.dot(com, com))
+    return float(np.max(np.abs(moments))) + abs(float(mass)) * lever
+
+
+def zero_moment_tolerance(tensor: np.ndarray, mass: float = 0.0, com=(0.0, 0.0, 0.0)) -> float:
+    """Principal moments within ± this of zero are zero to rounding: ``ZERO_ULPS · ε · scale``."""
+    return ZERO_ULPS * float(np.finfo(float).eps) * inertia_scale(tensor, mass, com)
+
+
+def is_point_mass(tensor: np.ndarray, mass: float, com=(0.0, 0.0, 0.0)) -> bool:
+    """True if every principal moment is zero to rounding (:func:`zero_moment_tolerance`).
+
+    A tensor written as zeros is a point mass (book §2.1); so is one whose moments are
+    rounding noise of the inertia about the link frame (icub's ``head``: ``ixz =
+    2.4e-35`` on 1.34 kg at 0.11 m, moments ±2.4e-35 against a scale of 0.017 kg·m²).
+    A noise tensor at ``c = 0`` has only its own moments as a scale, so it is no point
+    mass.
+    """
+    if not np.any(tensor):
+        return True
+    tol = zero_moment_tolerance(tensor, mass, com)
+    return bool(np.all(np.abs(principal_moments(tensor)) <= tol))
+
+
+def inertia_defect(tensor: np.ndarray, mass: float = 0.0, com=(0.0, 0.0, 0.0)) -> str | None:
+    """Why a rotational inertia is impossible, or None if it is a rigid body's.
+
+    It must be positive definite — its smallest principal moment above zero by more than
+    :func:`zero_moment_tolerance` — and its principal moments must satisfy the triangle
+    inequality ``I₁ + I₂ ≥ I₃`` to ``INERTIA_RTOL · I₃`` plus that tolerance; or all its
+    moments must be zero to rounding, a point mass (:func:`is_point_mass`).
+
+    Parameters
+    ----------
+    tensor : numpy.ndarray
+        Rotational inertia about the centre of mass, (3, 3), kg·m².
+    mass : float
+        The link's mass, kg (0 for a tensor judged on its own).
+    com : array_like
+        The centre of mass in the link frame, m.
+
+    Returns
+    -------
+    str or None
+        The defect, or None.
+    """
+    if is_point_mass(tensor, mass, com):
+        return None
+    moments = principal_moments(tensor)
+    tol = zero_moment_tolerance(tensor, mass, com)
+    if moments[0] <= tol:
         listed = ", ".join(f"{m:.6g}" for m in moments)
         return f"inertia tensor not positive definite (principal moments {listed})"
-    if moments[2] > moments[0] + moments[1] + INERTIA_RTOL * scale:
+    if moments[2] > moments[0] + moments[1] + INERTIA_RTOL * moments[2] + tol:
         return (
             f"principal moment {moments[2]:.6g} exceeds the sum of the other "
             f"two ({moments[0]:.6g} + {moments[1]:.6g}): triangle inequality violated"

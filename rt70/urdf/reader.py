@@ -233,8 +233,8 @@ class _Reader:
             return None
         if mass == 0.0 and not np.any(tensor):
             return None
-        if np.any(tensor):  # all zero with mass: a point mass (book §2.1)
-            defect = inertia_defect(tensor)
+        if np.any(tensor):  # zero, or zero to rounding, with mass: a point mass (book §2.1)
+            defect = inertia_defect(tensor, mass, xyz)
             if mass == 0.0:
                 detail = f" ({defect})" if defect else ""
                 defect = "zero mass but non-zero inertia tensor" + detail
@@ -287,7 +287,7 @@ class _Reader:
                     raise self.fail(InertiaError, f"link '{name}': {defect}")
                 links[name] = Link(name, Inertial(inertial.mass, inertial.com, np.diag(balanced)))
                 repairs.append(InertiaRepair(name, moments, balanced))
-                why = "not positive definite" if moments[0] <= 0.0 else "triangle inequality"
+                why = "triangle inequality" if "triangle" in defect else "not positive definite"
                 warn(
                     f"{where}: inertia repaired (balance inertia; {why}): principal moments "
                     f"{', '.join(f'{m:.6g}' for m in moments)} -> "
