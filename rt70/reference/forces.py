@@ -278,7 +278,8 @@ def deformations(model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jac
     joints = np.union1d(f1.joints, f2.joints)
     joint_jac = np.zeros((m.njoints, 6, m.nv))  # each parent joint's LOCAL Jacobian, once
     for joint in joints:
-        joint_jac[joint] = pin.getJointJacobian(m, d, int(joint), pin.LOCAL)
+        # eigenpy returns a 6×1 Jacobian (nv = 1) as a vector of 6
+        joint_jac[joint] = np.reshape(pin.getJointJacobian(m, d, int(joint), pin.LOCAL), (6, m.nv))
     J1 = f1.act_inverse @ joint_jac[f1.joints]  # getFrameJacobian(…, LOCAL), all frames
     J2 = f2.act_inverse @ joint_jac[f2.joints]
     # J_rel = J2 − Ad(M12⁻¹) J1; δ̇_trans = c12 v_rel, φ̇ = J_W(ρ)⁻¹ ω_rel
