@@ -89,6 +89,28 @@ def test_an_explicit_zero_stiffness_is_a_damper_alone():
     assert [(s.stiffness, s.damping) for s in desc.joint_springs] == [(0.0, 3.0)]
 
 
+@pytest.mark.parametrize(
+    ("kind", "first", "second"),
+    [
+        (
+            "<rt70:optical_point>",
+            '<rt70:optical_point name="f" link="link1" xyz="0 0 0"/>',
+            '<rt70:optical_point name="f" link="link2" xyz="0 0 1"/>',
+        ),
+        (
+            "<rt70:joint_spring>",
+            '<rt70:joint_spring name="s" joint="joint1" stiffness="1"/>',
+            '<rt70:joint_spring name="s" joint="joint2" stiffness="2"/>',
+        ),
+    ],
+    ids=["optical_point", "joint_spring"],
+)
+def test_two_elements_of_one_kind_and_name_are_refused(kind, first, second):
+    """A second element of a name would shadow the first in every named result."""
+    message = refusal(pendulum_with(GRAVITY + first + second))
+    assert f"two {kind} elements named" in message
+
+
 # --- every kind of the table ------------------------------------------------------------
 
 

@@ -445,6 +445,7 @@ class _Reader:
                 desc.optical_points.append(OpticalPoint(name, link, self.numbers(elem, "xyz", 3)))
             else:  # a kind declared in RT70 must be read here, never skipped
                 raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
+        self.check_unique_names(desc)
         if not (winds or air or no_slips):
             return desc
         return dataclasses.replace(
@@ -453,6 +454,24 @@ class _Reader:
             air_density=air[0] if air else desc.air_density,
             no_slips=tuple(no_slips),
         )
+
+    def check_unique_names(self, desc: RobotDescription) -> None:
+        """Refuse two elements of one kind with one name: results are named by them.
+
+        Springs, bushings (a strut is ``package/strut``) and optical points each name an
+        output, a row or a column; a second one of a name would silently shadow the
+        first. (Drives, winds and loops are checked where they are read.)
+        """
+        for kind, elements in (
+            ("<rt70:joint_spring>", desc.joint_springs),
+            ("<rt70:bushing> or <rt70:strut>", desc.bushings),
+            ("<rt70:optical_point>", desc.optical_points),
+        ):
+            seen: set[str] = set()
+            for element in elements:
+                if element.name in seen:
+                    raise self.fail(ExtensionError, f"two {kind} elements named '{element.name}'")
+                seen.add(element.name)
 
     def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
         link = elem.get(attr)
