@@ -29,7 +29,7 @@ def _rate(text: str) -> tuple[str, float]:
     name, sep, value = text.partition("=")
     if not sep or not name:
         raise argparse.ArgumentTypeError(f"'{text}' is not COORD=VALUE")
-    return name, options.finite_float(value)
+    return name, options.physical_float(value)
 
 
 def add_parser(sub) -> argparse.ArgumentParser:

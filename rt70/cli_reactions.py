@@ -53,7 +53,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     )
     rea.add_argument(
         "--wind",
-        type=options.positive_float,
+        type=options.wind_speed,
         metavar="SPEED",
         help="also with a steady wind of SPEED m/s",
     )

@@ -30,6 +30,17 @@ ELEVATION_RANGE = (0.0, 90.0)
 #: Smallest relative tolerance ``solve_ivp`` honours (100 machine epsilons).
 MIN_RTOL = 100 * sys.float_info.epsilon
 
+#: Largest magnitude of a physical number given as an option (a rate, a position): the
+#: bound of every number rt70 reads from a model (``rt70.urdf.reader.MAX_MAGNITUDE``,
+#: docs/urdf-reader.md): a product of ten such numbers stays below the largest double.
+MAX_MAGNITUDE = 1e30
+
+#: Largest mean wind speed, m/s: the wind load's model (constant coefficients, dynamic
+#: pressure ½ρv², docs/wind.md) is that of incompressible flow, which holds below Mach 0.3
+#: — 0.3 × 340.3 m/s, the speed of sound in the ISA sea-level air the default density is
+#: of. (The strongest gust measured, 113 m/s at Barrow Island in 1996, is above it.)
+MAX_WIND_SPEED = 0.3 * 340.3
+
 #: Largest ``rt70 bench --K``: the batched mass matrices alone take ``K nv²`` floats
 #: (1.4 GB for the RT-70 scene at this K).
 MAX_BATCH = 100_000
@@ -82,6 +93,38 @@ def non_negative_float(text: str) -> float:
     value = _number(text)
     if value < 0.0:
         raise argparse.ArgumentTypeError(f"must be at least 0, got {text}")
+    return value
+
+
+def physical_float(text: str) -> float:
+    """A finite number of magnitude at most :data:`MAX_MAGNITUDE`."""
+    value = _number(text)
+    if abs(value) > MAX_MAGNITUDE:
+        raise argparse.ArgumentTypeError(
+            f"magnitude above {MAX_MAGNITUDE:g}, the largest number rt70 reads "
+            f"(docs/urdf-reader.md), got {text}"
+        )
+    return value
+
+
+def wind_speed(text: str) -> float:
+    """A mean wind speed, m/s: ``0 < v ≤`` :data:`MAX_WIND_SPEED` (incompressible flow)."""
+    value = positive_float(text)
+    if value > MAX_WIND_SPEED:
+        raise argparse.ArgumentTypeError(
+            f"at most {MAX_WIND_SPEED:.0f} m/s, Mach 0.3: the wind load's model (½ρv², constant "
+            f"coefficients) is that of incompressible flow, got {text}"
+        )
+    return value
+
+
+def angle_error(text: str) -> float:
+    """An angle off a programmed one, rad: ``|x| ≤ π`` (a heading is an angle modulo 2π)."""
+    value = _number(text)
+    if abs(value) > math.pi:
+        raise argparse.ArgumentTypeError(
+            f"must lie in [-π, π] (an angle off the programmed heading), got {text}"
+        )
     return value
 
 

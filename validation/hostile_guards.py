@@ -96,7 +96,9 @@ def cases(tmp: Path) -> list[Case]:
     (tmp / "big.csv").write_text(header + "0,1e300,0,0\n90,1e300,1e300,1e300\n180,1e300,0,0\n")
     (tmp / "e31.csv").write_text(header + "0,1e31,0,0\n90,1,1,1\n180,1,0,0\n")
     (tmp / "e29.csv").write_text(header + "0,1e29,0,0\n90,1e29,1e29,1e29\n180,1e29,0,0\n")
-    rows = "".join(f"{180 * i / 2_000_000!r},1,{0 if i in (0, 2_000_000) else 1},0\n" for i in range(2_000_001))
+    rows = "".join(
+        f"{180 * i / 2_000_000!r},1,{0 if i in (0, 2_000_000) else 1},0\n" for i in range(2_000_001)
+    )
     (tmp / "huge.csv").write_text(header + rows)
     (tmp / "binary.csv").write_bytes(os.urandom(4096))
     for label, table in [
@@ -164,7 +166,12 @@ def cases(tmp: Path) -> list[Case]:
         add(f"reactions {label}", "reactions", scene, "--elevation", "45", "--wind", "10")
     four = (ROOT / "urdf" / "four_bar.urdf").read_text()
     loop_far = tmp / "loop_far.urdf"
-    loop_far.write_text(four.replace('xyz="0.45 0 0" rpy="0 0 0"/>\n  </rt70:loop>', 'xyz="1e30 0 0" rpy="0 0 0"/>\n  </rt70:loop>'))
+    loop_far.write_text(
+        four.replace(
+            'xyz="0.45 0 0" rpy="0 0 0"/>\n  </rt70:loop>',
+            'xyz="1e30 0 0" rpy="0 0 0"/>\n  </rt70:loop>',
+        )
+    )
     add("validate loop 1e30", "validate", str(loop_far), "--samples", "1")
     add("modes loop 1e30", "modes", str(loop_far))
     add("simulate loop 1e30", "simulate", str(loop_far), "--t-end", "1")
@@ -174,17 +181,67 @@ def cases(tmp: Path) -> list[Case]:
         add(f"pointing --wind {w}", "pointing", "rt70_servo", "--wind", w)
     add("pointing --duration 1e12", "pointing", "rt70_servo", "--wind", "10", "--duration", "1e12")
     add("pointing --duration 1e8", "pointing", "rt70_servo", "--wind", "10", "--duration", "1e8")
-    add("pointing --direction 1e300", "pointing", "rt70_servo", "--wind", "10", "--direction", "1e300")
+    add(
+        "pointing --direction 1e300",
+        "pointing",
+        "rt70_servo",
+        "--wind",
+        "10",
+        "--direction",
+        "1e300",
+    )
     add("pointing --azimuth 1e300", "pointing", "rt70_servo", "--wind", "10", "--azimuth", "1e300")
-    add("pointing --seed 2**80", "pointing", "rt70_servo", "--wind", "10", "--duration", "2", "--seed", str(2**80))
-    add("pointing --elevation 0 wind 60", "pointing", "rt70_servo", "--wind", "60", "--elevation", "0")
+    add(
+        "pointing --seed 2**80",
+        "pointing",
+        "rt70_servo",
+        "--wind",
+        "10",
+        "--duration",
+        "2",
+        "--seed",
+        str(2**80),
+    )
+    add(
+        "pointing --elevation 0 wind 60",
+        "pointing",
+        "rt70_servo",
+        "--wind",
+        "60",
+        "--elevation",
+        "0",
+    )
 
     # reactions
     for w in ("1e10", "1e300", "1e-300"):
         add(f"reactions --wind {w}", "reactions", "rt70_servo", "--elevation", "45", "--wind", w)
-    add("reactions --direction 1e300", "reactions", "rt70_servo", "--elevation", "45", "--wind", "10", "--direction", "1e300")
-    add("reactions --azimuth 1e300", "reactions", "rt70_servo", "--elevation", "45", "--azimuth", "1e300")
-    add("reactions 10k elevations", "reactions", "rt70_servo", "--elevation", ",".join(["45"] * 10_000))
+    add(
+        "reactions --direction 1e300",
+        "reactions",
+        "rt70_servo",
+        "--elevation",
+        "45",
+        "--wind",
+        "10",
+        "--direction",
+        "1e300",
+    )
+    add(
+        "reactions --azimuth 1e300",
+        "reactions",
+        "rt70_servo",
+        "--elevation",
+        "45",
+        "--azimuth",
+        "1e300",
+    )
+    add(
+        "reactions 10k elevations",
+        "reactions",
+        "rt70_servo",
+        "--elevation",
+        ",".join(["45"] * 10_000),
+    )
 
     # modes, plant
     add("modes --azimuth 1e300", "modes", "rt70_servo", "--azimuth", "1e300")
@@ -193,7 +250,15 @@ def cases(tmp: Path) -> list[Case]:
     add("plant --reduce 10000", "plant", "rt70_servo", "--reduce", "10000")
     add("plant --reduce 1", "plant", "rt70_servo", "--reduce", "1")
     add("plant --azimuth 1e300", "plant", "rt70_servo", "--azimuth", "1e300")
-    add("plant --elevation 88.99 reduce", "plant", "rt70_servo", "--elevation", "88.99", "--reduce", "4")
+    add(
+        "plant --elevation 88.99 reduce",
+        "plant",
+        "rt70_servo",
+        "--elevation",
+        "88.99",
+        "--reduce",
+        "4",
+    )
 
     # simulate
     add("simulate --t-end 1e12", "simulate", "rt70_servo", "--t-end", "1e12")
@@ -201,16 +266,62 @@ def cases(tmp: Path) -> list[Case]:
     add("simulate rt70 --t-end 1e12", "simulate", "rt70", "--t-end", "1e12")
     add("simulate --t-end 1e-300", "simulate", "rt70_servo", "--t-end", "1e-300")
     add("simulate rt70 --t-end 1e-300", "simulate", "rt70", "--t-end", "1e-300")
-    add("simulate step-el at 90", "simulate", "rt70_servo", "--scenario", "step-elevation", "--elevation", "90", "--t-end", "3")
-    add("simulate step-el at 0", "simulate", "rt70_servo", "--scenario", "step-elevation", "--elevation", "0", "--t-end", "3")
-    add("simulate step-el at 89.5", "simulate", "rt70_servo", "--scenario", "step-elevation", "--elevation", "89.5", "--t-end", "3")
-    add("simulate step-az short", "simulate", "rt70_servo", "--scenario", "step-azimuth", "--t-end", "0.5")
+    add(
+        "simulate step-el at 90",
+        "simulate",
+        "rt70_servo",
+        "--scenario",
+        "step-elevation",
+        "--elevation",
+        "90",
+        "--t-end",
+        "3",
+    )
+    add(
+        "simulate step-el at 0",
+        "simulate",
+        "rt70_servo",
+        "--scenario",
+        "step-elevation",
+        "--elevation",
+        "0",
+        "--t-end",
+        "3",
+    )
+    add(
+        "simulate step-el at 89.5",
+        "simulate",
+        "rt70_servo",
+        "--scenario",
+        "step-elevation",
+        "--elevation",
+        "89.5",
+        "--t-end",
+        "3",
+    )
+    add(
+        "simulate step-az short",
+        "simulate",
+        "rt70_servo",
+        "--scenario",
+        "step-azimuth",
+        "--t-end",
+        "0.5",
+    )
     add("simulate track short", "simulate", "rt70_servo", "--scenario", "track", "--t-end", "0.5")
     add("simulate --azimuth 1e300", "simulate", "rt70_servo", "--azimuth", "1e300", "--t-end", "1")
     add("simulate --rtol 0.9", "simulate", "rt70_servo", "--rtol", "0.9", "--t-end", "2")
     add("simulate RK45 hold", "simulate", "rt70_servo", "--method", "RK45", "--t-end", "5")
     add("simulate rt70 RK23", "simulate", "rt70", "--method", "RK23", "--t-end", "10")
-    add("simulate --out csv 1e5", "simulate", "rt70_servo", "--t-end", "1e5", "--out", str(tmp / "o.csv"))
+    add(
+        "simulate --out csv 1e5",
+        "simulate",
+        "rt70_servo",
+        "--t-end",
+        "1e5",
+        "--out",
+        str(tmp / "o.csv"),
+    )
 
     # cart
     add("cart --step 1e-9", "cart", "--step", "1e-9")
@@ -228,13 +339,50 @@ def cases(tmp: Path) -> list[Case]:
     # impact
     for r in ("1e300", "1e10", "1e200"):
         add(f"impact --rate {r}", "impact", "rt70", "--brake", "base_rx", "--rate", f"base_rx={r}")
-    add("impact --rate 1e300 pin", "impact", "rt70", "--pin", "main_mirror", "--rate", f"platform_rz=1e300")
+    add(
+        "impact --rate 1e300 pin",
+        "impact",
+        "rt70",
+        "--pin",
+        "main_mirror",
+        "--rate",
+        "platform_rz=1e300",
+    )
     add("impact --pin 1e300", "impact", "rt70", "--pin", "main_mirror:1e300,0,0")
     add("impact --after 1e12", "impact", "rt70", "--brake", "base_rx", "--after", "1e12")
     add("impact --after 1e-300", "impact", "rt70", "--brake", "base_rx", "--after", "1e-300")
-    add("impact --seed 2**80", "impact", "rt70", "--brake", "base_rx", "--state", "random", "--seed", str(2**80))
-    add("impact --json rate 1e300", "impact", "rt70", "--brake", "base_rx", "--rate", "base_rx=1e300", "--json")
-    add("impact servo rate 1e200 after", "impact", "rt70_servo", "--brake", "base_rx", "--rate", "base_rx=1e200", "--after", "0.01")
+    add(
+        "impact --seed 2**80",
+        "impact",
+        "rt70",
+        "--brake",
+        "base_rx",
+        "--state",
+        "random",
+        "--seed",
+        str(2**80),
+    )
+    add(
+        "impact --json rate 1e300",
+        "impact",
+        "rt70",
+        "--brake",
+        "base_rx",
+        "--rate",
+        "base_rx=1e300",
+        "--json",
+    )
+    add(
+        "impact servo rate 1e200 after",
+        "impact",
+        "rt70_servo",
+        "--brake",
+        "base_rx",
+        "--rate",
+        "base_rx=1e200",
+        "--after",
+        "0.01",
+    )
 
     # bench
     add("bench --K 10**12", "bench", "--K", str(10**12))
@@ -243,8 +391,15 @@ def cases(tmp: Path) -> list[Case]:
 
 
 def run_case(case: Case, timeout: float) -> tuple[str, str, float]:
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg", OMP_NUM_THREADS="1",
-               OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", PYTHONWARNINGS="")
+    env = dict(
+        os.environ,
+        PYTHONPATH=str(ROOT),
+        MPLBACKEND="Agg",
+        OMP_NUM_THREADS="1",
+        OPENBLAS_NUM_THREADS="1",
+        MKL_NUM_THREADS="1",
+        PYTHONWARNINGS="",
+    )
 
     def limit() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
