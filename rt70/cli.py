@@ -149,6 +149,7 @@ def _modes(args: argparse.Namespace) -> int:
         damped = modal.damped_modes(model.M, model.K, model.D)
     rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates)
     damped_summary = mode_table.damped_summary(result, damped)
+    options.check_finite({"modes": rows, "damped": damped_summary}, f"{scene.name}: modes")
     if args.json:
         out = {
             "scene": scene.name,
@@ -339,10 +340,11 @@ def _plant(args: argparse.Namespace) -> int:
             "peak_hz": err.freq_hz,
             "bound_2sum_hsv": red.bound,
         }
+    arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
+    options.check_finite({**info, **arrays}, f"{scene.name}: plant")
     if args.out:
         from rt70.atomic import atomic_write
 
-        arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
         labels = {k: np.array(info[k]) for k in ("states", "inputs", "outputs")}
         atomic_write(args.out, lambda tmp: np.savez_compressed(tmp, **arrays, **labels))
     if args.json:

@@ -117,18 +117,19 @@ def run(args: argparse.Namespace) -> int:
     end = cart.servo(scene, sol.y[:5, -1], sol.y[5:, -1], side=args.side).residuals
     stopped = sol.status == 1
     rows = [[float(sol.t[i]), *map(float, sol.y[[0, 1, 2, 5, 6, 7], i])] for i in picked]
+    out = {
+        "scene": scene.name,
+        "side": args.side,
+        "initial": {"M1": first.M1, "M2": first.M2, "lateral": first.lateral},
+        "columns": ["t", "x", "y", "theta", "xd", "yd", "thetad"],
+        "rows": rows,
+        "min_g": g_min,
+        "perturbations_start": first.residuals.tolist(),
+        "perturbations_end": end.tolist(),
+        "stopped_at": float(sol.t_events[0][0]) if stopped else None,
+    }
+    options.check_finite(out, f"{scene.name}: cart")
     if args.json:
-        out = {
-            "scene": scene.name,
-            "side": args.side,
-            "initial": {"M1": first.M1, "M2": first.M2, "lateral": first.lateral},
-            "columns": ["t", "x", "y", "theta", "xd", "yd", "thetad"],
-            "rows": rows,
-            "min_g": g_min,
-            "perturbations_start": first.residuals.tolist(),
-            "perturbations_end": end.tolist(),
-            "stopped_at": float(sol.t_events[0][0]) if stopped else None,
-        }
         print(json.dumps(out, indent=2))
         return 0
     print(

@@ -105,10 +105,11 @@ def run(args: argparse.Namespace) -> int:
         run = gust_run(
             scene, case, args.duration, seed=args.seed, progress=args.progress, model=model
         )
+    out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
+    if run is not None:
+        out["gust_run"] = run.to_dict()
+    options.check_finite(out, f"{scene.name}: pointing budget")
     if args.json:
-        out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
-        if run is not None:
-            out["gust_run"] = run.to_dict()
         print(json.dumps(out, indent=2))
         return 0
     print(format_budget(scene.name, budget))

@@ -46,22 +46,26 @@ Jacobian = Callable[[float, np.ndarray], np.ndarray]
 class EvaluationBudget:
     """Right-hand-side evaluations a run may take: ``minimum + per_second · (t1 − t0)``.
 
-    The command line's runs take at most about 1 000 evaluations per simulated second
-    (measured: ``rt70 simulate rt70`` 310/s with BDF, the rt70_servo hold 200/s with
-    LSODA, the cart 500/s with DOP853), so the default is 5× that and more. A run over
+    The command line's runs take a few hundred evaluations per simulated second
+    (measured: ``rt70 simulate rt70`` 3 125 over 10 s with BDF, the rt70_servo hold
+    11 639 over 60 s with LSODA, ``rt70 cart --duration 20`` 2 453 over 7 s with DOP853),
+    so the default allows 2 000 per second, six times the most, and 20 000 besides. A run over
     the budget is one its method cannot integrate at a reasonable cost — an explicit
     method on stiff springs, a drive or element stiffer than the implicit methods'
     Jacobian covers (its rows of the extra states are zero, :mod:`rt70.states`), a
     state driven extremely fast — and would otherwise look like a hang.
     """
 
-    minimum: int = 50_000
-    per_second: float = 5_000.0
+    minimum: int = 20_000
+    per_second: float = 2_000.0
 
     def limit(self, span: float) -> int:
         """The number of evaluations allowed over a span of ``span`` seconds."""
         return int(min(self.minimum + self.per_second * span, 1e15))
 
+
+#: The budget of every run of the command line (rt70/cli.py).
+COMMAND_BUDGET = EvaluationBudget()
 
 _BUDGET: ContextVar[EvaluationBudget | None] = ContextVar("rt70_evaluation_budget", default=None)
 
@@ -70,14 +74,22 @@ _BUDGET: ContextVar[EvaluationBudget | None] = ContextVar("rt70_evaluation_budge
 def evaluation_budget(budget: EvaluationBudget | None = None) -> Iterator[None]:
     """Inside the block every :func:`integrate` (and :func:`budgeted`) run has ``budget``.
 
+    ``budget`` defaults to :data:`COMMAND_BUDGET`.
+
     The command line runs its commands inside one (rt70/cli.py); library calls have none
     unless they ask.
     """
-    token = _BUDGET.set(EvaluationBudget() if budget is None else budget)
+    token = _BUDGET.set(COMMAND_BUDGET if budget is None else budget)
     try:
         yield
     finally:
         _BUDGET.reset(token)
+
+
+def budget_limit(span: float) -> int | None:
+    """Evaluations allowed over ``span`` seconds by the budget in force, or None."""
+    budget = _BUDGET.get()
+    return None if budget is None else budget.limit(span)
 
 
 def budgeted(rhs: Rhs, span: float, limit: int | None = None) -> Rhs:

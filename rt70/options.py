@@ -174,6 +174,54 @@ def elevation(text: str) -> float:
     return value
 
 
+# --- results ---------------------------------------------------------------------------
+def check_finite(result: object, what: str) -> None:
+    """Refuse a result (nested dicts, lists, numbers) holding a NaN or an infinity.
+
+    A command calls this on what it is about to print or write, so that NaN never
+    reaches an output without an error; a value that may be absent is None, not NaN.
+
+    Raises
+    ------
+    Rt70Error
+        Naming ``what`` and the key path of the first bad value.
+    """
+    from rt70.errors import Rt70Error
+
+    path = _non_finite(result, "")
+    if path is not None:
+        raise Rt70Error(f"{what}: {path or 'the result'} is NaN or infinite: nothing to report")
+
+
+def json_text(result: object, what: str) -> str:
+    """``json.dumps(result, indent=2)`` after :func:`check_finite` (no ``NaN`` in JSON)."""
+    import json
+
+    check_finite(result, what)
+    return json.dumps(result, indent=2)
+
+
+def _non_finite(value: object, path: str) -> str | None:
+    """The key path of the first NaN or infinity in ``value``, or None."""
+    if isinstance(value, dict):
+        items = ((f"{path}.{k}" if path else str(k), v) for k, v in value.items())
+    elif isinstance(value, list | tuple):
+        items = ((f"{path}[{i}]", v) for i, v in enumerate(value))
+    elif isinstance(value, float):
+        return None if math.isfinite(value) else path
+    else:
+        items = ()
+        if hasattr(value, "dtype") and getattr(value.dtype, "kind", "") in "fc":
+            import numpy as np
+
+            return None if np.isfinite(value).all() else path
+    for key, item in items:
+        bad = _non_finite(item, key)
+        if bad is not None:
+            return bad
+    return None
+
+
 # --- output paths ------------------------------------------------------------------------
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse output paths the command could not write, before it starts.

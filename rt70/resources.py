@@ -164,10 +164,13 @@ def time_series_samples(channels: int, available: int | None = None) -> int | No
     return max(int(MEMORY_FRACTION * available / time_series_bytes(1, channels)), 1)
 
 
-def check_time_series(samples: float, channels: int, what: str, source: str) -> None:
+def check_time_series(
+    samples: float, channels: int, what: str, source: str, available: int | None = None
+) -> None:
     """Refuse a run whose ``samples × channels`` time series this machine cannot hold.
 
-    ``source`` names the option or the call that asked for it (``--t-end 1e+12``).
+    ``source`` names the option or the call that asked for it (``--t-end 1e+12``);
+    ``available`` as :func:`check_memory`.
 
     Raises
     ------
@@ -178,6 +181,7 @@ def check_time_series(samples: float, channels: int, what: str, source: str) -> 
         time_series_bytes(samples, channels),
         f"{what} ({float(samples):.3g} samples of {channels} values)",
         source,
+        available,
     )
 
 

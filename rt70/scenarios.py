@@ -443,6 +443,11 @@ def run_scenario(
         ELEVATION_COORDINATE: lambda t: e0 - np.radians(sc.elevation(t)),
     }
     components = drives(scene, q0, torques, refs)
+    if sc.t_end * samples_per_s < 1.0:
+        raise Rt70Error(
+            f"{scene.name}: --t-end {sc.t_end:g}: a scenario is measured on samples every "
+            f"{1 / samples_per_s:g} s; it must last at least that long"
+        )
     n_t = np.ceil(sc.t_end * samples_per_s) + 1
     check_time_series(
         n_t,
