@@ -12,17 +12,12 @@ Every option is checked before any work starts (:mod:`rt70.options`); SIGTERM be
 normal exit, so outputs being written are cleaned up (:mod:`rt70.atomic`).
 
 Numerical trouble is an error, never a stray warning beside a result: inside a command
-every ``RuntimeWarning`` — numpy's floating-point warnings (overflow, invalid value,
-division by zero) and scipy's (``LinAlgWarning`` of an ill-conditioned solve, the
-Lyapunov solver's marginal eigenvalues) — is raised as an exception and printed as the
-command's one ``rt70: error:`` line (exit 2). Code that expects such values and checks
-them says so with ``np.errstate`` where it computes them. The integrators' own warnings
-(LSODA's convergence failures, ``ODEintWarning``) are caught where they are issued and
-become part of the run's message (:mod:`rt70.integrators`). Every run of an integrator
-has an evaluation budget (:class:`rt70.integrators.EvaluationBudget`; not ``bench``,
-which measures methods at any cost), so a run its method cannot integrate stops with one
-line instead of running on; sizes and durations are checked against the memory
-(:mod:`rt70.resources`) before the work.
+every ``RuntimeWarning`` (numpy's overflow, invalid value, division by zero; scipy's
+``LinAlgWarning`` and the Lyapunov solver's marginal eigenvalues) is raised and printed
+as the one ``rt70: error:`` line, exit 2 (:func:`rt70.options.warning_guards`); code
+that expects such values says so with ``np.errstate`` and checks them. The solvers'
+warnings join the run's message, and every integration but ``bench``'s has an evaluation
+budget: a run its method cannot integrate stops with one line (:mod:`rt70.integrators`).
 """
 
 from __future__ import annotations
@@ -33,11 +28,9 @@ import os
 import signal
 import sys
 import warnings
-from contextlib import nullcontext
 
 from rt70 import cli_cart, cli_impact, cli_pointing, cli_reactions, cli_sweep, options
-from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
-from rt70.integrators import evaluation_budget
+from rt70.errors import ResourceError, Rt70Error, SingularConfigurationError
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
 EXIT_TERMINATED = 128 + signal.SIGTERM
@@ -679,11 +672,8 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
-    budget = nullcontext() if args.command in UNBUDGETED else evaluation_budget()
-    with options.sigterm_exits(EXIT_TERMINATED), warnings.catch_warnings(), budget:
-        warnings.simplefilter("error", RuntimeWarning)  # numerical trouble: an error
-        warnings.simplefilter("always", Rt70Warning)
-        warnings.showwarning = _show_warning
+    guards = options.warning_guards(args.command)  # module docstring
+    with options.sigterm_exits(EXIT_TERMINATED), warnings.catch_warnings(), guards:
         try:
             options.check_outputs(args)  # before any work: a bad output path exits 2 at once
             code = args.func(args)
@@ -693,7 +683,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"rt70: error: {exc}", file=sys.stderr)
             return 2
         except RuntimeWarning as exc:  # numpy's floating-point warnings, scipy's LinAlgWarning
-            print(f"rt70: error: {_numerical_failure(args, exc)}", file=sys.stderr)
+            print(f"rt70: error: {options.numerical_failure(args.command, exc)}", file=sys.stderr)
             return 2
         except BrokenPipeError:
             # the reader went away (``| head``); Python flushes stdout again at exit:
@@ -704,31 +694,6 @@ def main(argv: list[str] | None = None) -> int:
         except KeyboardInterrupt:
             print("rt70: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
-
-
-#: Commands run without an :class:`~rt70.integrators.EvaluationBudget`: ``bench``
-#: measures methods at any cost by design, ``sweep`` keeps its own limits.
-UNBUDGETED = ("bench", "sweep")
-
-
-def _numerical_failure(args: argparse.Namespace, exc: RuntimeWarning) -> str:
-    """The one line for a RuntimeWarning that reached the command line (module docstring)."""
-    what = " ".join(str(exc).split())
-    return (
-        f"{args.command}: numerical failure ({type(exc).__name__}: {what}): an input is beyond "
-        "what the computation can represent; check the options' and the model's magnitudes"
-    )
-
-
-_default_showwarning = warnings.showwarning
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Print an :class:`~rt70.errors.Rt70Warning` as one ``rt70: warning:`` line on stderr."""
-    if issubclass(category, Rt70Warning):
-        print(f"rt70: warning: {message}", file=sys.stderr)
-    else:
-        _default_showwarning(message, category, filename, lineno, file, line)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ import signal
 import sys
 import tempfile
 import threading
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -281,6 +282,57 @@ def check_writable_directory(directory: Path) -> None:
         ) from None
     os.close(fd)
     os.unlink(name)
+
+
+# --- numerical trouble -------------------------------------------------------------------
+#: Commands run without an :class:`~rt70.integrators.EvaluationBudget`: ``bench``
+#: measures methods at any cost by design, ``sweep`` keeps its own limits.
+UNBUDGETED = ("bench", "sweep")
+
+
+@contextmanager
+def warning_guards(command: str) -> Iterator[None]:
+    """Warnings as the command line treats them, and the integrations' budget.
+
+    Enter it inside ``warnings.catch_warnings()`` (rt70/cli.py's docstring): an
+    :class:`~rt70.errors.Rt70Warning` is printed each time as one ``rt70: warning:``
+    line; numpy's floating-point warnings and scipy's ``LinAlgWarning`` (every
+    ``RuntimeWarning``) become exceptions that the command line prints as its one error
+    line (:func:`numerical_failure`); every integration of ``command`` but those of
+    :data:`UNBUDGETED` runs under :func:`rt70.integrators.evaluation_budget`.
+    """
+    from contextlib import nullcontext
+
+    from rt70.errors import Rt70Warning
+    from rt70.integrators import evaluation_budget
+
+    warnings.simplefilter("error", RuntimeWarning)
+    warnings.simplefilter("always", Rt70Warning)
+    warnings.showwarning = _show_warning
+    with nullcontext() if command in UNBUDGETED else evaluation_budget():
+        yield
+
+
+_default_showwarning = warnings.showwarning
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print an :class:`~rt70.errors.Rt70Warning` as one ``rt70: warning:`` line on stderr."""
+    from rt70.errors import Rt70Warning
+
+    if issubclass(category, Rt70Warning):
+        print(f"rt70: warning: {message}", file=sys.stderr)
+    else:
+        _default_showwarning(message, category, filename, lineno, file, line)
+
+
+def numerical_failure(command: str, exc: RuntimeWarning) -> str:
+    """The error line of a RuntimeWarning that reached the command line."""
+    what = " ".join(str(exc).split())
+    return (
+        f"{command}: numerical failure ({type(exc).__name__}: {what}): an input is beyond "
+        "what the computation can represent; check the options' and the model's magnitudes"
+    )
 
 
 # --- signals -----------------------------------------------------------------------------
