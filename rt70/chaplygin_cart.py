@@ -26,6 +26,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rt70.errors import Rt70Error
+from rt70.integrators import budgeted
 from rt70.nonholonomic import perturbation_matrix, program_acceleration, program_multipliers
 from rt70.nonholonomic_scene import constraint_rows, reduced_system
 from rt70.scene import Scene
@@ -217,7 +218,7 @@ def simulate(
 
     times = np.asarray(times, dtype=float)
     return solve_ivp(
-        rhs,
+        budgeted(rhs, float(times[-1])),
         (0.0, float(times[-1])),
         np.concatenate([q0, qd0_ind]),
         method="DOP853",

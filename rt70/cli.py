@@ -8,6 +8,14 @@ cannot load are listed as ``not loaded: <name>: <reason>`` lines, no error by th
 
 Every option is checked before any work starts (:mod:`rt70.options`); SIGTERM becomes a
 normal exit, so outputs being written are cleaned up (:mod:`rt70.atomic`).
+
+Numerical trouble is an error, never a stray warning beside a result: inside a command
+every ``RuntimeWarning`` (numpy's overflow, invalid value, division by zero; scipy's
+``LinAlgWarning`` and the Lyapunov solver's marginal eigenvalues) is raised and printed
+as the one ``rt70: error:`` line, exit 2 (:func:`rt70.options.warning_guards`); code
+that expects such values says so with ``np.errstate`` and checks them. The solvers'
+warnings join the run's message, and every integration but ``bench``'s has an evaluation
+budget: a run its method cannot integrate stops with one line (:mod:`rt70.integrators`).
 """
 
 from __future__ import annotations
@@ -19,7 +27,7 @@ import sys
 import warnings
 
 from rt70 import cli_cart, cli_impact, cli_pointing, cli_reactions, cli_sweep, options
-from rt70.errors import ResourceError, Rt70Error, Rt70Warning, SingularConfigurationError
+from rt70.errors import ResourceError, Rt70Error, SingularConfigurationError
 from rt70.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 
@@ -127,6 +135,7 @@ def _modes(args: argparse.Namespace) -> int:
         damped = modal.damped_modes(model.M, model.K, model.D)
     rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates)
     damped_summary = mode_table.damped_summary(result, damped)
+    options.check_finite({"modes": rows, "damped": damped_summary}, f"{scene.name}: modes")
     if args.json:
         out = {
             "scene": scene.name,
@@ -316,10 +325,11 @@ def _plant(args: argparse.Namespace) -> int:
             "peak_hz": err.freq_hz,
             "bound_2sum_hsv": red.bound,
         }
+    arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
+    options.check_finite({**info, **arrays}, f"{scene.name}: plant")
     if args.out:
         from rt70.atomic import atomic_write
 
-        arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
         labels = {k: np.array(info[k]) for k in ("states", "inputs", "outputs")}
         atomic_write(args.out, lambda tmp: np.savez_compressed(tmp, **arrays, **labels))
     if args.json:
@@ -656,13 +666,13 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
+    guards = options.warning_guards(args.command)  # module docstring
     with (
         options.sigterm_exits(EXIT_TERMINATED),
         options.checked_stdout(),  # '> file' on a full disk: one line, exit 2
         warnings.catch_warnings(),
+        guards,
     ):
-        warnings.simplefilter("always", Rt70Warning)
-        warnings.showwarning = _show_warning
         try:
             options.check_outputs(args)  # before any work: a bad output path exits 2 at once
             code = args.func(args)
@@ -670,6 +680,9 @@ def main(argv: list[str] | None = None) -> int:
             return code
         except Rt70Error as exc:
             print(f"rt70: error: {exc}", file=sys.stderr)
+            return 2
+        except RuntimeWarning as exc:  # numpy's floating-point warnings, scipy's LinAlgWarning
+            print(f"rt70: error: {options.numerical_failure(args.command, exc)}", file=sys.stderr)
             return 2
         except BrokenPipeError:
             # the reader went away (``| head``); Python flushes stdout again at exit:
@@ -680,17 +693,6 @@ def main(argv: list[str] | None = None) -> int:
         except KeyboardInterrupt:
             print("rt70: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
-
-
-_default_showwarning = warnings.showwarning
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Print an :class:`~rt70.errors.Rt70Warning` as one ``rt70: warning:`` line on stderr."""
-    if issubclass(category, Rt70Warning):
-        print(f"rt70: warning: {message}", file=sys.stderr)
-    else:
-        _default_showwarning(message, category, filename, lineno, file, line)
 
 
 if __name__ == "__main__":

@@ -13,9 +13,17 @@ import numpy as np
 
 from rt70 import options
 from rt70.errors import Rt70Error
+from rt70.resources import check_time_series
 
 #: Longest run accepted, s (the cart reaches the target's neighbourhood in about 10 s).
 MAX_DURATION = 100.0
+
+#: Interval of the grid on which the obstacle function g is sampled, s.
+GRID = 0.01
+
+#: Values kept per sample: the state (8) and a printed row's seven Python floats (about
+#: four float64 each: a float object and its list slot).
+CHANNELS = 8 + 7 * 4
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -36,14 +44,14 @@ def add_parser(sub) -> argparse.ArgumentParser:
     car.add_argument(
         "--start",
         nargs=2,
-        type=options.finite_float,
+        type=options.physical_float,
         default=(4.0, 0.5),
         metavar=("X", "Y"),
         help="start of M, m (default 4 0.5)",
     )
     car.add_argument(
         "--heading-error",
-        type=options.finite_float,
+        type=options.angle_error,
         default=0.0,
         metavar="RAD",
         help="heading off the programmed one at the start, rad (default 0)",
@@ -83,6 +91,12 @@ def run(args: argparse.Namespace) -> int:
         raise Rt70Error(f"--step {args.step:g} is longer than --duration {args.duration:g}")
     if args.speed_error <= -1.0:
         raise Rt70Error(f"--speed-error {args.speed_error:g}: the speed must stay positive")
+    check_time_series(
+        args.duration / args.step + args.duration / GRID + 2,
+        CHANNELS,
+        f"the states every --step and every {GRID:g} s over {args.duration:g} s",
+        f"--step {args.step:g}",
+    )
     scene = load_scene(args.scene)
     cart.check_scene(scene)
     with options.option_at_fault(f"--start {args.start[0]:g} {args.start[1]:g}"):
@@ -94,29 +108,30 @@ def run(args: argparse.Namespace) -> int:
         first = cart.servo(scene, q, qd, side=args.side)
     n = int(np.floor(args.duration / args.step + 1e-9))
     shown = np.unique(np.round(np.append(np.arange(n + 1) * args.step, args.duration), 12))
-    grid = np.linspace(0.0, args.duration, int(np.ceil(args.duration / 0.01)) + 1)
+    grid = np.linspace(0.0, args.duration, int(np.ceil(args.duration / GRID)) + 1)
     sol = cart.simulate(
         scene, q, qd, np.unique(np.concatenate([shown, grid])), side=args.side, stop_radius=0.01
     )
-    g_min = float(np.min(cart.obstacle(sol.y[0], sol.y[1])))  # on a 0.01-s grid
+    g_min = float(np.min(cart.obstacle(sol.y[0], sol.y[1])))  # on the GRID
     picked = [i for i, t in enumerate(sol.t) if np.min(np.abs(shown - t)) < 1e-9]
     if picked[-1] != sol.t.size - 1:
         picked.append(sol.t.size - 1)  # where a stopped run ended
     end = cart.servo(scene, sol.y[:5, -1], sol.y[5:, -1], side=args.side).residuals
     stopped = sol.status == 1
     rows = [[float(sol.t[i]), *map(float, sol.y[[0, 1, 2, 5, 6, 7], i])] for i in picked]
+    out = {
+        "scene": scene.name,
+        "side": args.side,
+        "initial": {"M1": first.M1, "M2": first.M2, "lateral": first.lateral},
+        "columns": ["t", "x", "y", "theta", "xd", "yd", "thetad"],
+        "rows": rows,
+        "min_g": g_min,
+        "perturbations_start": first.residuals.tolist(),
+        "perturbations_end": end.tolist(),
+        "stopped_at": float(sol.t_events[0][0]) if stopped else None,
+    }
+    options.check_finite(out, f"{scene.name}: cart")
     if args.json:
-        out = {
-            "scene": scene.name,
-            "side": args.side,
-            "initial": {"M1": first.M1, "M2": first.M2, "lateral": first.lateral},
-            "columns": ["t", "x", "y", "theta", "xd", "yd", "thetad"],
-            "rows": rows,
-            "min_g": g_min,
-            "perturbations_start": first.residuals.tolist(),
-            "perturbations_end": end.tolist(),
-            "stopped_at": float(sol.t_events[0][0]) if stopped else None,
-        }
         print(json.dumps(out, indent=2))
         return 0
     print(

@@ -29,7 +29,7 @@ def _rate(text: str) -> tuple[str, float]:
     name, sep, value = text.partition("=")
     if not sep or not name:
         raise argparse.ArgumentTypeError(f"'{text}' is not COORD=VALUE")
-    return name, options.finite_float(value)
+    return name, options.physical_float(value)
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -165,33 +165,34 @@ def run(args: argparse.Namespace) -> int:
     err_j = _relative(
         np.concatenate(list(shock.values())), np.concatenate(list(shock_ref.values()))
     )
+    out = {
+        "scene": scene.name,
+        "locks": labels(locks),  # one label per impulse (a lock given twice: twice)
+        "restitution": impact.restitution,
+        "coordinates": names,
+        "q": q.tolist(),
+        "qd_before": impact.qd_before.tolist(),
+        "qd_after": impact.qd_after.tolist(),
+        "impulses": impact.impulses.tolist(),  # in the order of "locks"
+        "rank": impact.rank,
+        "kinetic_before": impact.kinetic_before,
+        "kinetic_after": impact.kinetic_after,
+        "energy_lost": impact.energy_lost,
+        "carnot": impact.carnot,
+        "balance": impact.balance,
+        "pinocchio": {
+            "qd_after": ref.qd_after.tolist(),
+            "impulses": ref.impulses.tolist(),
+            "max_rel_err_qd_after": err_v,
+            "max_rel_err_impulses": err_l,
+            "max_rel_err_joint_impulses": err_j,
+        },
+        "joint_impulses": {k: v.tolist() for k, v in shock.items()},  # [F; M], joint axes
+    }
+    if audit is not None:
+        out["audit"] = audit.to_dict()
+    options.check_finite(out, f"{scene.name}: impact")
     if args.json:
-        out = {
-            "scene": scene.name,
-            "locks": labels(locks),  # one label per impulse (a lock given twice: twice)
-            "restitution": impact.restitution,
-            "coordinates": names,
-            "q": q.tolist(),
-            "qd_before": impact.qd_before.tolist(),
-            "qd_after": impact.qd_after.tolist(),
-            "impulses": impact.impulses.tolist(),  # in the order of "locks"
-            "rank": impact.rank,
-            "kinetic_before": impact.kinetic_before,
-            "kinetic_after": impact.kinetic_after,
-            "energy_lost": impact.energy_lost,
-            "carnot": impact.carnot,
-            "balance": impact.balance,
-            "pinocchio": {
-                "qd_after": ref.qd_after.tolist(),
-                "impulses": ref.impulses.tolist(),
-                "max_rel_err_qd_after": err_v,
-                "max_rel_err_impulses": err_l,
-                "max_rel_err_joint_impulses": err_j,
-            },
-            "joint_impulses": {k: v.tolist() for k, v in shock.items()},  # [F; M], joint axes
-        }
-        if audit is not None:
-            out["audit"] = audit.to_dict()
         print(json.dumps(out, indent=2))
         return 0
     print(

@@ -36,7 +36,7 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
     add_pointing_arguments(poi, default="45")
     poi.add_argument(
         "--wind",
-        type=options.positive_float,
+        type=options.wind_speed,
         required=True,
         metavar="SPEED",
         help="mean wind speed at the antenna, m/s",
@@ -92,6 +92,10 @@ def run(args: argparse.Namespace) -> int:
         )
         scene = load_scene(SERVO_SCENE)
     check_scene(scene)
+    if args.duration is not None:  # before the budget's work
+        from rt70.gust_run import check_duration
+
+        check_duration(scene, args.duration)
     model = budget_model(scene, case)
     budget = pointing_budget(scene, case, model)
     run = None
@@ -101,10 +105,11 @@ def run(args: argparse.Namespace) -> int:
         run = gust_run(
             scene, case, args.duration, seed=args.seed, progress=args.progress, model=model
         )
+    out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
+    if run is not None:
+        out["gust_run"] = run.to_dict()
+    options.check_finite(out, f"{scene.name}: pointing budget")
     if args.json:
-        out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
-        if run is not None:
-            out["gust_run"] = run.to_dict()
         print(json.dumps(out, indent=2))
         return 0
     print(format_budget(scene.name, budget))

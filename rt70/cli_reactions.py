@@ -53,7 +53,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     )
     rea.add_argument(
         "--wind",
-        type=options.positive_float,
+        type=options.wind_speed,
         metavar="SPEED",
         help="also with a steady wind of SPEED m/s",
     )
@@ -93,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     bl.check_scene(scene, speed > 0.0)
     rows = bl.load_table(scene, elevations, args.azimuth, speed, directions)
+    options.check_finite([b.to_dict() for b in rows], f"{scene.name}: reactions")
     if out is not None:
         bl.write_output(out, rows)
     if args.json:

@@ -106,6 +106,29 @@ class DcDrive(StateComponent):
         p = parameters
         return np.array([torque / (p.i_r * p.c_m), p.i_r * (angle + torque / p.C_r), 0.0])
 
+    def fastest_rate(self) -> tuple[float, str]:
+        """The drive's fastest rate, 1/s, and which it is (a stiffness check's input).
+
+        The rates of the motor seen alone, the load held: the armature's ``R_a/L_a``, the
+        electromechanical ``√(c_m c_e/(L_a J_m))``, the reducer's ``√(C_r/(J_m i_r²))``
+        and its damping's ``D_r/(J_m i_r²)``, the rotor's ``D_m/J_m``. The implicit
+        methods' Jacobian treats the drive's states explicitly (:mod:`rt70.states`), so
+        a run needs steps of about the inverse of the fastest (rt70_servo: 50 1/s, the
+        armature).
+        """
+        p = self.p
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            rates = {
+                "R_a/L_a": p.R_a / p.L_a,
+                "√(c_m c_e/(L_a J_m))": np.sqrt(p.c_m * p.c_e / (p.L_a * p.J_m)),
+                "√(C_r/(J_m i_r²))": np.sqrt(p.C_r / (p.J_m * p.i_r**2)),
+                "D_r/(J_m i_r²)": p.D_r / (p.J_m * p.i_r**2),
+                "D_m/J_m": p.D_m / p.J_m,
+            }
+        label = max(rates, key=lambda k: np.nan_to_num(rates[k], nan=np.inf))
+        rate = float(rates[label])
+        return (rate if np.isfinite(rate) else np.inf), label
+
     def twist(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> tuple[float, float]:
         """The reducer's twist and its rate, ``(Δ, Δ̇) = (α − α_m/i_r, α̇ − ω_m/i_r)`` (4.139)."""
         p, c = self.p, self.coupling

@@ -94,6 +94,31 @@ def _rms(y: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum(y * y, axis=1))))
 
 
+#: Extra states of the nonlinear run per drive, at most (motor, servo, anti-windup).
+STATES_PER_DRIVE = 8
+
+
+def check_duration(scene: Scene, duration: float, dt: float = DT, outputs=()) -> None:
+    """Refuse a record whose samples (every ``dt`` over ``duration``) this machine cannot hold.
+
+    Raises
+    ------
+    rt70.errors.ResourceError
+        Naming ``--duration`` (:func:`rt70.resources.check_time_series`).
+    """
+    from rt70.resources import check_time_series
+    from rt70.simulate import sample_channels
+
+    extra = 2 + STATES_PER_DRIVE * len(scene.description.drives)
+    channels = sample_channels(scene.textbook.nv, extra, outputs) + 1  # and the gust
+    check_time_series(
+        duration / dt + 1,
+        channels,
+        f"a gust record sampled every {dt:g} s",
+        f"{scene.name}: --duration {duration:g}",
+    )
+
+
 def gust_run(
     scene: Scene,
     case: PointingCase,
@@ -129,6 +154,7 @@ def gust_run(
     elif model.case != case:
         raise Rt70Error(f"the budget model is of {model.case}, not of {case}")
     outputs = model.outputs
+    check_duration(scene, duration, dt, outputs)
     series = realise(GustFilter(case.speed), duration, dt, seed)
     t = series.t
     # the nonlinear model, at rest in the windy equilibrium held by its drives

@@ -21,8 +21,8 @@ pinion on the stator pushes the sector's link at the mesh point with ``F = K/ρ`
 the pitch circle's tangent and the sector pushes back on the pinion, two Wrenches whose
 generalised force is exactly ``K ∂θ_d/∂q`` for the mesh angle θ_d (docs/urdf-extensions.md,
 ``<rt70:drive>``). Each side hands in the link's and the stator's poses from its own
-kinematics. This module sits below both sides: it imports nothing of rt70
-but the argument checks (tests/test_import_rules.py, ``SHARED``).
+kinematics. This module sits below both sides: it imports nothing of rt70 but the errors
+and the argument checks (tests/test_import_rules.py, ``SHARED``).
 """
 
 from __future__ import annotations
@@ -32,11 +32,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from rt70.arrays import check_vector
+from rt70.errors import Rt70Error
 
 Vector3 = tuple[float, float, float]
 
 #: A frame's pose in ground axes: its rotation (3, 3) and its origin (3,).
 Pose = tuple[np.ndarray, np.ndarray]
+
+
+#: Relative accuracy to which a sector's pitch circle must survive the rounding of the
+#: positions it is built from (:meth:`SectorMesh.at_construction`).
+RADIUS_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -94,18 +100,34 @@ class SectorMesh:
 
     @classmethod
     def at_construction(
-        cls, xyz, direction, axis, radius: float, link: Pose, stator: Pose
+        cls, xyz, direction, axis, radius: float, link: Pose, stator: Pose, where: str = "sector"
     ) -> SectorMesh:
         """The circle from the sector's data (link axes) and both poses at q = 0.
 
         The centre lies at ``xyz + radius (axis × direction)`` in the link: the tangent
         ``direction`` turns positively about ``axis``.
+
+        Raises
+        ------
+        Rt70Error
+            (naming ``where``) If the radius is lost in the rounding of the positions:
+            the centre and the mesh point, each rounded to ε of the positions' size, must
+            lie ``radius`` apart to :data:`RADIUS_TOLERANCE`, or θ_d would be rounding
+            noise (its gradient 1/ρ, a division by a rounded difference).
         """
         (R_l, p_l), (R_s, p_s) = link, stator
         xyz, t, a = (np.asarray(x, dtype=float) for x in (xyz, direction, axis))
         centre_link = xyz + radius * np.cross(a, t)
         centre = R_s.T @ (p_l + R_l @ centre_link - p_s)
         mesh = R_s.T @ (p_l + R_l @ xyz - p_s)
+        distance = float(np.linalg.norm(mesh - centre))
+        if not abs(distance - radius) <= RADIUS_TOLERANCE * radius:
+            size = max(float(np.abs(np.concatenate([p_l, p_s, xyz])).max()), 1.0)
+            raise Rt70Error(
+                f"{where}: radius {radius:g} m is lost in the rounding of positions of "
+                f"{size:.3g} m (the pitch circle's centre and mesh point lie {distance:.3g} m "
+                "apart): no gear angle can be computed"
+            )
         u = (mesh - centre) / radius
         a_s = R_s.T @ R_l @ a
         return cls(centre, u, np.cross(a_s, u))

@@ -17,6 +17,7 @@ docs/impacts.md.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -28,6 +29,10 @@ from rt70.scene import Scene, require_coordinates
 
 #: The sides :func:`engage` can solve on.
 SIDES = ("textbook", "reference")
+
+#: Largest coordinate of a stow pin's point, m: the bound of every number rt70 reads
+#: from a model (``rt70.urdf.reader.MAX_MAGNITUDE``).
+MAX_POINT = 1e30
 
 #: URDF joint types a brake can hold.
 BRAKE_JOINT_TYPES = ("revolute", "continuous", "prismatic")
@@ -88,6 +93,11 @@ def parse_pin(text: str) -> StowPin:
         raise Rt70Error(f"stow pin '{text}': the point must be three numbers x,y,z") from None
     if len(xyz) != 3:
         raise Rt70Error(f"stow pin '{text}': the point must be three numbers x,y,z")
+    if not all(math.isfinite(v) and abs(v) <= MAX_POINT for v in xyz):
+        raise Rt70Error(
+            f"--pin {text}: the point must be finite, of magnitude at most {MAX_POINT:g} m "
+            "(the largest number rt70 reads, docs/urdf-reader.md)"
+        )
     return StowPin(link, np.array(xyz))
 
 

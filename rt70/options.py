@@ -16,12 +16,13 @@ import signal
 import sys
 import tempfile
 import threading
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import NoReturn
 
-from rt70.errors import OutputError, Rt70Error
+from rt70.errors import OutputError, Rt70Error, Rt70Warning
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
 EXIT_TERMINATED = 128 + signal.SIGTERM
@@ -45,6 +46,17 @@ ELEVATION_RANGE = (0.0, 90.0)
 
 #: Smallest relative tolerance ``solve_ivp`` honours (100 machine epsilons).
 MIN_RTOL = 100 * sys.float_info.epsilon
+
+#: Largest magnitude of a physical number given as an option (a rate, a position): the
+#: bound of every number rt70 reads from a model (``rt70.urdf.reader.MAX_MAGNITUDE``,
+#: docs/urdf-reader.md): a product of ten such numbers stays below the largest double.
+MAX_MAGNITUDE = 1e30
+
+#: Largest mean wind speed, m/s: the wind load's model (constant coefficients, dynamic
+#: pressure ½ρv², docs/wind.md) is that of incompressible flow, which holds below Mach 0.3
+#: — 0.3 × 340.3 m/s, the speed of sound in the ISA sea-level air the default density is
+#: of. (The strongest gust measured, 113 m/s at Barrow Island in 1996, is above it.)
+MAX_WIND_SPEED = 0.3 * 340.3
 
 #: Largest ``rt70 bench --K``: the batched mass matrices alone take ``K nv²`` floats
 #: (1.4 GB for the RT-70 scene at this K).
@@ -98,6 +110,38 @@ def non_negative_float(text: str) -> float:
     value = _number(text)
     if value < 0.0:
         raise argparse.ArgumentTypeError(f"must be at least 0, got {text}")
+    return value
+
+
+def physical_float(text: str) -> float:
+    """A finite number of magnitude at most :data:`MAX_MAGNITUDE`."""
+    value = _number(text)
+    if abs(value) > MAX_MAGNITUDE:
+        raise argparse.ArgumentTypeError(
+            f"magnitude above {MAX_MAGNITUDE:g}, the largest number rt70 reads "
+            f"(docs/urdf-reader.md), got {text}"
+        )
+    return value
+
+
+def wind_speed(text: str) -> float:
+    """A mean wind speed, m/s: ``0 < v ≤`` :data:`MAX_WIND_SPEED` (incompressible flow)."""
+    value = positive_float(text)
+    if value > MAX_WIND_SPEED:
+        raise argparse.ArgumentTypeError(
+            f"at most {MAX_WIND_SPEED:.0f} m/s, Mach 0.3: the wind load's model (½ρv², constant "
+            f"coefficients) is that of incompressible flow, got {text}"
+        )
+    return value
+
+
+def angle_error(text: str) -> float:
+    """An angle off a programmed one, rad: ``|x| ≤ π`` (a heading is an angle modulo 2π)."""
+    value = _number(text)
+    if abs(value) > math.pi:
+        raise argparse.ArgumentTypeError(
+            f"must lie in [-π, π] (an angle off the programmed heading), got {text}"
+        )
     return value
 
 
@@ -168,6 +212,52 @@ def option_at_fault(option: str) -> Iterator[None]:
         yield
     except Rt70Error as exc:
         raise type(exc)(f"{option}: {exc}") from None
+
+
+# --- results ---------------------------------------------------------------------------
+def check_finite(result: object, what: str) -> None:
+    """Refuse a result (nested dicts, lists, numbers) holding a NaN or an infinity.
+
+    A command calls this on what it is about to print or write, so that NaN never
+    reaches an output without an error; a value that may be absent is None, not NaN.
+
+    Raises
+    ------
+    Rt70Error
+        Naming ``what`` and the key path of the first bad value.
+    """
+    path = _non_finite(result, "")
+    if path is not None:
+        raise Rt70Error(f"{what}: {path or 'the result'} is NaN or infinite: nothing to report")
+
+
+def json_text(result: object, what: str) -> str:
+    """``json.dumps(result, indent=2)`` after :func:`check_finite` (no ``NaN`` in JSON)."""
+    import json
+
+    check_finite(result, what)
+    return json.dumps(result, indent=2)
+
+
+def _non_finite(value: object, path: str) -> str | None:
+    """The key path of the first NaN or infinity in ``value``, or None."""
+    if isinstance(value, dict):
+        items = ((f"{path}.{k}" if path else str(k), v) for k, v in value.items())
+    elif isinstance(value, list | tuple):
+        items = ((f"{path}[{i}]", v) for i, v in enumerate(value))
+    elif isinstance(value, float):
+        return None if math.isfinite(value) else path
+    else:
+        items = ()
+        if hasattr(value, "dtype") and getattr(value.dtype, "kind", "") in "fc":
+            import numpy as np
+
+            return None if np.isfinite(value).all() else path
+    for key, item in items:
+        bad = _non_finite(item, key)
+        if bad is not None:
+            return bad
+    return None
 
 
 # --- output paths ------------------------------------------------------------------------
@@ -283,6 +373,54 @@ def checked_stdout() -> Iterator[None]:
         yield
     finally:
         sys.stdout = stream
+
+
+# --- numerical trouble -------------------------------------------------------------------
+#: Commands run without an :class:`~rt70.integrators.EvaluationBudget`: ``bench``
+#: measures methods at any cost by design, ``sweep`` keeps its own limits.
+UNBUDGETED = ("bench", "sweep")
+
+
+@contextmanager
+def warning_guards(command: str) -> Iterator[None]:
+    """Warnings as the command line treats them, and the integrations' budget.
+
+    Enter it inside ``warnings.catch_warnings()`` (rt70/cli.py's docstring): an
+    :class:`~rt70.errors.Rt70Warning` is printed each time as one ``rt70: warning:``
+    line; numpy's floating-point warnings and scipy's ``LinAlgWarning`` (every
+    ``RuntimeWarning``) become exceptions that the command line prints as its one error
+    line (:func:`numerical_failure`); every integration of ``command`` but those of
+    :data:`UNBUDGETED` runs under :func:`rt70.integrators.evaluation_budget`.
+    """
+    from contextlib import nullcontext
+
+    from rt70.integrators import evaluation_budget
+
+    warnings.simplefilter("error", RuntimeWarning)
+    warnings.simplefilter("always", Rt70Warning)
+    warnings.showwarning = _show_warning
+    with nullcontext() if command in UNBUDGETED else evaluation_budget():
+        yield
+
+
+_default_showwarning = warnings.showwarning
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print an :class:`~rt70.errors.Rt70Warning` as one ``rt70: warning:`` line on stderr."""
+    if issubclass(category, Rt70Warning):
+        print(f"rt70: warning: {message}", file=sys.stderr)
+    else:
+        _default_showwarning(message, category, filename, lineno, file, line)
+
+
+def numerical_failure(command: str, exc: RuntimeWarning) -> str:
+    """The error line of a RuntimeWarning that reached the command line."""
+    what = " ".join(str(exc).split())
+    return (
+        f"{command}: numerical failure ({type(exc).__name__}: {what}): an input is beyond "
+        "what the computation can represent; check the options' and the model's magnitudes"
+    )
 
 
 # --- signals -----------------------------------------------------------------------------

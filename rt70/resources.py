@@ -31,6 +31,16 @@ The textbook's mass check
     :func:`massless_peak_bytes`. A 20 000-link revolute chain would need 35 GB; it is
     refused before the check starts (:func:`check_massless`).
 
+Time series
+    A simulation keeps every sample of its state (the solver's rows), then the result's
+    arrays built from them (q, q̇, the energies, the extra states, the outputs) and
+    products formed from those: :func:`time_series_bytes` counts
+    :data:`TIME_SERIES_COPIES` float64 copies of ``samples × channels``, and
+    :func:`check_time_series` refuses a run (a duration, a print step, a sampling rate)
+    whose samples would exceed :data:`MEMORY_FRACTION` of ``MemAvailable`` — before the
+    run, where the number of samples is known (output times given), or as the most
+    samples a run may take where it is not (one per step: :func:`time_series_samples`).
+
 Nothing here imports Pinocchio.
 """
 
@@ -58,6 +68,10 @@ PARSER_MAX_DEPTH = 40_000
 
 _MEMINFO = Path("/proc/meminfo")
 _DOFS = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
+
+#: Float64 copies of a run's time series held at its peak (the solver's rows, the
+#: result's arrays, the products formed from them; module docstring).
+TIME_SERIES_COPIES = 4
 
 T = TypeVar("T")
 
@@ -151,6 +165,44 @@ def check_memory(needed: int, what: str, source: str, available: int | None = No
             f"{source}: {what} would need about {_gb(needed)} of memory; this run may use "
             f"{_gb(budget)} ({MEMORY_FRACTION:.0%} of the {_gb(available)} available)"
         )
+
+
+def time_series_bytes(samples: float, channels: int) -> float:
+    """Peak memory of ``samples`` samples of ``channels`` float64 values, bytes.
+
+    ``8 · samples · channels · TIME_SERIES_COPIES``; ``samples`` may be a float (a
+    duration over a step, before it is rounded), so a huge request does not overflow.
+    """
+    return 8.0 * float(samples) * channels * TIME_SERIES_COPIES
+
+
+def time_series_samples(channels: int, available: int | None = None) -> int | None:
+    """Most samples of ``channels`` values this run may keep (None where memory is unknown)."""
+    available = available_memory() if available is None else available
+    if available is None:
+        return None
+    return max(int(MEMORY_FRACTION * available / time_series_bytes(1, channels)), 1)
+
+
+def check_time_series(
+    samples: float, channels: int, what: str, source: str, available: int | None = None
+) -> None:
+    """Refuse a run whose ``samples × channels`` time series this machine cannot hold.
+
+    ``source`` names the option or the call that asked for it (``--t-end 1e+12``);
+    ``available`` as :func:`check_memory`.
+
+    Raises
+    ------
+    ResourceError
+        Naming ``source``, the samples and the memory.
+    """
+    check_memory(
+        time_series_bytes(samples, channels),
+        f"{what} ({float(samples):.3g} samples of {channels} values)",
+        source,
+        available,
+    )
 
 
 def check_reference(desc: RobotDescription) -> None:

@@ -41,6 +41,7 @@ from rt70.errors import Rt70Error
 from rt70.geartrains import equivalent_drive
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.outputs import Output, evaluate
+from rt70.resources import check_time_series
 from rt70.scene import Scene
 from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE, AxisDrive
 from rt70.scenes.rt70_optics import rt70_mirror_outputs, rt70_mirror_system
@@ -59,7 +60,7 @@ from rt70.servo_metrics import (  # noqa: F401  (re-exported: the scenario's num
     settling_time,
     summary_lines,
 )
-from rt70.simulate import SimulationResult, simulate
+from rt70.simulate import SimulationResult, sample_channels, simulate
 from rt70.states import StateComponent
 
 #: The scenarios by name (``rt70 simulate --scenario``).
@@ -442,7 +443,21 @@ def run_scenario(
         ELEVATION_COORDINATE: lambda t: e0 - np.radians(sc.elevation(t)),
     }
     components = drives(scene, q0, torques, refs)
-    n_t = int(np.ceil(sc.t_end * samples_per_s)) + 1
+    if sc.t_end * samples_per_s < 1.0:
+        raise Rt70Error(
+            f"{scene.name}: --t-end {sc.t_end:g}: a scenario is measured on samples every "
+            f"{1 / samples_per_s:g} s; it must last at least that long"
+        )
+    n_t = np.ceil(sc.t_end * samples_per_s) + 1
+    check_time_series(
+        n_t,
+        sample_channels(
+            len(names), 2 + sum(len(c.names) for c in components), [mirror_axis_output(scene)]
+        ),
+        f"scenario '{sc.name}' sampled {samples_per_s:g} times a second",
+        f"{scene.name}: --t-end {sc.t_end:g}",
+    )
+    n_t = int(n_t)
     t_eval = np.linspace(0.0, sc.t_end, n_t)
     result = simulate(
         scene,

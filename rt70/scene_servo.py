@@ -141,14 +141,20 @@ def scene_equilibrium(
     def force(q: np.ndarray) -> np.ndarray:
         return static_force(scene, q) if load is None else static_force(scene, q) + load(q)
 
-    for _ in range(MAX_ITER):
-        G = np.column_stack([c.angle_gradient(q)[1] for c in couplings])
-        R = force(q) + G @ K
+    for k in range(MAX_ITER):
+        with np.errstate(over="ignore", invalid="ignore"):  # checked just below
+            G = np.column_stack([c.angle_gradient(q)[1] for c in couplings])
+            R = force(q) + G @ K
         size = float(np.max(np.abs(R))) / scale
+        if not np.isfinite(size):
+            raise Rt70Error(
+                f"{scene.name}: drives' equilibrium: the static forces are not finite after "
+                f"{k} Newton step(s): the load (a wind?) deforms the structure beyond any "
+                "equilibrium its stiffness can give"
+            )
         if size <= tol:
             return q, K, size
-        J = np.column_stack([-S[:, free], G])
-        step = scipy.linalg.solve(J, -R)
+        step = _newton_step(scene, np.column_stack([-S[:, free], G]), R)
         q[free] += step[: free.size]
         K += step[free.size :]
         if np.abs(step[: free.size]).max() <= STEP_TOL * max(1.0, np.abs(q).max()):
@@ -159,6 +165,24 @@ def scene_equilibrium(
         f"{scene.name}: drives' equilibrium not found in {MAX_ITER} Newton steps "
         f"(residual {size:.2g} of the force scale)"
     )
+
+
+def _newton_step(scene: Scene, J: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """``J⁻¹(−R)`` with J's columns scaled to unit max-norm first.
+
+    The columns mix units (a coordinate's stiffness, N·m/rad, against a sector's angle
+    gradient, 1/m): scaled, the solve's conditioning is the equations', not the units'.
+    """
+    scale = np.max(np.abs(J), axis=0)
+    scale[scale == 0.0] = 1.0
+    try:
+        step = scipy.linalg.solve(J / scale, -R) / scale
+    except (np.linalg.LinAlgError, ValueError):
+        raise Rt70Error(
+            f"{scene.name}: drives' equilibrium: Newton's matrix is singular or not finite "
+            "(a coordinate nothing holds?)"
+        ) from None
+    return step
 
 
 def scene_servos(

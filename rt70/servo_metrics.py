@@ -68,6 +68,25 @@ def predicted_settling(step_arcsec: float, gains: CascadeGains, band: float = BA
     return float(slew + settling_time(t, errors / ARCSEC, band))
 
 
+#: Metrics that are NaN when the run never settled (:func:`settling_time`) or the drive
+#: has no gains to predict from; every other metric must be finite.
+MAY_BE_NAN = (
+    "settle_s",
+    "axis_settle_s",
+    "predicted_settle_s",
+    "tracking_rms_arcsec",
+    "tracking_max_after_settle_arcsec",
+)
+
+
+def _check_finite(m: dict[str, float]) -> None:
+    from rt70.errors import Rt70Error
+
+    bad = [k for k, v in m.items() if k not in MAY_BE_NAN and not np.isfinite(v)]
+    if bad:
+        raise Rt70Error(f"the scenario's {', '.join(bad)} is not finite: nothing to report")
+
+
 def measure(run: ScenarioRun) -> dict[str, float]:
     """The scenario's numbers: settling, overshoot, peak torque, pointing and tracking errors.
 
@@ -114,27 +133,57 @@ def measure(run: ScenarioRun) -> dict[str, float]:
     return m
 
 
+def _inside(settle: float, t_end: float, what: str = "") -> str:
+    """``inside 1″ from t = … s``, or that the run ended outside the band (NaN)."""
+    if np.isfinite(settle):
+        return f"inside {BAND_ARCSEC:g}″ from t = {settle:.3g} s"
+    return f"not inside {BAND_ARCSEC:g}″ by the end of the run (t = {t_end:g} s{what})"
+
+
 def summary_lines(run: ScenarioRun) -> list[str]:
-    """The scenario's numbers as a few lines of text (``rt70 simulate``, the notebook)."""
+    """The scenario's numbers as a few lines of text (``rt70 simulate``, the notebook).
+
+    A settling time that is NaN (the run ended outside the band) reads "not inside …
+    by the end of the run"; every other number must be finite.
+
+    Raises
+    ------
+    Rt70Error
+        If a number other than a settling time (or what follows from one) is NaN or
+        infinite: it would otherwise be printed as ``nan``.
+    """
     m, sc = run.metrics, run.scenario
+    t_end = float(run.result.t[-1])
+    _check_finite(m)
     lines = [
         f"pointing error (mirror axis vs its equilibrium at the reference): max "
         f"{m['pointing_drift_arcsec']:.3g}″, final {m['final_pointing_arcsec']:.3g}″, "
-        f"inside {BAND_ARCSEC:g}″ from t = {m['settle_s']:.3g} s",
+        + _inside(m["settle_s"], t_end),
         f"static gravity sag of the mirror axis (4.157, calibrated by a pointing model): "
         f"{m['static_misalignment_arcsec']:.4g}″",
     ]
     if "step_arcsec" in m:
+        predicted = m["predicted_settle_s"]
+        prediction = (
+            f"predicted from the bandwidth {predicted:.3g} s"
+            if np.isfinite(predicted)
+            else "no prediction: the drive has no cascade gains"
+        )
         lines.append(
-            f"step {m['step_arcsec']:g}″: axis inside {BAND_ARCSEC:g}″ from "
-            f"{m['axis_settle_s']:.3g} s (predicted from the bandwidth "
-            f"{m['predicted_settle_s']:.3g} s), overshoot {m['overshoot_pct']:.3g} %"
+            f"step {m['step_arcsec']:g}″: axis {_inside(m['axis_settle_s'], t_end)} "
+            f"({prediction}), overshoot {m['overshoot_pct']:.3g} %"
         )
     if "tracking_rms_arcsec" in m:
-        lines.append(
-            f"tracking {sc.rate_arcsec_s:g}″/s: rms {m['tracking_rms_arcsec']:.3g}″, max "
-            f"{m['tracking_max_after_settle_arcsec']:.3g}″ after settling"
-        )
+        if np.isfinite(m["tracking_rms_arcsec"]):
+            lines.append(
+                f"tracking {sc.rate_arcsec_s:g}″/s: rms {m['tracking_rms_arcsec']:.3g}″, max "
+                f"{m['tracking_max_after_settle_arcsec']:.3g}″ after settling"
+            )
+        else:
+            lines.append(
+                f"tracking {sc.rate_arcsec_s:g}″/s: no tracking error after settling, the "
+                f"pointing error is {_inside(m['settle_s'], t_end)}"
+            )
     for axis in run.axis_torque:
         lines.append(
             f"{axis}: holding {m[f'holding_torque_{axis}_Nm']:.3g} N·m, peak "

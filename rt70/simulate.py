@@ -30,8 +30,9 @@ from rt70.errors import (
     SimulationError,
     SingularConfigurationError,
 )
-from rt70.integrators import CVODE_METHODS, METHODS, Stopwatch, integrate, load
+from rt70.integrators import CVODE_METHODS, METHODS, Stopwatch, budget_limit, integrate, load
 from rt70.outputs import Output, column_labels, evaluate, evaluate_trajectory
+from rt70.resources import check_time_series, time_series_samples
 from rt70.scene import Scene
 from rt70.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
@@ -442,7 +443,14 @@ def simulate(
     energy_scale = max(T0 + Uc0, 1e-12 * max(abs(Ug0), 1.0), 1e-300)
     atol_q = 1e-3 * rtol if atol is None else atol
     layout = StateLayout([EnergyAudit(rtol * energy_scale), *components], n)
+    _check_stiffness(scene, components, t1 - t0)
     atol_vec = np.concatenate([np.full(2 * n, atol_q), *layout.atol()])
+    channels = sample_channels(n, layout.size, outputs)
+    most_samples = None
+    if t_eval is not None:
+        check_time_series(t_eval.size, channels, "the output times", f"{scene.name}: t_eval")
+    else:  # one sample per step, each step at least one evaluation
+        most_samples = time_series_samples(channels)
     reached = [t0]  # the last time the right-hand side was evaluated at
     pushed = [False]  # whether a component ever pushed a force on the mechanics
 
@@ -506,6 +514,7 @@ def simulate(
                 atol_vec,
                 t_eval,
                 [_state_event(g, n) for g in events],
+                max_evaluations=most_samples,
             )
     except (Rt70Error, ValueError) as exc:
         # Rt70Error: the model cannot be integrated beyond this state; ValueError "array
@@ -519,6 +528,10 @@ def simulate(
     wall = time.perf_counter() - start
     spent = {"rhs": rhs_clock.seconds, "jacobian": 0.0 if jac_clock is None else jac_clock.seconds}
     timing = {**spent, "integrator": wall - spent["rhs"] - spent["jacobian"]}
+    if sol.t.size == 0:
+        raise SimulationError(
+            f"{scene.name}: integration failed before the first output time: {sol.message}"
+        )
     q, qd = sol.y[:n].T, sol.y[n : 2 * n].T
     energies = np.array([side.energies(a, b) for a, b in zip(q, qd, strict=True)])
     states = layout.read(sol.y)
@@ -561,6 +574,35 @@ def simulate(
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
     result.outputs = evaluate_trajectory(scene, q, outputs, output_side)
     return result
+
+
+def _check_stiffness(scene: Scene, components: Sequence[StateComponent], span: float) -> None:
+    """Refuse components too stiff to integrate within the evaluation budget in force.
+
+    A component with a ``fastest_rate()`` (a drive: :meth:`rt70.drives.DcDrive.fastest_rate`)
+    needs about ``rate · span`` steps, its states being treated explicitly by the implicit
+    methods' Jacobian (:mod:`rt70.states`); a run that would need more than the budget
+    (:func:`rt70.integrators.budget_limit`) is refused before it starts.
+    """
+    limit = budget_limit(span)
+    if limit is None:
+        return
+    for c in components:
+        if not hasattr(c, "fastest_rate"):
+            continue
+        rate, label = c.fastest_rate()
+        if rate * span > limit:
+            name = c.names[0].split(":")[0]
+            raise SimulationError(
+                f"{scene.name}: drive '{name}' is too stiff for this run: its rate {label} = "
+                f"{rate:.3g} 1/s needs about {rate * span:.3g} steps over {span:g} s, more "
+                f"than the evaluation budget ({limit}); check its parameters"
+            )
+
+
+def sample_channels(nv: int, extra_states: int, outputs: Sequence[Output] = ()) -> int:
+    """Values a run keeps per sample: q, q̇, the extra states, three energies, the outputs."""
+    return 2 * nv + extra_states + 3 + sum(o.size for o in outputs)
 
 
 def _state_event(g: Event, n: int) -> Callable[[float, np.ndarray], float]:

@@ -48,6 +48,7 @@ and so is shielding of one body by another (conservative).
 from __future__ import annotations
 
 import math
+import stat
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -69,6 +70,18 @@ BUILTIN_TABLES = ("dish", "cylinder")
 
 #: Header of a coefficient table (after the ``#`` comment lines).
 TABLE_HEADER = ("theta_deg", "axial", "normal", "moment")
+
+#: Most rows of a coefficient table (θ every 0.018°; wind-tunnel tables have tens): the
+#: periodic spline through 2·10⁵ rows takes 1.7 s to build, through 10⁴ under 0.1 s.
+MAX_TABLE_ROWS = 10_000
+
+#: Largest size of a coefficient table file, bytes (10⁴ rows of four numbers written in
+#: full precision are about 0.8 MB).
+MAX_TABLE_BYTES = 2**20
+
+#: Largest magnitude of a coefficient: the bound of every number rt70 reads from a model
+#: (``rt70.urdf.reader.MAX_MAGNITUDE``, docs/urdf-reader.md; a test holds the two equal).
+MAX_COEFFICIENT = 1e30
 
 #: How close to zero C_N and C_M must be at θ = 0° and 180° (a body of revolution).
 END_TOLERANCE = 1e-12
@@ -219,8 +232,21 @@ class CoefficientTable:
         rows = np.asarray(rows, dtype=float)
         if rows.ndim != 2 or rows.shape[1] != 4 or rows.shape[0] < 3:
             raise WindError(f"{source}: a coefficient table needs at least 3 rows of 4 numbers")
+        if rows.shape[0] > MAX_TABLE_ROWS:
+            raise WindError(
+                f"{source}: {rows.shape[0]} rows; a coefficient table has at most "
+                f"{MAX_TABLE_ROWS} (θ every {180 / MAX_TABLE_ROWS:g}°)"
+            )
         if not np.all(np.isfinite(rows)):
             raise WindError(f"{source}: NaN or infinite value in the coefficient table")
+        big = np.abs(rows[:, 1:]) > MAX_COEFFICIENT
+        if big.any():
+            i, k = np.argwhere(big)[0]
+            raise WindError(
+                f"{source}: {TABLE_HEADER[k + 1]} coefficient {rows[i, k + 1]:g} at theta_deg = "
+                f"{rows[i, 0]:g}: magnitude above {MAX_COEFFICIENT:g}, the largest number rt70 "
+                "reads (docs/urdf-reader.md)"
+            )
         theta = rows[:, 0]
         if theta[0] != 0.0 or theta[-1] != 180.0 or np.any(np.diff(theta) <= 0.0):
             raise WindError(
@@ -276,10 +302,31 @@ class CoefficientTable:
 
     @classmethod
     def from_csv(cls, path: str | Path) -> CoefficientTable:
-        """Read a CSV file (see :meth:`from_text`); a missing file is a WindError."""
+        """Read a CSV file (see :meth:`from_text`).
+
+        Raises
+        ------
+        WindError
+            If the file is missing or unreadable, is not a regular file (a FIFO or a
+            device such as ``/dev/zero`` would block or never end), or is larger than
+            :data:`MAX_TABLE_BYTES`; and as :meth:`from_text`.
+        """
+        path = Path(path)
         try:
-            text = Path(path).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
+            if not stat.S_ISREG(path.stat().st_mode):
+                raise WindError(f"{path}: is not a regular file (a device or a pipe?)")
+            with path.open("rb") as file:
+                data = file.read(MAX_TABLE_BYTES + 1)
+        except OSError as exc:
+            raise WindError(f"{path}: cannot read the coefficient table ({exc})") from None
+        if len(data) > MAX_TABLE_BYTES:
+            raise WindError(
+                f"{path}: larger than {MAX_TABLE_BYTES // 2**20} MiB, which no coefficient "
+                f"table needs (at most {MAX_TABLE_ROWS} rows)"
+            )
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError as exc:
             raise WindError(f"{path}: cannot read the coefficient table ({exc})") from None
         return cls.from_text(text, str(path))
 

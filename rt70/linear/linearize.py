@@ -191,8 +191,14 @@ def equilibrium(
     scale = max(float(np.max(np.abs(static_force(scene, q)))), 1.0)
     K, previous = None, np.inf
     for _ in range(max_iter):
-        residual = hold.reduce_force(static_force(scene, q))
+        with np.errstate(over="ignore", invalid="ignore"):  # checked just below
+            residual = hold.reduce_force(static_force(scene, q))
         size = float(np.max(np.abs(residual), initial=0.0))
+        if not np.isfinite(size):
+            raise Rt70Error(
+                f"{scene.name}: static equilibrium: the forces are not finite on Newton's "
+                "way (a load or a number in the model beyond what its stiffness can hold?)"
+            )
         if size <= tol * scale:
             return q
         if K is not None and size <= REUSE_RATIO * previous:

@@ -40,7 +40,8 @@ def sector_mesh(model: ReferenceModel, data: ReferenceData, drive: Drive) -> Sec
     s = drive.sector
     q0 = np.zeros(model.nv)
     link, stator = link_pose(model, data, q0, s.link), link_pose(model, data, q0, s.stator)
-    return SectorMesh.at_construction(s.xyz, s.direction, s.axis, s.radius, link, stator)
+    where = f"drive '{drive.name}' <rt70:sector>"
+    return SectorMesh.at_construction(s.xyz, s.direction, s.axis, s.radius, link, stator, where)
 
 
 def _joint_torque(

@@ -67,7 +67,8 @@ def sector_mesh(model: Model, data: Data, drive: Drive) -> SectorMesh:
     s = drive.sector
     q0 = np.zeros(model.nv)
     link, stator = link_pose(model, data, q0, s.link), link_pose(model, data, q0, s.stator)
-    return SectorMesh.at_construction(s.xyz, s.direction, s.axis, s.radius, link, stator)
+    where = f"drive '{drive.name}' <rt70:sector>"
+    return SectorMesh.at_construction(s.xyz, s.direction, s.axis, s.radius, link, stator, where)
 
 
 def drive_angle(model: Model, data: Data, q: np.ndarray, drive: Drive, mesh=None) -> float:
