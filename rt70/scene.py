@@ -141,9 +141,15 @@ def load_scene(target: str | Path, balance_inertia: bool = False) -> Scene:
     return _scene(path.stem, path, read_source(path), str(path), balance_inertia)
 
 
-def scene_from_text(text: str, name: str = "<string>", balance_inertia: bool = False) -> Scene:
-    """Build a scene from URDF text (generated models, tests); ``name`` labels messages."""
-    return _scene(name, Path(name), text, name, balance_inertia)
+def scene_from_text(
+    text: str, name: str = "<string>", balance_inertia: bool = False, source: str | None = None
+) -> Scene:
+    """Build a scene from URDF text (generated models, tests, a sweep's workers).
+
+    ``source`` (the file the text was read from) labels messages about its content;
+    without it, ``name`` does.
+    """
+    return _scene(name, Path(source or name), text, source or name, balance_inertia)
 
 
 def _scene(name: str, path: Path, text: str, source: str, balance_inertia: bool) -> Scene:

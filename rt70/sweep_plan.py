@@ -242,18 +242,23 @@ def make_grid(
 
 @dataclass(frozen=True)
 class SceneSource:
-    """A scene's file content (what the workers build it from) and its SHA-256."""
+    """A scene's file content (what the workers build it from) and its SHA-256.
+
+    ``origin`` is the file it was read from, the name messages about its content give
+    (the scene's name where it came from no file).
+    """
 
     name: str
     text: str
     sha256: str
+    origin: str = ""
 
     @classmethod
     def read(cls, target: str | Path) -> SceneSource:
         """Read a scene by name or path (:func:`rt70.scene.scene_path`)."""
         path = scene_path(target)
         text = read_source(path)
-        return cls(path.stem, text, hashlib.sha256(text.encode()).hexdigest())
+        return cls(path.stem, text, hashlib.sha256(text.encode()).hexdigest(), str(path))
 
 
 #: Scenes built in this process, most recently used last: (sha256, scales) → Scene.
@@ -278,7 +283,7 @@ def build_scene(source: SceneSource, scales: Mapping[str, float] | None = None) 
     if scales:
         scene = scaled_scene(build_scene(source), scales)
     else:
-        scene = scene_from_text(source.text, source.name)
+        scene = scene_from_text(source.text, source.name, source=source.origin or None)
     _SCENES[key] = scene
     while len(_SCENES) > SCENES_KEPT:
         _SCENES.popitem(last=False)

@@ -677,7 +677,7 @@ def test_a_repeated_optical_point_is_refused(tmp_path, capsys):
     argv = ["sweep", str(scene), "--workers", "0", "--out", str(tmp_path / "s.npz")]
     assert cli(argv) == 2
     line = one_error_line(capsys.readouterr().err)
-    assert "<rt70:optical_point name='main_mirror_focus'> is given 2 times" in line
+    assert f"{scene}: two <rt70:optical_point> elements named 'main_mirror_focus'" in line
 
 
 # --- faults of the cluster ---------------------------------------------------------------------
