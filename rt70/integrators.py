@@ -92,11 +92,35 @@ def budget_limit(span: float) -> int | None:
     return None if budget is None else budget.limit(span)
 
 
-def budgeted(rhs: Rhs, span: float, limit: int | None = None) -> Rhs:
+#: Evaluations after which a run that keeps one sample per step (no output times)
+#: checks its pace (:func:`budgeted`): about a second of work on the RT-70.
+PACE_CHECK = 2_000
+
+#: How many times the samples memory holds the extrapolated evaluations must exceed
+#: for the pace check to stop a run: a step takes one to a few evaluations, and a run's
+#: start (transients, the step size growing from its cautious first value) is slower
+#: than the rest, so the extrapolation overestimates the samples — never by this much.
+PACE_MARGIN = 10
+
+
+def budgeted(rhs: Rhs, span: float, limit: int | None = None, t0: float = 0.0) -> Rhs:
     """``rhs`` counting its calls; past the limit it raises :class:`SimulationError`.
 
     The limit is the smaller of ``limit`` and the budget in force
     (:func:`evaluation_budget`); with neither, ``rhs`` is returned unchanged.
+
+    ``limit`` is the most samples a run without output times may keep (one per step,
+    each step at least one evaluation: :func:`rt70.resources.time_series_samples`). Such
+    a run also checks its pace after :data:`PACE_CHECK` evaluations: extrapolated from
+    how far it got (from ``t0``) to the whole ``span``, a run that would take over
+    :data:`PACE_MARGIN` times ``limit`` evaluations is stopped then, in about a second,
+    rather than after minutes at the memory limit (``rt70 simulate rt70 --t-end 1e12``).
+
+    Raises
+    ------
+    SimulationError
+        Past the limit, or at the pace check (the run would keep more samples than
+        memory holds).
     """
     budget = _BUDGET.get()
     limits = [x for x in (limit, None if budget is None else budget.limit(span)) if x is not None]
@@ -107,6 +131,8 @@ def budgeted(rhs: Rhs, span: float, limit: int | None = None) -> Rhs:
 
     def counted(t: float, x: np.ndarray) -> np.ndarray:
         calls[0] += 1
+        if calls[0] == PACE_CHECK and limit is not None:
+            _check_pace(t - t0, span, limit)
         if calls[0] > most:
             why = (
                 "the memory this run may use for its samples (one per step)"
@@ -120,6 +146,20 @@ def budgeted(rhs: Rhs, span: float, limit: int | None = None) -> Rhs:
         return rhs(t, x)
 
     return counted
+
+
+def _check_pace(elapsed: float, span: float, limit: int) -> None:
+    """Refuse a run whose pace so far needs far more samples than memory holds."""
+    if elapsed <= 0.0:
+        return
+    expected = PACE_CHECK * (span / elapsed)
+    if expected > PACE_MARGIN * limit:
+        raise SimulationError(
+            f"at the pace of its first {PACE_CHECK} evaluations (over {elapsed:.3g} s) a "
+            f"run of {span:.3g} s takes about {expected:.2g} evaluations and keeps a "
+            f"sample per step, far more than the {limit} samples this machine's memory "
+            "holds; shorten the run (from Python, or give output times: t_eval)"
+        )
 
 
 class Stopwatch:
@@ -223,7 +263,7 @@ def integrate(
     SimulationError
         When the run takes more evaluations than allowed (:func:`budgeted`).
     """
-    rhs = budgeted(rhs, float(t_span[1]) - float(t_span[0]), max_evaluations)
+    rhs = budgeted(rhs, float(t_span[1]) - float(t_span[0]), max_evaluations, float(t_span[0]))
     if method in CVODE_METHODS:
         return _cvode(method, rhs, jac, t_span, y0, rtol, atol, t_eval, events)
     from scipy.integrate import solve_ivp

@@ -373,6 +373,7 @@ def test_bad_input(name, tmp_path, capsys):
     assert lines[0] == f"rt70: error: {message}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "name", ["malformed-xml-unclosed-tag", "link-with-two-parents", "unknown-scene-name"]
 )

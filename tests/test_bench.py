@@ -14,6 +14,7 @@ from rt70.reports import bench
 from rt70.reports.threads import pools, single_threaded
 
 
+@pytest.mark.slow
 def test_bench_quick_writes_results(tmp_path, capsys):
     assert main(["bench", "--quick", "--K", "20", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out

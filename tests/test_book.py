@@ -23,6 +23,7 @@ def report(tmp_path_factory):
     return path.read_text(encoding="utf-8")
 
 
+@pytest.mark.slow
 def test_elevation_spectrum_reproduced_to_all_digits(report):
     assert "All printed digits reproduced: yes" in report
     for f in rt70_data.ELEVATION_SPECTRUM_HZ[1:]:

@@ -202,6 +202,7 @@ print(scene.reference.nv)
 """
 
 
+@pytest.mark.slow
 def test_deep_tree_parses_on_the_big_stack_thread():
     """5000 levels: beyond the main thread's limit, well within the parser thread's."""
     proc = subprocess.run(
@@ -344,6 +345,7 @@ sys.exit(main(["simulate", "double_pendulum", "--t-end", "0.05", "--out", sys.ar
 """
 
 
+@pytest.mark.slow
 def test_sigterm_while_writing_leaves_the_old_files_and_no_temporaries(tmp_path):
     out = tmp_path / "run.csv"
     out.write_text("old csv")
@@ -432,6 +434,7 @@ def test_simulate_writes_the_set(tmp_path, capsys):
 # --- 5. a closed standard output --------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "args", [["modes", "rt70_elevation"], ["validate", "--json", "--samples", "1", "rt70"]]
 )

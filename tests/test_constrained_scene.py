@@ -49,6 +49,7 @@ def _no_loop_jacobian(model, data, q):
     return np.zeros((0, q.size))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "argv",
     [["rt70_servo"], ["rt70", "--elevation", "30", "--lock-axes"]],

@@ -26,6 +26,7 @@ def test_every_scene_is_covered():
     } <= set(scene_names())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", scene_names())
 def test_scene_agrees_with_pinocchio(name):
     scene = load_scene(name)
@@ -110,6 +111,7 @@ def test_power_balance_of_equations_of_motion():
     assert_close(dE, qd @ Qd, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_cli_validate_all_scenes_exit_0(capsys):
     assert main(["validate", "--samples", "2"]) == 0
     out = capsys.readouterr().out

@@ -52,6 +52,7 @@ def runs(turret):
     return out
 
 
+@pytest.mark.slow
 def test_backends_agree_on_the_driven_trajectory(runs):
     (a, _), (b, _) = runs["pinocchio"], runs["textbook"]
     assert a.success and b.success
@@ -111,6 +112,7 @@ def test_twist_on_the_coordinate_with_the_sector_force_breaks_the_balance(turret
     assert np.max(np.abs(residual)) > 1e4 * RTOL * scale
 
 
+@pytest.mark.slow
 def test_servo_reads_the_drive_angle_and_its_energy_balances(turret):
     """A ServoDrive on the scene's elevation sector: its position loop reads θ_d, not the
     coordinate; the audit (voltage read back from the loop) closes the balance."""

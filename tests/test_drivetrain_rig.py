@@ -8,6 +8,7 @@ of each run, in arc seconds.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from rt70.reports.drivetrain import CASES, run_case
 from rt70.scenes.rt70_drives import FRICTION
@@ -18,6 +19,7 @@ CASE = {c.label: c for c in CASES}
 TARGET = 1.0
 
 
+@pytest.mark.slow
 def test_backlash_without_bias_makes_a_limit_cycle():
     """One effective train (no bias), backlash, no friction, holding a 2″ step: the
     position loop's integrator hunts across the gap (measured over 4–8 s: rms 2.7″,
@@ -36,6 +38,7 @@ def test_counter_torque_removes_the_backlash():
     assert r.result.relative_drift < 1e-3  # the energy audit of the mechanics closes
 
 
+@pytest.mark.slow
 def test_friction_makes_the_hold_stick_and_slip():
     """Dry friction (book's law, no backlash, trains biased) holding a 2″ step: the
     integrator winds up while the axis sticks, it breaks away and overshoots: a hunting

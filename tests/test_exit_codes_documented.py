@@ -199,6 +199,7 @@ def _signalled(signum: int) -> tuple[int, str]:
     return proc.returncode, (seen + err).decode(errors="replace")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("signum", "expected"),
     [(signal.SIGTERM, EXIT_TERMINATED), (signal.SIGINT, EXIT_INTERRUPTED)],

@@ -85,6 +85,7 @@ def test_pair_without_gap_or_bias_is_the_servo_drive():
         assert_close(two.force(0.0, q, qd, y)[0], one.force(0.0, q, qd, x)[0], rel=1e-12)
 
 
+@pytest.mark.slow
 def test_counter_torque_keeps_both_trains_engaged():
     """Backlash in both trains, a bias of 10 N·m per train: through a 1° step (peak net
     torque 13.6 N·m, below twice the bias) train 1 always pushes and train 2 always holds back,
@@ -125,6 +126,7 @@ def test_counter_torque_keeps_both_trains_engaged():
     assert_close(_step(linear, t, rtol=1e-7).q, run.q, rel=1e-5, scale=STEP)
 
 
+@pytest.mark.slow
 def test_without_bias_the_gap_is_crossed():
     """The same step without bias: the trains leave contact (torque zero inside the gap) on
     the way: what the bias prevents."""

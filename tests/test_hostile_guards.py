@@ -187,6 +187,27 @@ def test_the_budget_counts_evaluations():
     assert integrators.budgeted(np.negative, 5.0) is np.negative  # no budget outside
 
 
+def test_a_run_kept_step_by_step_checks_its_pace_against_memory():
+    """One sample per step: a run whose start extrapolates to far more samples than
+    memory holds stops at the pace check, not after minutes at the memory limit."""
+    check = integrators.PACE_CHECK
+    dt = 1e-3  # simulated seconds per evaluation
+    fits = integrators.budgeted(np.negative, span=check * dt * 5, limit=check, t0=2.0)
+    for k in range(1, check + 1):  # 5 × the pace check's work over the span: within the margin
+        fits(2.0 + k * dt, np.ones(1))
+    huge = integrators.budgeted(np.negative, span=1e12, limit=10**6, t0=2.0)
+    for k in range(1, check):
+        huge(2.0 + k * dt, np.ones(1))
+    with pytest.raises(SimulationError, match=r"about 1e\+15 evaluations .* 1000000 samples"):
+        huge(2.0 + check * dt, np.ones(1))
+
+
+def test_an_endless_structural_run_is_one_line_within_its_first_evaluations(capsys):
+    line = one_error(capsys, ["simulate", "double_pendulum", "--t-end", "1e12"])
+    assert "double_pendulum: integration stopped at t = " in line
+    assert "at the pace of its first 2000 evaluations" in line and "memory holds" in line
+
+
 def test_a_solver_failing_before_its_first_output_time_leaves_an_empty_record():
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # a solver's warning would go into the message

@@ -301,6 +301,7 @@ def test_rt70_modules_are_all_listed():
     assert len(_generic_modules()) > len(GENERIC)  # the packages' modules are found
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("module", _generic_modules())
 def test_generic_analysis_knows_no_telescope(module):
     """No generic analysis loads the RT-70's tables, chapter-2 models or states, even

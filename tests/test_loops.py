@@ -299,6 +299,7 @@ def crank_slider_start():
     return scene, x0
 
 
+@pytest.mark.slow
 def test_crank_slider_ten_seconds_stays_closed(crank_slider_start):
     """Target of issue 12: |Φ| ≤ 1e-10 over 10 s with stabilisation; the drift without."""
     scene, x0 = crank_slider_start

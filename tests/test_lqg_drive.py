@@ -113,6 +113,7 @@ def test_steady_controller_puts_the_voltage_in_the_integral(start):
         LqgDrive.steady_controller(m, np.array([0.0, 1e-3, 0.0]), 7.0)
 
 
+@pytest.mark.slow
 def test_small_step_follows_the_linear_closed_loop(scene):
     """100″ azimuth step for 0.4 s at 45°: nonlinear model vs linear LQG loop within 0.01″.
 

@@ -82,6 +82,7 @@ def test_bad_input_is_refused_with_its_name():
         mass_kernel.mass_matrix(m, mass_kernel.KernelData(m), np.array([np.inf] * m.nv))
 
 
+@pytest.mark.slow
 def test_a_second_process_loads_the_kernel_from_the_cache():
     """``cache=True``: after a first call has compiled it, another process pays no compiling."""
     code = (

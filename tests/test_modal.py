@@ -282,6 +282,7 @@ def test_modal_state_space_matches_full_and_truncates():
 # ---------------------------------------------------------------------------- responses
 
 
+@pytest.mark.slow
 def test_oscillator_resonance_peak_is_20_db():
     """ξ = 0.05: |H(jΩ)|/H(0) = 1/(2ξ) = +20 dB exactly at ω = Ω; the true maximum
     1/(2ξ√(1−ξ²)) = +20.011 dB lies at Ω√(1−2ξ²). Both are within ±0.05 dB of the

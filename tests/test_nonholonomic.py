@@ -245,6 +245,7 @@ def test_initial_servo_forces_are_the_indicative_ones(cart_scene):
     assert_close(tb.qdd, ref.qdd, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_controlled_cart_goes_round_the_ellipse(cart_scene):
     q, qd = cart.on_manifold_start(4.0, 0.5)
     times = np.concatenate([np.linspace(0, 6, 241), [1.0, 2.0]])
@@ -264,6 +265,7 @@ def test_controlled_cart_goes_round_the_ellipse(cart_scene):
     assert_close(res, np.zeros_like(res), rel=1e-8, scale=START_SPEED)
 
 
+@pytest.mark.slow
 def test_off_manifold_start_decays_with_the_chosen_poles(cart_scene):
     """Heading error 0.2 rad, speed 10 % high: α follows the perturbation equations."""
     q, qd = cart.on_manifold_start(4.0, 0.5)
@@ -324,6 +326,7 @@ def test_perturbation_gains_must_be_stable():
 
 
 # --- the Chaplygin sleigh -------------------------------------------------------------------
+@pytest.mark.slow
 def test_sleigh_matches_the_analytic_solution(sleigh):
     """m = 1, c = 0.2, J_M = 0.09, ω0 = 1, v0 = 0: v = V tanh(Vkt), ω = ω0 / cosh(Vkt)."""
     m, c, JM = 1.0, 0.2, 0.09

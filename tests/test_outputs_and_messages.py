@@ -460,6 +460,7 @@ def loop_files(tmp_path_factory) -> dict[str, Path]:
     return files
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(CANNOT_CLOSE))
 def test_validate_refuses_loops_that_cannot_close_before_comparing(
     name, loop_files, monkeypatch, capsys
@@ -479,6 +480,7 @@ def test_validate_refuses_loops_that_cannot_close_before_comparing(
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", [["simulate", "--t-end", "0.01"], ["modes"]])
 def test_every_command_gives_the_same_loop_error(command, loop_files, capsys):
     assert main(["validate", "--samples", "1", str(loop_files["too_far"])]) == 2

@@ -59,6 +59,7 @@ def installed(tmp_path_factory) -> Path:
     return tmp / "venv" / "bin"
 
 
+@pytest.mark.slow
 def test_installed_wheel_validates_from_any_directory(installed, tmp_path):
     proc = _run([str(installed / "rt70"), "validate", "--samples", "1"], tmp_path)
     assert f"{len(scene_names())} target(s)" in proc.stdout  # every scene in urdf/

@@ -23,6 +23,7 @@ def budgets(scene):
     return {v: pointing_budget(scene, PointingCase(45.0, 0.0, v)) for v in (5.0, 10.0, 20.0)}
 
 
+@pytest.mark.slow
 def test_steady_errors_follow_the_square_of_the_wind_speed(budgets):
     """Measured on real antennas; here exact but for the load's dependence on the
     deflected attitude (aerodynamic stiffness): exponents 1.99–2.01."""
@@ -46,6 +47,7 @@ def test_gust_error_is_mostly_the_quasi_static_response(budgets):
         assert len(b.modes) == 3 and all(np.isfinite(m.share) for m in b.modes)
 
 
+@pytest.mark.slow
 def test_gust_record_nonlinear_equals_linear_with_the_exact_load_law(scene):
     """Same gusts: the nonlinear model (structure, servos with clamps, load exact in
     (v̄+v′)²) against the linear loop fed v′ + v′²/2v̄; measured 0.4 % of the peak."""
@@ -142,6 +144,7 @@ def test_plant_wind_inputs_give_disturbance_to_pointing_transfer_functions(scene
         wind_inputs(scene, q0, 0.0, 0.0)
 
 
+@pytest.mark.slow
 def test_pointing_command_runs_a_gust_record_on_the_budget_model(capsys):
     """``--duration``: the record's Lyapunov rms is the budget's gust rms (one model)."""
     argv = ["pointing", "rt70_servo", "--wind", "10", "--duration", "1", "--json"]

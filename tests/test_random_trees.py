@@ -76,11 +76,13 @@ def assert_agrees(text: str, label: str, seed: int, samples: int = 2) -> None:
 # --- (a) revolute, prismatic and fixed joints -------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", SEEDS, ids=lambda s: f"seed={s}")
 def test_random_tree_basic(seed):
     assert_agrees(random_tree(seed, joint_types=BASIC), "random_tree[basic]", seed)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(1000, 1000 + len(SEEDS)), ids=lambda s: f"seed={s}")
 def test_random_tree_basic_more(seed):
     assert_agrees(random_tree(seed, joint_types=BASIC), "random_tree[basic]", seed)
@@ -92,6 +94,7 @@ def test_random_tree_basic_more(seed):
 FAMILY_CASES = [(family, base + k) for family, (base, _) in FAMILIES.items() for k in SEEDS]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("family", "seed"), FAMILY_CASES, ids=[f"{f}-seed={s}" for f, s in FAMILY_CASES]
 )
@@ -103,6 +106,7 @@ def test_random_tree_family(family, seed):
 # --- large and structured scenes --------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_serial_chain_50():
     assert_agrees(serial_chain(50), "serial_chain(50)", 0)
 

@@ -55,6 +55,7 @@ def test_talos_full_is_a_reordering_for_pinocchio():
     assert not ref.identity_map
 
 
+@pytest.mark.slow
 def test_every_robot_names_its_coordinates_in_the_files_order():
     from rt70.robots import survey
 

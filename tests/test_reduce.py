@@ -23,6 +23,7 @@ def plants():
     return both["locked"], both["free"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("which", "order"), [(0, 4), (0, 8), (0, 16), (1, 8), (1, 16), (1, 24)])
 def test_balanced_truncation_error_lies_between_its_bounds(plants, which, order):
     """σ_{k+1} ≤ ‖G − G_r‖∞ ≤ 2 Σ_{i>k} σ_i (Glover) over the stable part's σ_i.

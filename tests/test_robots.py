@@ -55,6 +55,7 @@ def test_every_urdf_file_has_one_name():
     assert set(ROBOTS.values()) == files
 
 
+@pytest.mark.slow
 def test_survey_accounts_for_every_robot(surveyed):
     loaded, failed = surveyed
     assert set(loaded) | set(failed) == set(ROBOTS)
@@ -75,6 +76,7 @@ def test_robots_not_loaded_are_exactly_the_known_ones(surveyed):
     assert {name: reason.split(":")[0] for name, reason in failed.items()} == NOT_LOADED
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(set(ROBOTS) - set(NOT_LOADED)))
 def test_robot_agrees_with_pinocchio(surveyed, name):
     loaded, failed = surveyed

@@ -88,6 +88,7 @@ def test_steady_push_equals_the_drive_held_equilibrium(case):
     assert_close(linear, static, rel=1e-3)
 
 
+@pytest.mark.slow
 def test_linear_loop_follows_the_nonlinear_servo(case):
     """6 s after a step load: the linear closed loop equals the nonlinear simulation."""
     scene, factory, held, q0, torques, outs, loop = case

@@ -28,6 +28,7 @@ def _step_run(gains, t_end=4.0):
     return t, run
 
 
+@pytest.mark.slow
 def test_one_degree_step_settles_without_error():
     """1° step, 1 Hz position loop: 10 % overshoot, 2 % band in 2.0 s, error decaying.
 
@@ -47,6 +48,7 @@ def test_one_degree_step_settles_without_error():
     assert 0.5 < settle < 2.5, settle
 
 
+@pytest.mark.slow
 def test_slower_position_loop_settles_later():
     """The bandwidth sets the speed: a 0.5 Hz loop settles later than a 1 Hz loop."""
 
@@ -58,6 +60,7 @@ def test_slower_position_loop_settles_later():
     assert settling(0.5) > 1.5 * settling(1.0)
 
 
+@pytest.mark.slow
 def test_rate_limit_clamps_the_axis_speed():
     """With the axis rate clamped, the step becomes a ramp at the limit (anti-windup)."""
     limit = 0.2 * STEP  # rad/s: the 1° step takes about 5 s

@@ -28,6 +28,7 @@ def test_backends_agree_on_trajectories():
     assert_close(b.qd, a.qd, rel=1e-8, scale=scale)
 
 
+@pytest.mark.slow
 def test_rt70_backends_agree_from_the_listing_state():
     scene = load_scene("rt70")
     t = np.linspace(0.0, 0.05, 11)
@@ -49,6 +50,7 @@ def test_energy_balance_of_a_conservative_model():
     assert not r.drift_flagged
 
 
+@pytest.mark.slow
 def test_energy_balance_of_a_damped_model_closes_with_dissipation():
     scene = load_scene("two_body_gravity")
     n = scene.textbook.nv

@@ -27,6 +27,7 @@ def pendulum_reference():
     return simulate(scene, (0.0, 2.0), PENDULUM_X0, method="Radau", rtol=1e-12, t_eval=t)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["CVODE", "CVODE_ADAMS"])
 def test_cvode_follows_radau_on_the_double_pendulum(method, pendulum_reference):
     """Against Radau at rtol 1e-12: within DRIFT_FACTOR · rtol (measured ≤ 20 · rtol)."""

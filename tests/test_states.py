@@ -160,6 +160,7 @@ def _before(scene, backend, method, rtol, x0, t_span, inputs=None):
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
 @pytest.mark.parametrize(
     "name, method, inputs",

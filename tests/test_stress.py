@@ -169,6 +169,7 @@ def test_free_floating_model(floating):
     assert np.linalg.norm(P) > 0.1 and np.linalg.norm(L) > 0.1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
 def test_free_floating_momentum_conserved(floating, backend):
     x0 = free_floating_state(floating)
@@ -184,6 +185,7 @@ def test_free_floating_momentum_conserved(floating, backend):
     assert np.max(np.abs(res.q[-1] - res.q[0])) > 1e-3
 
 
+@pytest.mark.slow
 def test_momentum_changes_under_gravity():
     scene = scene_from_text(set_gravity(free_floating_text(2), (0.0, 0.0, -9.81)), "falling")
     x0 = free_floating_state(scene)
@@ -253,6 +255,7 @@ def _lines_executed_in(package, call):
     return count, value
 
 
+@pytest.mark.slow
 def test_long_chain_reads_in_linear_work():
     """The reader's cycle check was cubic (a 1000-body chain took 382 s to read): four
     times the bodies must cost four times the lines executed in rt70.urdf, not 16 or 64."""
@@ -265,6 +268,7 @@ def test_long_chain_reads_in_linear_work():
     assert work[1] <= 4.4 * work[0], work  # linear, within 10 %
 
 
+@pytest.mark.slow
 def test_long_chain_reads_and_builds():
     from rt70.scenes.synthetic import elastic_chain
 
@@ -273,6 +277,7 @@ def test_long_chain_reads_and_builds():
     assert model.nv == 6000 and model.parent[-1] == 998
 
 
+@pytest.mark.slow
 def test_write_report_quick(tmp_path):
     path = write_report(tmp_path, quick=True)
     assert path == tmp_path / "stress.md"

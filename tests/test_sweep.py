@@ -133,6 +133,7 @@ def test_a_failed_point_is_nan_with_its_message(tmp_path):
 # --- Dask ----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_dask_cluster_equals_serial_bit_for_bit(small, serial_result, tmp_path):
     """A real LocalCluster: 2 worker processes over loopback, the same numbers."""
     from distributed import Client, LocalCluster
@@ -176,6 +177,7 @@ def test_dask_cluster_equals_serial_bit_for_bit(small, serial_result, tmp_path):
     }
 
 
+@pytest.mark.slow
 def test_cli_sweep_on_a_local_cluster(tmp_path, capsys, serial_result):
     """`rt70 sweep` starts its own 2-worker cluster, closes it, writes NPZ + JSON."""
     out = tmp_path / "cli.npz"

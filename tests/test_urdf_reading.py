@@ -583,6 +583,7 @@ def test_refused(name, tmp_path, capsys):
     assert out == "" and err.splitlines() == [f"rt70: error: {message}"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["pinocchio-refuses-a-revolute-without-limits", "dtd-entity"])
 def test_refused_in_a_subprocess(name, tmp_path):
     """One stderr line, nothing from Pinocchio's C++ parser, no traceback."""

@@ -499,6 +499,7 @@ CLI_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(CLI_CASES))
 def test_cli_refuses_in_one_line_with_exit_2(name, tmp_path):
     text, needle = CLI_CASES[name]

@@ -55,6 +55,7 @@ def two_body():
     return scene
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
 @pytest.mark.parametrize("side", [0, 1], ids=["textbook", "pinocchio"])
 @pytest.mark.parametrize("quantity", QUANTITIES)
@@ -173,6 +174,7 @@ def test_robot_without_degree_of_freedom_exits_2():
     assert len(lines) == 1 and "hector" in lines[0] and "no degree of freedom" in lines[0]
 
 
+@pytest.mark.slow
 def test_no_target_exits_2(tmp_path):
     env = {**os.environ, "RT70_URDF_DIR": str(tmp_path)}
     proc = _run("validate", env=env, cwd=str(tmp_path))
@@ -193,6 +195,7 @@ def test_samples_below_one_is_refused(two_body):
         cross_check(two_body, samples=0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("target", "message"), [("/dev/null", "not a regular file"), ("/tmp", "is a directory")]
 )

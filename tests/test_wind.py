@@ -479,6 +479,7 @@ def _trapezoid_work(result, force) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(steps)])
 
 
+@pytest.mark.slow
 def test_simulated_wind_power_is_its_input_work(servo):
     """RT-70 (no drives) in a 20 m/s front wind: W_u = ∫ q̇ᵀQ_w dt and the energy balances."""
     from rt70.simulate import simulate
@@ -494,6 +495,7 @@ def test_simulated_wind_power_is_its_input_work(servo):
     assert_close(work, result.input_work, rel=1e-4)
 
 
+@pytest.mark.slow
 def test_gusty_wind_on_the_textbook_backend(turret):
     from rt70.simulate import simulate
     from rt70.wind_load import WindLoad

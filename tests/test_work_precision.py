@@ -36,6 +36,7 @@ def _com_scale(problem):
     return float(np.max(np.abs(wpw.com_positions(scene, q0[None, :]))))
 
 
+@pytest.mark.slow
 def test_quick_run_writes_files(quick_rows, tmp_path):
     paths = wp.write_results(quick_rows, tmp_path)
     assert [p.name for p in paths] == ["work_precision.csv", "work_precision.png"]
@@ -124,6 +125,7 @@ def test_a_run_over_the_cap_skips_the_tighter_tolerances(monkeypatch):
     assert by["BDF", wp.QUICK_RTOLS[1]].times_s == "0.0100;0.0100"
 
 
+@pytest.mark.slow
 def test_worker_abandons_a_run_over_a_zero_cap():
     """A cap of 0 s: over it whether the result comes back in time or the worker is
     killed waiting for it — the same outcome on any machine."""
@@ -194,6 +196,7 @@ def test_real_time_target_is_judged_on_the_fastest_run_to_the_error():
     assert check.line() in text and "not measured by this report" in text
 
 
+@pytest.mark.slow
 def test_centre_of_mass_error_beside_the_state_error(quick_rows, tmp_path):
     size = {p.name: _com_scale(p) for p in PROBLEMS}
     for r in quick_rows:

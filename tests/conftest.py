@@ -1,0 +1,22 @@
+"""Suite-wide settings: which tests the fast subset (``pytest -m "not slow"``) leaves out.
+
+A test is slow when it takes over about 1.5 s on the development machine (it carries
+``@pytest.mark.slow``), or when it uses one of :data:`SLOW_FIXTURES`: a module fixture
+that builds something expensive once for its module (a wheel installed into a fresh
+environment, a work–precision run, every robot surveyed, the book's report). Marking
+only the first such test would move the fixture's cost to the next one. docs/testing.md.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+#: Module fixtures that take seconds to build: every test that uses one is slow.
+SLOW_FIXTURES = frozenset({"installed", "quick_rows", "runs", "surveyed", "report", "budgets"})
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark the tests that use a fixture of :data:`SLOW_FIXTURES` as slow."""
+    for item in items:
+        if SLOW_FIXTURES.intersection(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)
