@@ -665,6 +665,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
     guards = options.warning_guards(args.command)  # module docstring
     with (
@@ -682,7 +683,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"rt70: error: {exc}", file=sys.stderr)
             return 2
         except RuntimeWarning as exc:  # numpy's floating-point warnings, scipy's LinAlgWarning
-            print(f"rt70: error: {options.numerical_failure(args.command, exc)}", file=sys.stderr)
+            print(f"rt70: error: {options.numerical_failure(argv, exc)}", file=sys.stderr)
             return 2
         except BrokenPipeError:
             # the reader went away (``| head``); Python flushes stdout again at exit:

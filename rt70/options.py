@@ -207,11 +207,17 @@ def option_at_fault(option: str) -> Iterator[None]:
     option
         The option and its value as the user wrote them (``"--reduce 10000"``), with the
         scene in front where the limit is the scene's (``"rt70: --reduce 10000"``).
+
+    A floating-point failure inside the block (a ``RuntimeWarning`` raised, as the
+    command line raises them: :func:`warning_guards`) becomes an
+    :class:`~rt70.errors.Rt70Error` naming the option the same way.
     """
     try:
         yield
     except Rt70Error as exc:
         raise type(exc)(f"{option}: {exc}") from None
+    except RuntimeWarning as exc:
+        raise Rt70Error(f"{option}: {_numerical(exc)}") from None
 
 
 # --- results ---------------------------------------------------------------------------
@@ -414,12 +420,23 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
         _default_showwarning(message, category, filename, lineno, file, line)
 
 
-def numerical_failure(command: str, exc: RuntimeWarning) -> str:
-    """The error line of a RuntimeWarning that reached the command line."""
+def numerical_failure(argv: list[str], exc: RuntimeWarning) -> str:
+    """The error line of a RuntimeWarning that reached the command line.
+
+    No check named the value at fault, so the line names what the user gave: the
+    command as typed (its scene file and options, ``argv``) and the failure.
+    """
+    import shlex
+
+    return f"rt70 {shlex.join(argv)}: {_numerical(exc)}"
+
+
+def _numerical(exc: RuntimeWarning) -> str:
+    """``numerical failure (<warning>): ...``: what a floating-point failure says."""
     what = " ".join(str(exc).split())
     return (
-        f"{command}: numerical failure ({type(exc).__name__}: {what}): an input is beyond "
-        "what the computation can represent; check the options' and the model's magnitudes"
+        f"numerical failure ({type(exc).__name__}: {what}): an input is beyond what the "
+        "computation can represent; check the magnitudes of these options and of the model"
     )
 
 

@@ -322,4 +322,15 @@ def test_a_runtime_warning_is_the_one_error_line(monkeypatch, capsys):
 
     monkeypatch.setattr(rt70.scene, "load_scene", overflowing)
     line = one_error(capsys, ["modes", "two_body_gravity"])
-    assert line.startswith("rt70: error: modes: numerical failure (RuntimeWarning: overflow")
+    assert line.startswith(
+        "rt70: error: rt70 modes two_body_gravity: numerical failure (RuntimeWarning: overflow"
+    )
+
+
+def test_a_floating_point_failure_names_the_option_at_fault(capsys):
+    """cart's start speed enters the torques squared: 1e300 overflows in the servo."""
+    line = one_error(capsys, ["cart", "--speed-error", "1e300"])
+    assert line.startswith(
+        "rt70: error: the start state (--start, --heading-error, --speed-error): numerical "
+        "failure (RuntimeWarning: overflow"
+    )
