@@ -228,7 +228,7 @@ def _add_pointing_arguments(parser: argparse.ArgumentParser, default: str = "zen
         help=f"RT-70 elevation, degrees, 0 (horizon) to 90 (zenith); default {default}",
     )
     parser.add_argument(
-        "--azimuth", type=options.finite_float, help="RT-70 azimuth, degrees (default 0)"
+        "--azimuth", type=options.angle_deg, help="RT-70 azimuth, degrees (default 0)"
     )
 
 

@@ -43,7 +43,7 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
     )
     poi.add_argument(
         "--direction",
-        type=options.finite_float,
+        type=options.angle_deg,
         help="azimuth the wind blows from, degrees (default: the pointing's azimuth, a "
         "front wind into the dish)",
     )

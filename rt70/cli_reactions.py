@@ -28,7 +28,7 @@ def _directions(text: str) -> tuple[float, ...]:
     parts = [p.strip() for p in text.split(",")]
     if not all(parts):
         raise argparse.ArgumentTypeError(f"expected directions like 0,180, got '{text}'")
-    return tuple(options.finite_float(p) for p in parts)
+    return tuple(options.angle_deg(p) for p in parts)
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -49,7 +49,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         help="elevations, degrees, comma-separated (default 0,15,30,45,60,75,90)",
     )
     rea.add_argument(
-        "--azimuth", type=options.finite_float, default=0.0, help="azimuth, degrees (default 0)"
+        "--azimuth", type=options.angle_deg, default=0.0, help="azimuth, degrees (default 0)"
     )
     rea.add_argument(
         "--wind",

@@ -44,6 +44,11 @@ EXIT_CODES = {
 #: are given at 0° and 90°; :func:`rt70.scenes.rt70_state.rt70_pointing`).
 ELEVATION_RANGE = (0.0, 90.0)
 
+#: Largest magnitude of an azimuth or a wind direction on the command line, degrees: one
+#: turn either way holds every direction; beyond it a float's spacing grows until the
+#: angle means nothing (1e300° is no direction at all). ``rt70 sweep`` has the same bound.
+MAX_TURN_DEG = 360.0
+
 #: Smallest relative tolerance ``solve_ivp`` honours (100 machine epsilons).
 MIN_RTOL = 100 * sys.float_info.epsilon
 
@@ -187,6 +192,17 @@ def elevation(text: str) -> float:
     if not low <= value <= high:
         raise argparse.ArgumentTypeError(
             f"the RT-70 points from {low:g}° (horizon) to {high:g}° (zenith), got {text}"
+        )
+    return value
+
+
+def angle_deg(text: str) -> float:
+    """An azimuth or a wind direction in degrees, within ±:data:`MAX_TURN_DEG`."""
+    value = _number(text)
+    if not abs(value) <= MAX_TURN_DEG:
+        raise argparse.ArgumentTypeError(
+            f"must lie in [-{MAX_TURN_DEG:g}, {MAX_TURN_DEG:g}] degrees (one turn either way "
+            f"holds every direction), got {text}"
         )
     return value
 

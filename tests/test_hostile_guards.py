@@ -34,6 +34,7 @@ from rt70 import options
 from rt70.cli import main
 from rt70.errors import Rt70Error, SimulationError
 from rt70.scene import URDF_DIR
+from rt70.testing import assert_close
 from rt70.urdf import reader
 from rt70.wind import MAX_COEFFICIENT, MAX_TABLE_BYTES, MAX_TABLE_ROWS
 
@@ -124,6 +125,10 @@ def test_a_table_with_too_many_rows_or_bytes_is_refused(tmp_path, capsys):
         (["cart", "--heading-error", "1e300"], "--heading-error"),
         (["cart", "--heading-error", "3.2"], "--heading-error"),
         (["impact", "rt70", "--pin", "main_mirror:1e300,0,0"], "--pin"),
+        (["pointing", "rt70_servo", "--azimuth", "1e300"], "--azimuth"),
+        (["pointing", "rt70_servo", "--direction", "-361"], "--direction"),
+        (["simulate", "rt70_servo", "--azimuth", "400"], "--azimuth"),
+        (["reactions", "rt70_servo", "--direction", "0,1e300"], "--direction"),
     ],
 )
 def test_physical_options_beyond_their_bound_are_refused(capsys, argv, named):
@@ -132,7 +137,7 @@ def test_physical_options_beyond_their_bound_are_refused(capsys, argv, named):
 
 
 def test_the_wind_bound_is_mach_0_3(capsys):
-    assert options.MAX_WIND_SPEED == pytest.approx(102.09)
+    assert_close(options.MAX_WIND_SPEED, 102.09, rel=1e-12)  # 0.3 × 340.3 m/s, to the digit
     assert options.wind_speed("102") == 102.0
 
 
