@@ -2,7 +2,7 @@
 
 import sys
 
-from rt70.cli import main
+from rt70.cli.main import main
 
 if __name__ == "__main__":  # guarded: benchmark workers are started with "spawn"
     sys.exit(main())

@@ -37,7 +37,7 @@ class NonFiniteError(UrdfError):
 
 
 class MagnitudeError(UrdfError):
-    """A number in the model is finite but beyond ``rt70.urdf.reader.MAX_MAGNITUDE``."""
+    """A number in the model is finite but beyond ``rt70.urdf.elements.MAX_MAGNITUDE``."""
 
 
 class XacroError(UrdfError):

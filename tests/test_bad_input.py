@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rt70.cli
-import rt70.scene
+import rt70.cli.main
+import rt70.model.scene
 import rt70.urdf
 from rt70.errors import (
     ExtensionError,
@@ -347,7 +347,7 @@ def test_bad_input(name, tmp_path, capsys):
     target = target_of(case, name, tmp_path)
 
     # (a) the reader raises exactly the expected class, message names file and element
-    raisers = [rt70.scene.load_scene]
+    raisers = [rt70.model.scene.load_scene]
     if case.source is not SCENE:
         raisers.append(rt70.urdf.read_urdf)
     for read in raisers:
@@ -364,7 +364,7 @@ def test_bad_input(name, tmp_path, capsys):
 
     # (b) the CLI: exit code 2, one line on stderr, no traceback
     capsys.readouterr()
-    assert rt70.cli.main(["validate", target]) == 2
+    assert rt70.cli.main.main(["validate", target]) == 2
     out, err = capsys.readouterr()
     assert out == ""
     assert "Traceback" not in err
@@ -418,7 +418,7 @@ def test_good_file_passes_the_reader(tmp_path):
 
 @pytest.fixture(scope="module")
 def pendulum():
-    scene = rt70.scene.load_scene("double_pendulum")
+    scene = rt70.model.scene.load_scene("double_pendulum")
     return scene.textbook, scene.textbook_data
 
 

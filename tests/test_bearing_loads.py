@@ -1,4 +1,4 @@
-"""The RT-70's bearing and reducer loads (rt70.bearing_loads) and ``rt70 reactions``."""
+"""The RT-70's bearing and reducer loads (rt70.telescope.bearing_loads) and ``rt70 reactions``."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import json
 import numpy as np
 import pytest
 
-from rt70 import bearing_loads as bl
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.errors import Rt70Error
-from rt70.scenarios import EQUILIBRIUM_TOL
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
+from rt70.telescope import bearing_loads as bl
+from rt70.telescope.scenarios import EQUILIBRIUM_TOL
 from rt70.testing import assert_close
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_info
 
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.reports import bench
 from rt70.reports.threads import pools, single_threaded
 
@@ -99,11 +99,11 @@ def test_validation_script_writes_the_committed_results(monkeypatch):
     import runpy
     from pathlib import Path
 
-    import rt70.cli
+    import rt70.cli.main
 
     script = Path(__file__).parents[1] / "validation" / "bench_mass_matrix.py"
     calls = []
-    monkeypatch.setattr(rt70.cli, "main", lambda argv: calls.append(argv) or 0)
+    monkeypatch.setattr(rt70.cli.main, "main", lambda argv: calls.append(argv) or 0)
     for argv in (["--quick"], ["--out", "elsewhere"]):
         monkeypatch.setattr("sys.argv", [str(script), *argv])
         with pytest.raises(SystemExit) as done:

@@ -1,6 +1,6 @@
 """Nothing reachable from the command line crashes or eats the machine (issue 8, part 3).
 
-- memory and parser guards (rt70.resources): the estimates, the refusals (with a
+- memory and parser guards (rt70.guards.resources): the estimates, the refusals (with a
   monkeypatched available memory: nothing large is allocated), one small measurement,
   a tree deeper than Pinocchio's main-thread limit parsed on the big-stack thread;
 - the linear-time lookups behind many bushings and joint springs (results, not timings:
@@ -26,10 +26,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rt70.resources as resources
+import rt70.guards.resources as resources
+import rt70.reference.limits as limits
 from rt70 import reference
-from rt70.atomic import atomic_write_all
-from rt70.cli import EXIT_BROKEN_PIPE, EXIT_TERMINATED, main
+from rt70.cli.main import EXIT_BROKEN_PIPE, EXIT_TERMINATED, main
 from rt70.errors import (
     NonFiniteError,
     OutputError,
@@ -38,9 +38,10 @@ from rt70.errors import (
     ShapeError,
     SimulationError,
 )
-from rt70.scene import load_scene, scene_from_text
+from rt70.guards.atomic import atomic_write_all
+from rt70.model.scene import load_scene, scene_from_text
 from rt70.scenes.synthetic import serial_chain
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.textbook import dynamics, forces, structured
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -142,7 +143,7 @@ def test_cli_refuses_a_model_too_large(monkeypatch, tmp_path, capsys):
 _MEASURE = r"""
 import json
 from rt70.reference import ReferenceData, ReferenceModel
-from rt70.scene import scene_from_text
+from rt70.model.scene import scene_from_text
 from rt70.scenes.synthetic import serial_chain
 
 def status():  # resident memory: peak (VmHWM), anonymous, file-backed (libraries), shared
@@ -173,7 +174,7 @@ def test_reference_estimate_bounds_a_measured_peak():
 
 def test_tree_depth_and_parser_guard(monkeypatch):
     desc = scene_from_text(chain_urdf(["revolute", "fixed", "revolute"])).description
-    assert resources.tree_depth(desc) == 4
+    assert limits.tree_depth(desc) == 4
     monkeypatch.setattr(resources, "PARSER_MAX_DEPTH", 3)
     scene = scene_from_text(chain_urdf(["revolute", "fixed", "revolute"]), "deep.urdf")
     with pytest.raises(ResourceError, match=r"^deep\.urdf: kinematic tree 4 links deep"):
@@ -188,7 +189,7 @@ def test_run_with_stack_returns_and_raises():
 
 _DEEP = r"""
 import sys
-from rt70.scene import scene_from_text
+from rt70.model.scene import scene_from_text
 n = 5000  # the main thread's 8 MiB stack segfaults Pinocchio's parser near 3770 levels
 inertial = sys.argv[1]
 parts = ['<robot name="deep">', '<link name="l0"/>']
@@ -247,8 +248,8 @@ def no_work(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the options were checked")
 
-    monkeypatch.setattr("rt70.scene.load_scene", forbidden)
-    monkeypatch.setattr("rt70.simulate.simulate", forbidden)
+    monkeypatch.setattr("rt70.model.scene.load_scene", forbidden)
+    monkeypatch.setattr("rt70.simulation.simulate.simulate", forbidden)
 
 
 @pytest.mark.parametrize(
@@ -282,7 +283,7 @@ def test_bad_option_exits_2_before_any_work(argv, expected, no_work, capsys):
 
 
 def test_good_edge_options_are_accepted():
-    from rt70.cli import build_parser
+    from rt70.cli.main import build_parser
 
     args = build_parser().parse_args(["modes", "rt70", "--elevation", "0", "--azimuth", "-360"])
     assert (args.elevation, args.azimuth) == (0.0, -360.0)
@@ -340,7 +341,7 @@ def slow_savefig(self, fname, *args, **kwargs):  # a plot that takes forever to 
     time.sleep(120)
 
 Figure.savefig = slow_savefig
-from rt70.cli import main
+from rt70.cli.main import main
 sys.exit(main(["simulate", "double_pendulum", "--t-end", "0.05", "--out", sys.argv[1]]))
 """
 
@@ -393,8 +394,8 @@ def test_failure_between_files_keeps_the_old_set(tmp_path):
 _SIGTERM_BETWEEN_RENAMES = r"""
 import os, signal, sys
 from pathlib import Path
-from rt70.atomic import atomic_write_all
-from rt70.options import sigterm_exits
+from rt70.guards.atomic import atomic_write_all
+from rt70.cli.options import sigterm_exits
 
 real_replace = os.replace
 def replace_then_sigterm(src, dst):  # SIGTERM right after the first rename

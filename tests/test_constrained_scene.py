@@ -17,13 +17,13 @@ import json
 import numpy as np
 import pytest
 
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.errors import Rt70Error
 from rt70.linear import constrained_scene as cs
 from rt70.linear import linearize as lin
 from rt70.linear import modal
+from rt70.model.scene import load_scene
 from rt70.reference import points as ref_points
-from rt70.scene import load_scene
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import points as tb_points
 

@@ -1,4 +1,4 @@
-"""The constraint seam (rt70/constraints.py): mimic joints, locked coordinates and rigid
+"""The constraint seam (rt70/physics/constraints.py): mimic joints, locked coordinates and rigid
 links are one kind of thing, ``q_full = T q + q₀``, eliminated by ``Tᵀ … T``."""
 
 from __future__ import annotations
@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rt70 import constraints
 from rt70.errors import Rt70Error
 from rt70.linear import holonomic, topology
 from rt70.linear import linearize as lin
-from rt70.scene import load_scene, scene_from_text
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics import constraints
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import dynamics

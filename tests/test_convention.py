@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from rt70 import reference
+from rt70.model.scene import load_scene
 from rt70.reference import ReferenceData, ReferenceModel
-from rt70.scene import load_scene
 from rt70.textbook.model import Model
 
 ALL_JOINTS = Path(__file__).parent / "data" / "all_joint_types.urdf"

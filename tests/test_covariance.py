@@ -10,9 +10,9 @@ import scipy.stats
 from threadpoolctl import threadpool_limits
 
 from rt70.errors import Rt70Error
-from rt70.gusts import GustFilter, realise
 from rt70.linear import covariance as cov
 from rt70.testing import assert_close, close
+from rt70.wind.gusts import GustFilter, realise
 
 
 def parts(z: np.ndarray) -> np.ndarray:

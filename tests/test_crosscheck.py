@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from rt70 import reference
-from rt70.cli import main
-from rt70.scene import URDF_DIR, load_scene, scene_names
+from rt70.cli.main import main
+from rt70.crosscheck.validate import QUANTITIES, cross_check, quantities
+from rt70.model.scene import URDF_DIR, load_scene, scene_names
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import dynamics, forces
-from rt70.validate import QUANTITIES, cross_check, quantities
 
 TOL = 1e-10
 

@@ -14,11 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rt70.cli
-from rt70.drives import DcDrive, scene_drive, scene_drives
+import rt70.cli.main
+from rt70.control.drives import DcDrive, scene_drive, scene_drives
 from rt70.errors import ExtensionError, Rt70Error
+from rt70.model.scene import load_scene
 from rt70.reference import drives as ref_drives
-from rt70.scene import load_scene
 from rt70.scenes.generate import lumped_drive
 from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
 from rt70.scenes.rt70_state import rt70_pointing
@@ -142,7 +142,7 @@ def test_bad_drive_is_refused_naming_file_and_element(name, tmp_path, capsys):
     message = str(excinfo.value)
     assert message.startswith(f"{path}: ") and needle in message, message
     capsys.readouterr()
-    assert rt70.cli.main(["validate", str(path)]) == 2
+    assert rt70.cli.main.main(["validate", str(path)]) == 2
     err = capsys.readouterr().err.splitlines()
     assert err == [f"rt70: error: {message}"]
 

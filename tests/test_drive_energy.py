@@ -3,7 +3,7 @@
     ∫u I − ∫(R_a I² + D_m ω_m² + D_r Δ̇²) = Δ(½L_a I² + ½J_m ω_m² + ½C_r Δ²)
                                           + Δ(T + U_g + U_c) + E_ψ
 
-(:mod:`rt70.drive_energy`). It closes to the integration tolerance only because the
+(:mod:`rt70.control.drive_energy`). It closes to the integration tolerance only because the
 drive's force is the gradient of the angle its twist is measured on; the book's
 Δβ = β − α_m/i_r on the elevation coordinate with the force through the sector does not
 (the last test).
@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70.couplings import CoordinateCoupling, SceneCoupling
-from rt70.drive_energy import AuditedDrive, energy_balance
-from rt70.drives import DcDrive, drive_parameters, scene_drive, scene_drives
-from rt70.scene import load_scene
-from rt70.servo import ServoDrive, cascade_gains
-from rt70.simulate import simulate
+from rt70.control.drive_energy import AuditedDrive, energy_balance
+from rt70.control.drives import DcDrive, drive_parameters, scene_drive, scene_drives
+from rt70.control.servo import ServoDrive, cascade_gains
+from rt70.model.couplings import CoordinateCoupling, SceneCoupling
+from rt70.model.scene import load_scene
+from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
 
 TURRET = Path(__file__).parent / "data" / "turret_drives.urdf"

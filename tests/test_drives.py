@@ -1,4 +1,4 @@
-"""The DC drive as simulation states (rt70.drives) against its Lagrange form.
+"""The DC drive as simulation states (rt70.control.drives) against its Lagrange form.
 
 A rotor of inertia J_l on one joint, driven by the drive of formalism §4.5 through a
 compliant reducer: the nonlinear simulation with the drive as an extra-state component
@@ -16,10 +16,10 @@ from scipy.integrate import solve_ivp
 
 from rt70.bondgraph.lagrange import drive_lagrange
 from rt70.bondgraph.parameters import DriveParameters
-from rt70.drives import DcDrive
+from rt70.control.drives import DcDrive
 from rt70.errors import Rt70Error
-from rt70.scene import scene_from_text
-from rt70.simulate import simulate
+from rt70.model.scene import scene_from_text
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 J_L = 2.0

@@ -16,11 +16,11 @@ import pinocchio as pin
 import pytest
 
 from rt70.errors import SingularConfigurationError
+from rt70.model.scene import load_scene, scene_from_text
 from rt70.reference import forces
 from rt70.reference.element_kernels import ElementKernels
-from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.rt70_state import listing_initial_state
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 SCENES = ("rt70", "rt70_servo", "rt70_azimuth", "rt70_elevation", "three_masses",
@@ -104,7 +104,7 @@ def test_kernels_on_siblings_through_unaligned_prismatic_and_continuous_joints()
 def test_a_mimic_model_keeps_the_python_path():
     """The simulation's backend uses the kernels only where the book's coordinates are
     Pinocchio's (q, v); the gear reducer's mimic joints map them."""
-    from rt70.simulate import BACKENDS
+    from rt70.simulation.simulate import BACKENDS
 
     scene = load_scene("gear_reducer")
     assert not scene.reference.identity_map
@@ -136,7 +136,7 @@ def test_gimbal_lock_is_refused_like_the_python_path():
 def test_simulation_with_kernels_equals_the_python_path(monkeypatch):
     """The RT-70 from the listing's state: the fast path's trajectory is the Python path's
     to within the integration tolerance (same method, same rtol)."""
-    from rt70 import simulate as sim
+    from rt70.simulation import simulate as sim
 
     scene = load_scene("rt70")
     x0 = listing_initial_state(scene)
@@ -188,8 +188,8 @@ def test_a_new_element_kind_turns_the_kernels_off(monkeypatch):
 def test_compiled_wind_force_equals_pinocchios(direction):
     """The wind's generalised force from the compiled poses and point Jacobians against
     Pinocchio's placements and point Jacobians (rt70.reference.wind.wind_force)."""
+    from rt70.physics.aerodynamics import WindCondition
     from rt70.reference import wind as kin
-    from rt70.wind import WindCondition
 
     scene = load_scene("rt70_servo")
     ref, rd = scene.reference, scene.reference_data

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import rt70.reference as reference
+from rt70.model.scene import load_scene, scene_from_text
 from rt70.reference import forces as ref_forces
-from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.synthetic import random_tree
 from rt70.testing import assert_close
 from rt70.textbook import forces as tb_forces

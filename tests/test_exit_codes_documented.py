@@ -1,6 +1,6 @@
 """Every exit code that README.md, docs/*.md and ``rt70 --help`` state is what rt70 does.
 
-The statements (``grep -n -i exit README.md docs/*.md``, rt70/cli.py's docstring and
+The statements (``grep -n -i exit README.md docs/*.md``, rt70/cli/main.py's docstring and
 ``rt70 --help``), and where each is run:
 
 - README, "The cross-check": ``validate`` exits 0 when every row is within the
@@ -33,8 +33,8 @@ import threading
 import numpy as np
 import pytest
 
-from rt70.cli import main
-from rt70.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
+from rt70.cli.main import main
+from rt70.cli.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 NO_DOF = """<robot name="still">
   <link name="world"/>
@@ -125,7 +125,7 @@ def test_validate_disagreeing_is_1(error, monkeypatch, capsys):
 
 def _survey_with(failed: dict[str, str]):
     def survey(names=None, balance_inertia=False):
-        from rt70.scene import load_scene
+        from rt70.model.scene import load_scene
 
         return [load_scene("three_masses")], failed
 
@@ -138,7 +138,7 @@ def _survey_with(failed: dict[str, str]):
     ids=["not-loaded", "bug"],
 )
 def test_robots_not_loaded_are_no_error_but_a_bug_is_1(reason, expected, monkeypatch, capsys):
-    import rt70.robots as robots
+    import rt70.crosscheck.robots as robots
 
     monkeypatch.setattr(robots, "survey", _survey_with({"some_robot": reason}))
     assert exit_code(["validate", "robots", "--samples", "1"]) == expected
@@ -146,7 +146,7 @@ def test_robots_not_loaded_are_no_error_but_a_bug_is_1(reason, expected, monkeyp
 
 
 def test_simulate_stopped_before_the_end_is_1(monkeypatch, capsys):
-    import rt70.simulate as simulate
+    import rt70.simulation.simulate as simulate
 
     real = simulate.simulate
 

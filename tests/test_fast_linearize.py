@@ -9,7 +9,7 @@ import pytest
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.testing import assert_close
 from rt70.textbook import forces

@@ -1,21 +1,21 @@
-"""Dry friction of an axis (rt70.friction): the book's law, its regularisations, energy."""
+"""Dry friction of an axis (rt70.control.friction): the book's law, its regularisations, energy."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rt70.errors import Rt70Error
-from rt70.friction import (
+from rt70.control.friction import (
     AxisFriction,
     creep_speed,
     friction_torque,
     relay_torque,
     switched_rigid_axis,
 )
-from rt70.scene import scene_from_text
+from rt70.errors import Rt70Error
+from rt70.model.scene import scene_from_text
 from rt70.scenes.rt70_drives import FRICTION, KGF_M
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 TOP = FRICTION.top_speed

@@ -9,7 +9,7 @@ from rt70.bondgraph.lagrange import reducer_lagrange
 from rt70.bondgraph.parameters import GearReducerParameters
 from rt70.linear import linearize as lin
 from rt70.linear import modal
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes import mechanisms
 from rt70.testing import assert_close
 

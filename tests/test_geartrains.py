@@ -1,4 +1,4 @@
-"""Backlash and the two counter-torqued gear trains (rt70.geartrains)."""
+"""Backlash and the two counter-torqued gear trains (rt70.control.geartrains)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 from test_drives import J_L, PARAMS, ROTOR  # the same rotor and drive as the DcDrive tests
 
-from rt70.errors import Rt70Error
-from rt70.geartrains import (
+from rt70.control.geartrains import (
     TwoTrainDrive,
     TwoTrainServo,
     backlash_torque,
@@ -17,9 +16,10 @@ from rt70.geartrains import (
     equivalent_drive,
     train_gains,
 )
-from rt70.scene import scene_from_text
-from rt70.servo import ServoDrive, cascade_gains
-from rt70.simulate import simulate
+from rt70.control.servo import ServoDrive, cascade_gains
+from rt70.errors import Rt70Error
+from rt70.model.scene import scene_from_text
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 #: Stiff enough for the rigid-axis cascade design (as tests/test_servo.py).

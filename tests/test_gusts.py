@@ -1,4 +1,4 @@
-"""Davenport gusts: the spectrum, its shaping filter and exact realisations (rt70.gusts)."""
+"""Davenport gusts: the spectrum, its shaping filter and exact realisations (rt70.wind.gusts)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import scipy.linalg
 import scipy.signal
 from threadpoolctl import threadpool_limits
 
-from rt70 import gusts
 from rt70.errors import Rt70Error
 from rt70.linear.covariance import output_covariance, sample_variance_error
 from rt70.testing import MIN_REL, assert_close, close
+from rt70.wind import gusts
 
 KAPPA = gusts.DAVENPORT_KAPPA
 

@@ -22,21 +22,22 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rt70 import resources, validate
+from rt70.crosscheck import validate
+from rt70.crosscheck.impact_check import impact_scales, impact_values, state_locks
+from rt70.crosscheck.robots import load_robot, survey
+from rt70.crosscheck.validate import cross_check, random_state
 from rt70.errors import InertiaError, ResourceError, SingularConfigurationError
-from rt70.impact_check import impact_scales, impact_values, state_locks
-from rt70.kkt import schur_pinv, solve_kkt
-from rt70.locks import Brake, constraint_rows, engage
+from rt70.guards import resources
+from rt70.mechanics.locks import Brake, constraint_rows, engage
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics.kkt import schur_pinv, solve_kkt
 from rt70.reference import forces as ref_forces
 from rt70.reference.coordinates import to_pinocchio
-from rt70.robots import load_robot, survey
-from rt70.scene import load_scene, scene_from_text
 from rt70.testing import EPS, MIN_REL, assert_close
 from rt70.textbook import forces as tb_forces
 from rt70.textbook.dynamics import mass_matrix
 from rt70.textbook.kinematics import update_structure
 from rt70.urdf.inertia import ZERO_ULPS, inertia_defect, inertia_scale, is_point_mass
-from rt70.validate import cross_check, random_state
 
 ROOT = Path(__file__).resolve().parents[1]
 ALL_JOINTS = ROOT / "tests" / "data" / "all_joint_types.urdf"

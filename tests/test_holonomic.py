@@ -32,7 +32,7 @@ from rt70.linear.topology import (
     proportional_damping,
     topology_matrix,
 )
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes import rt70_data
 from rt70.scenes.rt70_chapter2 import azimuth_model, elevation_model
 from rt70.testing import MIN_REL, assert_close

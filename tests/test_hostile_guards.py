@@ -6,7 +6,7 @@ cases in subprocesses and counts them):
 - coefficient tables that are special files, too large, or hold numbers above 1e30;
 - physical options beyond a stated bound (wind speed: Mach 0.3; rates, positions: 1e30;
   a heading error: π);
-- sizes and durations beyond the memory (rt70.resources' time-series estimate);
+- sizes and durations beyond the memory (rt70.guards.resources' time-series estimate);
 - runs an integrator cannot finish: the evaluation budget, a solver failing before its
   first output time;
 - loads beyond any equilibrium (Newton's forces not finite);
@@ -14,7 +14,7 @@ cases in subprocesses and counts them):
 - numpy/scipy RuntimeWarnings become the one error line, never a stray warning.
 
 Each checks exit 2, exactly one stderr line starting ``rt70: error:`` that names the
-option, file or element, and no traceback; in-process (``rt70.cli.main``) unless a
+option, file or element, and no traceback; in-process (``rt70.cli.main.main``) unless a
 process of its own is needed.
 """
 
@@ -28,15 +28,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rt70.integrators as integrators
-import rt70.resources as resources
-from rt70 import options
-from rt70.cli import main
+import rt70.guards.resources as resources
+import rt70.simulation.integrators as integrators
+from rt70.cli import options
+from rt70.cli.main import main
 from rt70.errors import Rt70Error, SimulationError
-from rt70.scene import URDF_DIR
+from rt70.model.scene import URDF_DIR
+from rt70.physics.aerodynamics import MAX_COEFFICIENT, MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from rt70.testing import assert_close
-from rt70.urdf import reader
-from rt70.wind import MAX_COEFFICIENT, MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from rt70.urdf import elements
 
 SERVO = URDF_DIR / "rt70_servo.urdf"
 HEADER = "theta_deg,axial,normal,moment\n"
@@ -45,7 +45,7 @@ HEADER = "theta_deg,axial,normal,moment\n"
 def one_error(capsys, argv: list[str]) -> str:
     """Run ``rt70 ARGV`` in-process; assert exit 2 and one error line; return the line.
 
-    A bad option ends in argparse's ``SystemExit(2)`` (rt70.options.Parser), any other
+    A bad option ends in argparse's ``SystemExit(2)`` (rt70.cli.options.Parser), any other
     failure in main's return value.
     """
     try:
@@ -96,7 +96,7 @@ def test_coefficients_above_the_urdf_bound_are_refused(tmp_path, capsys, value):
 
 
 def test_the_table_bound_is_the_urdf_readers():
-    assert MAX_COEFFICIENT == reader.MAX_MAGNITUDE == options.MAX_MAGNITUDE
+    assert MAX_COEFFICIENT == elements.MAX_MAGNITUDE == options.MAX_MAGNITUDE
 
 
 def test_a_table_with_too_many_rows_or_bytes_is_refused(tmp_path, capsys):
@@ -165,9 +165,9 @@ def test_runs_beyond_the_memory_are_refused_before_the_work(capsys, argv, named)
 
 def test_a_run_without_output_times_stops_at_the_samples_memory_holds(monkeypatch, capsys):
     # one sample per step: the most evaluations are the samples memory holds (here 200)
-    import rt70.simulate
+    import rt70.simulation.simulate
 
-    monkeypatch.setattr(rt70.simulate, "time_series_samples", lambda channels: 200)
+    monkeypatch.setattr(rt70.simulation.simulate, "time_series_samples", lambda channels: 200)
     line = one_error(capsys, ["simulate", "rt70", "--t-end", "10"])
     assert "right-hand-side evaluations" in line and "memory" in line
 
@@ -290,7 +290,7 @@ def test_results_with_nan_are_refused():
 def test_settling_metrics_nan_is_text_other_nan_is_an_error():
     from types import SimpleNamespace
 
-    from rt70.servo_metrics import summary_lines
+    from rt70.telescope.servo_metrics import summary_lines
 
     m = {
         "pointing_drift_arcsec": 3.0,
@@ -317,15 +317,15 @@ def test_settling_metrics_nan_is_text_other_nan_is_an_error():
 
 # --- RuntimeWarnings ------------------------------------------------------------------------
 def test_a_runtime_warning_is_the_one_error_line(monkeypatch, capsys):
-    import rt70.scene
+    import rt70.model.scene
 
-    real = rt70.scene.load_scene
+    real = rt70.model.scene.load_scene
 
     def overflowing(*args, **kwargs):
         np.float64(1e308) * np.float64(10.0)  # numpy: "overflow encountered"
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(rt70.scene, "load_scene", overflowing)
+    monkeypatch.setattr(rt70.model.scene, "load_scene", overflowing)
     line = one_error(capsys, ["modes", "two_body_gravity"])
     assert line.startswith(
         "rt70: error: rt70 modes two_body_gravity: numerical failure (RuntimeWarning: overflow"

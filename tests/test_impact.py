@@ -1,4 +1,7 @@
-"""Impacts (companion source 004 (15)): rt70.impact, rt70.locks, both sides, the audit."""
+"""Impacts (companion source 004 (15)): the law, the locks, both sides, the energy audit.
+
+The law: rt70.physics.impact; the locks: rt70.mechanics.locks.
+"""
 
 import json
 from pathlib import Path
@@ -6,18 +9,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70.cli import main
-from rt70.engagement import engage_after
+from rt70.cli.main import main
+from rt70.crosscheck.impact_check import impact_scales, impact_values, state_locks
+from rt70.crosscheck.validate import random_state
 from rt70.errors import Rt70Error, UnknownLinkError
-from rt70.impact import solve_impact
-from rt70.impact_check import impact_scales, impact_values, state_locks
-from rt70.loads import Wrench
-from rt70.locks import Brake, StowPin, check_locks, engage, joint_impulses, parse_pin
-from rt70.scene import load_scene
-from rt70.simulate import simulate
+from rt70.mechanics.engagement import engage_after
+from rt70.mechanics.locks import Brake, StowPin, check_locks, engage, joint_impulses, parse_pin
+from rt70.model.scene import load_scene
+from rt70.physics.impact import solve_impact
+from rt70.physics.loads import Wrench
+from rt70.simulation.simulate import simulate
 from rt70.testing import EPS, assert_close
 from rt70.textbook import dynamics, points
-from rt70.validate import random_state
 
 ALL_JOINT_TYPES = Path(__file__).parent / "data" / "all_joint_types.urdf"
 
@@ -133,7 +136,7 @@ def test_textbook_impact_equals_pinocchio_impulse_dynamics(name):
     The issue's target, 1e-12 relative, holds on the small scenes; the RT-70's mass
     matrix has a condition number of about 10⁶, so there the two sides' last-digit
     differences of A (4e-16) move q̇⁺ and Λ by up to a few 1e-12 (docs/impacts.md): the
-    test asks for the rounding bound of :func:`rt70.impact_check.impact_scales` instead.
+    test asks for the rounding bound of :func:`rt70.crosscheck.impact_check.impact_scales` instead.
     """
     scene = load_scene(name)
     rng = np.random.default_rng(0)
@@ -284,7 +287,7 @@ ONE_AXIS = """<?xml version="1.0"?>
 
 def test_one_coordinate_pin_and_brake_agree():
     """nv = 1: Pinocchio's frame Jacobian comes back as a vector (found by random trees)."""
-    from rt70.scene import scene_from_text
+    from rt70.model.scene import scene_from_text
 
     scene = scene_from_text(ONE_AXIS, "one_axis")
     q, qd = np.array([0.4]), np.array([1.5])

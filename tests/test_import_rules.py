@@ -1,12 +1,16 @@
-"""Who may import whom (docs/architecture.md): the layers as an import graph, checked.
+"""Who may import whom (docs/architecture.md): the folders as floors, checked.
+
+Each folder of the package stands on a floor (:data:`FLOORS`): a module imports its own
+folder and the floors below, never a floor above nor a folder beside it on its own floor,
+and the modules' import graph has no circle. Within the lower floors finer rules hold:
 
 The two sides of the cross-check stay independent only if the import graph says so:
 ``rt70/urdf/`` (the reader) imports nothing of the textbook side nor of the reference
 side; ``rt70/textbook/`` never imports the reference side (nor Pinocchio, see
 tests/test_independence.py) and the reference side never imports the textbook; both
-may use the shared math below them (``rt70.rotations``; the textbook also
-``rt70.constraints``) and the small helpers every
-layer uses (``rt70.errors``, ``rt70.arrays``). The generic analyses and the simulation
+may use the shared math below them (``rt70.physics.rotations``; the textbook also
+``rt70.physics.constraints``) and the small helpers every
+layer uses (``rt70.errors``, ``rt70.guards.arrays``). The generic analyses and the simulation
 load no RT-70 module (:data:`RT70_MODULES`), not even through another module. Every
 import is found statically, at any depth (inside functions too).
 
@@ -16,7 +20,7 @@ the core in a fresh interpreter.
 
 The reports and benchmarks (``rt70/reports/``) are built on the core and apart from it:
 no module outside ``rt70/reports/`` imports them, except the command line
-(``rt70/cli.py``), which runs them.
+(``rt70/cli/main.py``), which runs them.
 """
 
 from __future__ import annotations
@@ -31,47 +35,73 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "rt70"
 
-#: Modules below both sides that any layer may import (``rt70.loads``: the plain
-#: Wrench value both sides turn into a generalised force; ``rt70.wind``: the wind's
-#: Wrench on a body at a pose each side computes).
+#: Modules below both sides that any layer may import (``rt70.physics.loads``: the plain
+#: Wrench value both sides turn into a generalised force; ``rt70.physics.aerodynamics``:
+#: the wind's Wrench on a body at a pose each side computes).
 SHARED = (
     "rt70.errors",
-    "rt70.arrays",
-    "rt70.rotations",
-    "rt70.loads",
-    "rt70.constraints",
-    "rt70.wind",
-    "rt70.kkt",
-    "rt70.baumgarte",
+    "rt70.guards.arrays",
+    "rt70.physics.rotations",
+    "rt70.physics.loads",
+    "rt70.physics.constraints",
+    "rt70.physics.aerodynamics",
+    "rt70.physics.kkt",
+    "rt70.physics.baumgarte",
 )
 
 #: layer (module prefix) → module prefixes it may import from rt70.
 RULES = {
     "rt70.urdf": ("rt70.urdf", *SHARED),
     "rt70.textbook": ("rt70.textbook", "rt70.urdf", *SHARED),
-    # not rt70.constraints: the reference side maps mimic joints on its own, so the
+    # not rt70.physics.constraints: the reference side maps mimic joints on its own, so the
     # cross-check also checks the textbook's constraint matrix G
     "rt70.reference": (
         "rt70.reference",
         "rt70.urdf",
-        "rt70.resources",
+        "rt70.guards.resources",
         *SHARED[:4],
-        "rt70.wind",
-        "rt70.baumgarte",
+        "rt70.physics.aerodynamics",
+        "rt70.physics.baumgarte",
     ),
-    "rt70.resources": ("rt70.urdf.description", *SHARED),
-    "rt70.rotations": (),
+    "rt70.guards.resources": ("rt70.errors",),
+    "rt70.physics.rotations": (),
     "rt70.errors": (),
-    "rt70.arrays": ("rt70.errors",),
-    "rt70.constraints": ("rt70.errors",),
+    "rt70.guards.arrays": ("rt70.errors",),
+    "rt70.physics.constraints": ("rt70.errors",),
     # a second formulation of the drives, independent of both rigid-body sides
     "rt70.bondgraph": ("rt70.bondgraph", *SHARED),
-    "rt70.loads": ("rt70.arrays", "rt70.errors"),
-    "rt70.wind": ("rt70.errors", "rt70.loads"),
-    "rt70.kkt": ("rt70.errors",),
-    "rt70.baumgarte": ("rt70.errors",),
-    "rt70.nonholonomic": ("rt70.errors", "rt70.kkt"),
+    "rt70.physics.loads": ("rt70.guards.arrays", "rt70.errors"),
+    "rt70.physics.aerodynamics": ("rt70.errors", "rt70.physics.loads"),
+    "rt70.physics.kkt": ("rt70.errors",),
+    "rt70.physics.baumgarte": ("rt70.errors",),
+    "rt70.physics.nonholonomic": ("rt70.errors", "rt70.physics.kkt"),
 }
+
+
+#: The folders of the package from the ground up (docs/architecture.md gives each one's
+#: role). A module may import its own folder and any folder on a lower floor; folders on
+#: one floor are independent of each other (the two sides of the cross-check above all).
+FLOORS = (
+    ("rt70.errors", "rt70.testing"),
+    ("rt70.guards", "rt70.bondgraph"),
+    ("rt70.physics",),
+    ("rt70.urdf",),
+    ("rt70.textbook", "rt70.reference"),
+    ("rt70.model",),
+    ("rt70.simulation", "rt70.linear"),
+    ("rt70.mechanics", "rt70.control"),
+    ("rt70.wind", "rt70.scenes"),
+    ("rt70.telescope",),
+    ("rt70.crosscheck", "rt70.sweep"),
+    ("rt70.plotting",),
+    ("rt70.reports",),
+    ("rt70.cli",),
+    ("rt70.__main__",),
+)
+
+#: The package's face (``rt70/__init__.py``) is not a folder: it stands on the floor of
+#: the highest module it imports, and only modules above that may import it.
+FACE = "rt70"
 
 
 def _module_name(path: Path) -> str:
@@ -114,7 +144,7 @@ def _allowed(layer: str, imported: str) -> bool:
 
 def test_graph_is_found():
     assert "rt70.urdf.reader" in MODULES and "rt70.textbook.dynamics" in MODULES
-    assert "rt70.rotations" in _imports(MODULES["rt70.urdf.reader"])
+    assert "rt70.physics.rotations" in _imports(MODULES["rt70.urdf.reader"])
 
 
 @pytest.mark.parametrize("module", [m for m in MODULES if _layer(m)])
@@ -148,9 +178,9 @@ def test_reader_knows_no_textbook():
 NO_MATPLOTLIB = (
     "rt70.linear.modal",
     "rt70.linear.responses",
-    "rt70.simulate",
-    "rt70.validate",
-    "rt70.scene",
+    "rt70.simulation.simulate",
+    "rt70.crosscheck.validate",
+    "rt70.model.scene",
 )
 
 
@@ -179,7 +209,7 @@ def test_plotting_is_where_matplotlib_is():
 
 
 #: Modules outside rt70/reports/ that may import the reports: the command line runs them.
-REPORT_USERS = ("rt70.cli",)
+REPORT_USERS = ("rt70.cli.main",)
 
 
 def _is_report(module: str) -> bool:
@@ -206,7 +236,7 @@ def test_core_never_imports_the_reports(module):
 def test_report_rule_sees_the_reports():
     """The rule has something to check: the reports exist and the command line uses them."""
     assert "rt70.reports.book" in MODULES and "rt70.reports.stress.report" in MODULES
-    assert any(_is_report(m) for m in _imports(MODULES["rt70.cli"]))
+    assert any(_is_report(m) for m in _imports(MODULES["rt70.cli.main"]))
     assert not _is_report("rt70.reporting") and _is_report("rt70.reports.bench")
 
 
@@ -240,24 +270,24 @@ RT70_MODULES = (
 #: Generic analyses and simulation: they take what they need of a scene as arguments.
 GENERIC = (
     "rt70.linear",
-    "rt70.simulate",
-    "rt70.states",
-    "rt70.outputs",
-    "rt70.optics",
-    "rt70.loads",
-    "rt70.wind",
-    "rt70.wind_load",
-    "rt70.constraints",
-    "rt70.kkt",
+    "rt70.simulation.simulate",
+    "rt70.simulation.states",
+    "rt70.model.outputs",
+    "rt70.model.optics",
+    "rt70.physics.loads",
+    "rt70.physics.aerodynamics",
+    "rt70.wind.load",
+    "rt70.physics.constraints",
+    "rt70.physics.kkt",
     "rt70.bondgraph",
-    "rt70.drives",
-    "rt70.servo",
-    "rt70.couplings",
-    "rt70.drive_energy",
-    "rt70.friction",
-    "rt70.geartrains",
-    "rt70.validate",
-    "rt70.scene",
+    "rt70.control.drives",
+    "rt70.control.servo",
+    "rt70.model.couplings",
+    "rt70.control.drive_energy",
+    "rt70.control.friction",
+    "rt70.control.geartrains",
+    "rt70.crosscheck.validate",
+    "rt70.model.scene",
     "rt70.reference",
     "rt70.textbook",
     "rt70.urdf",
@@ -329,3 +359,107 @@ def test_no_module_is_over_the_size_limit():
     assert sizes and max(sizes.values()) > 100  # the modules were found and counted
     over = {m: n for m, n in sizes.items() if n > MAX_MODULE_LINES}
     assert not over, f"modules over {MAX_MODULE_LINES} lines: {over}"
+
+
+# --- the floors (issue 22) ----------------------------------------------------------------
+
+
+def _folder(module: str) -> str | None:
+    """The folder of :data:`FLOORS` that ``module`` lies in (None for the face or unknown)."""
+    folders = [f for floor in FLOORS for f in floor]
+    inside = [f for f in folders if module == f or module.startswith(f + ".")]
+    return max(inside, key=len, default=None)
+
+
+def _floor(module: str) -> int:
+    """The floor of ``module``: its folder's, or for the face the highest it imports."""
+    if module == FACE:
+        return max(_floor(m) for m in _imported_modules(MODULES[FACE]) if m != FACE)
+    folder = _folder(module)
+    assert folder is not None, f"{module} lies in no folder of FLOORS: give it one"
+    return next(i for i, floor in enumerate(FLOORS) if folder in floor)
+
+
+def test_every_module_has_a_floor():
+    """A new folder must take its place in FLOORS (and a line in docs/architecture.md)."""
+    lost = [m for m in MODULES if m != FACE and _folder(m) is None]
+    assert not lost, f"modules in no folder of FLOORS: {lost}"
+    assert len(MODULES) > 150  # the package was found
+
+
+@pytest.mark.parametrize("module", sorted(set(MODULES) - {FACE}))
+def test_no_import_upward_or_sideways(module):
+    """A module imports its own folder or lower floors, never up nor to a neighbour."""
+    floor, folder = _floor(module), _folder(module)
+    bad = sorted(
+        m
+        for m in _imported_modules(MODULES[module])
+        if m in MODULES and _folder(m) != folder and _floor(m) >= floor
+    )
+    assert not bad, f"{module} (floor {floor}: {FLOORS[floor]}) imports upward or sideways: {bad}"
+
+
+def _circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+    for start in graph:
+        if start in index:
+            continue
+        work = [(start, iter(sorted(graph[start])))]
+        index[start] = low[start] = len(index)
+        stack.append(start)
+        on_stack.add(start)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in graph:
+                    continue
+                if child not in index:
+                    index[child] = low[child] = len(index)
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(graph[child]))))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = []
+                while True:
+                    top = stack.pop()
+                    on_stack.discard(top)
+                    component.append(top)
+                    if top == node:
+                        break
+                if len(component) > 1:
+                    found.append(sorted(component))
+    return found
+
+
+def _module_graph() -> dict[str, set[str]]:
+    """Every module and the modules it imports, at any depth, ``if TYPE_CHECKING`` too."""
+    return {m: _imported_modules(p) & MODULES.keys() - {m} for m, p in MODULES.items()}
+
+
+def test_the_import_graph_has_no_circle():
+    assert _circles(_module_graph()) == []
+
+
+def test_circle_detector_finds_a_circle():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": set()}
+    assert _circles(graph) == [["a", "b", "c"]]
+    assert _circles({"a": {"b"}, "b": set()}) == []
+
+
+def test_floor_rule_refuses_a_step_up():
+    """The rule can fail: the reader importing the simulation would be a step up."""
+    assert _floor("rt70.urdf.reader") < _floor("rt70.simulation.simulate")
+    assert _floor("rt70.textbook.dynamics") == _floor("rt70.reference.dynamics")
+    assert _folder("rt70.textbook.dynamics") != _folder("rt70.reference.dynamics")

@@ -1,10 +1,10 @@
-"""The KKT solve of the constrained equations (14) (rt70.kkt): range-space method."""
+"""The KKT solve of the constrained equations (14) (rt70.physics.kkt): range-space method."""
 
 import numpy as np
 import pytest
 
 from rt70.errors import Rt70Error
-from rt70.kkt import solve_kkt
+from rt70.physics.kkt import solve_kkt
 from rt70.testing import assert_close, tolerance
 
 #: The systems are 7 × 7 with A ≥ 7·1: well conditioned, solved to this relative error.

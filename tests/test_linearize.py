@@ -6,7 +6,7 @@ import pytest
 
 from rt70 import reference
 from rt70.linear import linearize as lin
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes import rt70_state
 from rt70.testing import assert_close
 

@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.linear import linearize as lin
 from rt70.linear import modal
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.testing import assert_close, tolerance
 

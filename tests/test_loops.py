@@ -17,15 +17,15 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg
 
-import rt70.cli
-from rt70.baumgarte import Baumgarte
-from rt70.closed_chains import CLOSURE_TOL, assemble
+import rt70.cli.main
 from rt70.errors import ExtensionError, Rt70Error, SimulationError
-from rt70.kkt import solve_kkt
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics.baumgarte import Baumgarte
+from rt70.physics.kkt import solve_kkt
 from rt70.reference import loops as rl
 from rt70.reference import points as ref_points
-from rt70.scene import load_scene, scene_from_text
-from rt70.simulate import simulate
+from rt70.simulation.closed_chains import CLOSURE_TOL, assemble
+from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import dynamics, forces
 from rt70.textbook import loops as tl
@@ -71,7 +71,7 @@ def reach(scene, q) -> float:
     """The largest distance of a loop's frame from the ground origin (m), the scale of Φ.
 
     Φ is a difference of such positions, each a sum of the links' offsets; the same scale
-    as :func:`rt70.loop_check.loop_scales` gives the loop rows of ``rt70 validate``.
+    as :func:`rt70.crosscheck.loop_check.loop_scales` gives the loop rows of ``rt70 validate``.
     """
     located = [
         (f.link, f.xyz) for loop in scene.description.loops for f in (loop.frame1, loop.frame2)
@@ -156,7 +156,7 @@ def test_bad_loop_element(case, tmp_path, capsys):
     for needle in needles:
         assert needle in message, message
     capsys.readouterr()
-    assert rt70.cli.main(["validate", str(path)]) == 2
+    assert rt70.cli.main.main(["validate", str(path)]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.splitlines() == [f"rt70: error: {message}"]
 
@@ -190,7 +190,7 @@ def test_both_sides_agree(scene, stabilization):
     if scene.name == "welded":  # Pinocchio's 6-D error is log₆, ours (p₁−p₂, log₃): on Φ = 0
         q, qd = assemble(scene, q, qd)
 
-    # the scales of rt70.loop_check.loop_scales: Φ is welded shut (0) on the manifold
+    # the scales of rt70.crosscheck.loop_check.loop_scales: Φ is welded shut (0) on the manifold
     length, speed = reach(scene, q), np.abs(qd).max()
     B_ref, C_ref = rl.loop_jacobian(ref, rd, q), rl.loop_bias(ref, rd, q, qd)
     assert_close(tl.loop_residual(tm, td, q), rl.loop_residual(ref, rd, q), rel=TOL, scale=length)
@@ -382,7 +382,7 @@ def test_kkt_matrix_is_indefinite_and_plain_cg_breaks_down(crank_slider_start):
 def test_modes_of_the_crank_slider_on_its_table_is_one_rigid_mode(capsys):
     """Gravity normal to its plane: one motion the loops leave, held by nothing — a rigid
     mode on the manifold (not the tree's three, not a refusal)."""
-    assert rt70.cli.main(["modes", "crank_slider", "--json"]) == 0
+    assert rt70.cli.main.main(["modes", "crank_slider", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["constraints"]["loop_rows"] == 3 and out["constraints"]["rank"] == 2
     assert [m["kind"] for m in out["modes"]] == ["rigid"]

@@ -1,4 +1,4 @@
-"""The LQG drive (rt70/lqg_drive.py) and its RT-70 factory (rt70/reports/servo_lqg.py).
+"""The LQG drive (rt70/control/lqg_drive.py) and its RT-70 factory (rt70/reports/servo_lqg.py).
 
 - the component's controller is the design's state space (derivative and voltage at
   random states), and its anti-windup acts only while the voltage is clamped;
@@ -14,14 +14,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rt70.control.lqg_drive import LqgDrive
 from rt70.errors import Rt70Error, ShapeError
 from rt70.linear.linearize import equilibrium, static_force
-from rt70.lqg_drive import LqgDrive
+from rt70.model.scene import load_scene
 from rt70.reports import servo_lqg as sl
-from rt70.scenarios import run_scenario
-from rt70.scene import load_scene
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
-from rt70.states import MechanicsForces
+from rt70.simulation.states import MechanicsForces
+from rt70.telescope.scenarios import run_scenario
 from rt70.testing import assert_close, close
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -143,9 +143,9 @@ def test_bad_controllers_are_refused(start):
 
 
 def test_component_knows_no_telescope():
-    tree = ast.parse((ROOT / "rt70" / "lqg_drive.py").read_text(encoding="utf-8"))
+    tree = ast.parse((ROOT / "rt70" / "control" / "lqg_drive.py").read_text(encoding="utf-8"))
     modules = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
     modules |= {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module}
     assert not [
-        m for m in modules if m.startswith(("rt70.scenes", "rt70.reports", "rt70.scenarios"))
+        m for m in modules if m.startswith(("rt70.scenes", "rt70.reports", "rt70.telescope"))
     ]

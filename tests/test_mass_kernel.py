@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rt70.crosscheck.robots import load_robot
 from rt70.errors import NonFiniteError, ShapeError
-from rt70.robots import load_robot
-from rt70.scene import load_scene, scene_names
+from rt70.model.scene import load_scene, scene_names
 from rt70.testing import assert_close
 from rt70.textbook import dynamics, mass_kernel, structured
 
@@ -87,7 +87,7 @@ def test_a_second_process_loads_the_kernel_from_the_cache():
     """``cache=True``: after a first call has compiled it, another process pays no compiling."""
     code = (
         "import numpy as np\n"
-        "from rt70.scene import load_scene\n"
+        "from rt70.model.scene import load_scene\n"
         "from rt70.textbook import mass_kernel as k\n"
         "m = load_scene('double_pendulum').textbook\n"
         "k.mass_matrix(m, k.KernelData(m), np.zeros(m.nv))\n"

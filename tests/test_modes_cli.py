@@ -3,8 +3,8 @@
 import json
 import re
 
-from rt70.cli import main
-from rt70.scene import URDF_DIR
+from rt70.cli.main import main
+from rt70.model.scene import URDF_DIR
 
 PRINTED_ELEVATION_HZ = ["0.0000", "3.2700", "4.2424", "6.3041", "7.2579", "19.6420"]
 

@@ -16,14 +16,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70 import chaplygin_cart as cart
-from rt70 import nonholonomic as nh
-from rt70 import nonholonomic_scene as ns
-from rt70.cli import main
+from rt70.cli.main import main
+from rt70.crosscheck.validate import cross_check, quantities
 from rt70.errors import ExtensionError, Rt70Error
-from rt70.scene import load_scene, scene_from_text
+from rt70.mechanics import chaplygin_cart as cart
+from rt70.mechanics import nonholonomic_scene as ns
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics import nonholonomic as nh
 from rt70.testing import MIN_REL, assert_close, close
-from rt70.validate import cross_check, quantities
 
 # proposed data of 002.3
 M0, M1_, L, K0, A_, B_, IA, IC = 10.0, 1.0, 0.1, 0.2, 0.1, 0.25, 0.0025, 0.005
@@ -176,7 +176,7 @@ def test_reduced_cart_is_48_and_the_corrected_412(cart_scene, side):
         _, red = ns.reduced_system(cart_scene, side, q, qd, cart.INDEPENDENT, names=cart.ROLLING)
         A_star = a_star_48(q[2])
         assert_close(red.A_star, A_star, rel=1e-13)
-        # the velocity terms on the scale ‖A*‖ ‖q̇‖² (as rt70.validate's bias)
+        # the velocity terms on the scale ‖A*‖ ‖q̇‖² (as rt70.crosscheck.validate's bias)
         bias_scale = np.abs(A_star).max() * np.abs(qd).max() ** 2
         assert_close(red.a, a_412(q[2], qd), rel=1e-13, scale=bias_scale)
         printed = a_412(q[2], qd, printed=True)

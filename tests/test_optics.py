@@ -1,4 +1,4 @@
-"""Outputs of the mirror system (book 4.1.8, :mod:`rt70.optics`): both sides, hand cases, C.
+"""Outputs of the mirror system (book 4.1.8, :mod:`rt70.model.optics`): both sides, hand cases, C.
 
 Each output is a formula of point positions that each side computes by its own
 kinematics; the sides must agree to 1e-10. Hand-made cases check the readings: the
@@ -14,12 +14,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rt70 import optics, outputs
 from rt70.errors import Rt70Error, SingularConfigurationError
 from rt70.linear.linearize import equilibrium
-from rt70.scene import load_scene
+from rt70.model import optics, outputs
+from rt70.model.scene import load_scene
 from rt70.scenes import rt70_optics, rt70_state
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
 
 ARCSEC = optics.ARCSEC

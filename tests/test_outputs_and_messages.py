@@ -27,10 +27,10 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-import rt70.atomic as atomic
-from rt70.atomic import atomic_write_all, atomic_write_text
-from rt70.cli import main
+import rt70.guards.atomic as atomic
+from rt70.cli.main import main
 from rt70.errors import OutputError
+from rt70.guards.atomic import atomic_write_all, atomic_write_text
 
 #: The errors of a file system that refuses data, and the reasons the message gives.
 DISK_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS)
@@ -234,7 +234,7 @@ def test_plant_out_on_a_full_disk(tmp_path, monkeypatch, capsys):
 
 @pytest.mark.parametrize("suffix", [".csv", ".json"])
 def test_reactions_output_on_a_full_disk(tmp_path, monkeypatch, capsys, suffix):
-    import rt70.bearing_loads as bl
+    import rt70.telescope.bearing_loads as bl
 
     expected = old_set(tmp_path, f"loads{suffix}")
     monkeypatch.setattr(bl, "load_table", lambda *a, **k: [])  # the loads are not the point
@@ -343,8 +343,8 @@ def test_standard_output_redirected_to_dev_full():
 
 
 def test_option_at_fault_keeps_the_class_and_prefixes_the_option():
+    from rt70.cli.options import option_at_fault
     from rt70.linear.topology import LinearModelError
-    from rt70.options import option_at_fault
 
     with pytest.raises(LinearModelError) as info, option_at_fault("--reduce 7"):
         raise LinearModelError("order must be between 1 and 6")
@@ -465,7 +465,7 @@ def loop_files(tmp_path_factory) -> dict[str, Path]:
 def test_validate_refuses_loops_that_cannot_close_before_comparing(
     name, loop_files, monkeypatch, capsys
 ):
-    import rt70.validate as validate
+    import rt70.crosscheck.validate as validate
 
     def no_comparison(*args):
         raise AssertionError("compared a model whose loops cannot close")
@@ -490,8 +490,8 @@ def test_every_command_gives_the_same_loop_error(command, loop_files, capsys):
 
 
 def test_both_sides_find_the_same_closest_configuration(loop_files):
-    from rt70.closed_chains import closure_search
-    from rt70.scene import load_scene
+    from rt70.model.scene import load_scene
+    from rt70.simulation.closed_chains import closure_search
     from rt70.testing import assert_close
 
     scene = load_scene(str(loop_files["too_far"]))
@@ -511,9 +511,9 @@ def test_redundant_consistent_loops_keep_working(loop_files, capsys):
 
 def test_newton_does_not_call_a_diverged_iteration_closed(loop_files):
     """The contradictory loops once 'converged' at q ~ 1e13 rad, |Φ| ~ 1 m (tol · |q|)."""
-    from rt70.closed_chains import assemble
     from rt70.errors import LoopClosureError
-    from rt70.scene import load_scene
+    from rt70.model.scene import load_scene
+    from rt70.simulation.closed_chains import assemble
 
     scene = load_scene(str(loop_files["contradictory"]))
     with pytest.raises(LoopClosureError, match="contradict each other"):

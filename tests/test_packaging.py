@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from rt70.scene import scene_names
+from rt70.model.scene import scene_names
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -72,7 +72,7 @@ def test_installed_wheel_validates_from_any_directory(installed, tmp_path):
 
 
 def test_installed_package_is_not_the_source_tree(installed, tmp_path):
-    code = "import rt70.scene as s; print(s.__file__); print(s.URDF_DIR)"
+    code = "import rt70.model.scene as s; print(s.__file__); print(s.URDF_DIR)"
     proc = _run([str(installed / "python"), "-c", code], tmp_path)
     module, scenes = proc.stdout.split()
     assert not module.startswith(str(ROOT)) and not scenes.startswith(str(ROOT))
@@ -82,7 +82,7 @@ def test_installed_package_is_not_the_source_tree(installed, tmp_path):
 def test_installed_package_ships_the_wind_tables(installed, tmp_path):
     """The built-in coefficient tables are package data (rt70/wind_tables/*.csv)."""
     code = (
-        "from rt70.wind import builtin_table as b\n"
+        "from rt70.physics.aerodynamics import builtin_table as b\n"
         "print(b('dish').axial[0], b('cylinder').normal[18], b('dish').source)\n"
     )
     proc = _run([str(installed / "python"), "-c", code], tmp_path)

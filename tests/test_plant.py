@@ -10,11 +10,11 @@ from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
 from rt70.linear.responses import frequency_response
-from rt70.loads import Wrench
-from rt70.outputs import optical_point_outputs
-from rt70.scene import load_scene
+from rt70.model.outputs import optical_point_outputs
+from rt70.model.scene import load_scene
+from rt70.physics.loads import Wrench
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 AXES = (AZIMUTH_COORDINATE, ELEVATION_COORDINATE)
@@ -135,7 +135,7 @@ def test_bad_plant_requests_are_clear(rt70_plant):
 def test_cli_plant_json_lists_named_inputs_and_outputs(capsys, tmp_path):
     import json
 
-    from rt70.cli import main
+    from rt70.cli.main import main
 
     out = tmp_path / "plant.npz"
     assert main(["plant", "rt70", "--elevation", "60", "--json", "--out", str(out)]) == 0
@@ -155,7 +155,7 @@ def test_cli_plant_json_lists_named_inputs_and_outputs(capsys, tmp_path):
 
 
 def test_cli_plant_bad_input(capsys, tmp_path):
-    from rt70.cli import main
+    from rt70.cli.main import main
 
     assert main(["plant", "rt70", "--out", str(tmp_path / "plant.txt")]) == 2
     assert ".npz" in capsys.readouterr().err

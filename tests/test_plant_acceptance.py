@@ -11,9 +11,9 @@ import pytest
 from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
 from rt70.linear.responses import frequency_response
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 F0 = 0.75  # Hz: between the 0.47 Hz and 1.03 Hz modes, on neither

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.testing import assert_close
 
 ARGV = ["plant", "rt70_servo", "--elevation", "45", "--reduce", "12"]

@@ -5,12 +5,12 @@ import json
 import numpy as np
 import pytest
 
-from rt70.cli import main
-from rt70.gust_run import gust_run
-from rt70.gusts import GustFilter
-from rt70.pointing import BUDGET_OUTPUTS, PointingCase, pointing_budget
-from rt70.scene import load_scene
+from rt70.cli.main import main
+from rt70.model.scene import load_scene
+from rt70.telescope.gust_run import gust_run
+from rt70.telescope.pointing import BUDGET_OUTPUTS, PointingCase, pointing_budget
 from rt70.testing import assert_close, close
+from rt70.wind.gusts import GustFilter
 
 
 @pytest.fixture(scope="module")
@@ -95,7 +95,7 @@ def test_pointing_command_refuses_bad_input(argv, capsys):
 
 def test_sweep_quantity_is_the_budget(budgets):
     """``rt70 sweep --quantity pointing`` stores the budget's numbers; no wind is a NaN."""
-    from rt70 import sweep as sw
+    from rt70.sweep import run as sw
 
     grid = sw.make_grid({"elevation": (45.0,), "wind": (0.0, 10.0)})
     result = sw.run(sw.plan("rt70_servo", grid, ["pointing"]), sw.serial)
@@ -118,8 +118,8 @@ def test_plant_wind_inputs_give_disturbance_to_pointing_transfer_functions(scene
 
     from rt70.linear import linearize as lin
     from rt70.linear.plant import plant, to_control
-    from rt70.pointing import budget_outputs, wind_inputs
     from rt70.scenes.rt70_state import rt70_pointing
+    from rt70.telescope.pointing import budget_outputs, wind_inputs
 
     case = PointingCase(45.0, 0.0, 10.0)
     held = rt70_pointing(45.0, 0.0)

@@ -2,12 +2,12 @@
 
 The textbook side (:mod:`rt70.textbook.points`, from the book's S) and the reference side
 (:mod:`rt70.reference.points`, from Pinocchio's joint Jacobians) compute point
-positions, point Jacobians and the generalised force of a wrench (:mod:`rt70.loads`);
+positions, point Jacobians and the generalised force of a wrench (:mod:`rt70.physics.loads`);
 they must agree to rounding on the RT-70, a floating-base scene, a planar scene and a
 scene with mimic joints (book coordinates ≠ Pinocchio's v on the last three). Each is
 also checked on its own: the Jacobian against finite differences of the position, the
 load's generalised force against the virtual work ``F·δp + M·δθ``. The outputs seam
-(:mod:`rt70.outputs`) evaluates the RT-70's optical points on either side and rides
+(:mod:`rt70.model.outputs`) evaluates the RT-70's optical points on either side and rides
 along a simulation.
 """
 
@@ -18,15 +18,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70 import outputs
 from rt70.errors import NonFiniteError, ShapeError, UnknownLinkError
 from rt70.linear import linearize as lin
-from rt70.loads import Wrench
+from rt70.model import outputs
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics.loads import Wrench
 from rt70.reference import points as ref_points
 from rt70.reports.stress.edits import free_floating_text
-from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.synthetic import serial_chain
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close, close
 from rt70.textbook import points as tb_points
 from rt70.textbook.kinematics import frame_jacobian, frame_pose, update_structure

@@ -6,15 +6,15 @@ chains, trees and elastic chains. Every quantity of the cross-check must agree t
 ``TOL`` relative to Pinocchio's max-norm.
 
 A quantity that nearly cancels (the velocity-product force of a tree whose joints
-barely couple) carries the rounding error of its terms; ``rt70.validate`` measures
+barely couple) carries the rounding error of its terms; ``rt70.crosscheck.validate`` measures
 each quantity against ``max(own norm, FLOOR · scale)`` with the scale the size of its
 terms at the state (``natural_scales``), so every row is held to the same tolerance.
 
 To reproduce a failure: ``rt70 validate`` takes no generated scenes, so in Python::
 
-    from rt70.scene import scene_from_text
+    from rt70.model.scene import scene_from_text
     from rt70.scenes.synthetic import random_tree
-    from rt70.validate import cross_check, format_table
+    from rt70.crosscheck.validate import cross_check, format_table
     scene = scene_from_text(random_tree(SEED, joint_types=TYPES), "s")
     print(format_table(cross_check(scene, samples=2, seed=SEED, repeat=1)))
 """
@@ -28,7 +28,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rt70.scene import scene_from_text
+from rt70.crosscheck.validate import QUANTITIES, cross_check
+from rt70.model.scene import scene_from_text
 from rt70.scenes.synthetic import (
     ALL_JOINT_TYPES,
     balanced_tree,
@@ -39,7 +40,6 @@ from rt70.scenes.synthetic import (
 from rt70.testing import assert_close, close
 from rt70.textbook import forces
 from rt70.urdf import read_urdf_string
-from rt70.validate import QUANTITIES, cross_check
 
 TOL = 1e-10
 SEEDS = range(50)

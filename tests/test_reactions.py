@@ -16,9 +16,9 @@ import pinocchio as pin
 import pytest
 
 from rt70.errors import ShapeError, UnknownLinkError
-from rt70.loads import Wrench
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics.loads import Wrench
 from rt70.reference import reactions as ref_reactions
-from rt70.scene import load_scene, scene_from_text
 from rt70.testing import assert_close
 from rt70.textbook import dynamics, points
 from rt70.textbook import reactions as tb_reactions

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70.robots import robot_path
+from rt70.crosscheck.robots import robot_path
 from rt70.testing import assert_close
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -45,7 +45,7 @@ def test_readme_snippet_compares_like_with_like(target, capsys):
 
 def test_talos_full_is_a_reordering_for_pinocchio():
     """The case the snippet guards: Pinocchio's own order differs from the file's."""
-    from rt70.scene import load_scene
+    from rt70.model.scene import load_scene
 
     scene = load_scene(robot_path("talos_full"))
     ref = scene.reference
@@ -57,7 +57,7 @@ def test_talos_full_is_a_reordering_for_pinocchio():
 
 @pytest.mark.slow
 def test_every_robot_names_its_coordinates_in_the_files_order():
-    from rt70.robots import survey
+    from rt70.crosscheck.robots import survey
 
     loaded, _ = survey()
     assert len(loaded) >= 40

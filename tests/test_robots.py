@@ -4,12 +4,12 @@ import json
 
 import pytest
 
-import rt70.robots
-from rt70.cli import main
+import rt70.crosscheck.robots
+from rt70.cli.main import main
+from rt70.crosscheck.robots import ROBOTS, UNEXPECTED, load_robot, robots_dir, survey
+from rt70.crosscheck.validate import cross_check
 from rt70.errors import Rt70Error, SceneError
-from rt70.robots import ROBOTS, UNEXPECTED, load_robot, robots_dir, survey
 from rt70.testing import assert_close
-from rt70.validate import cross_check
 
 TOL = 1e-10
 CHECKED = ("mass_matrix", "bias", "gravity", "forward_dynamics")
@@ -109,7 +109,7 @@ def test_unknown_robot_is_bad_input():
 
 
 def test_missing_package_is_a_clear_error(monkeypatch, tmp_path):
-    monkeypatch.setattr(rt70.robots, "_candidates", lambda: [tmp_path])
+    monkeypatch.setattr(rt70.crosscheck.robots, "_candidates", lambda: [tmp_path])
     with pytest.raises(Rt70Error, match="example-robot-data is not installed"):
         robots_dir()
 
@@ -118,7 +118,7 @@ def test_unexpected_exception_is_recorded(monkeypatch):
     def broken(name, *args, **kwargs):
         raise KeyError("boom")
 
-    monkeypatch.setattr(rt70.robots, "load_robot", broken)
+    monkeypatch.setattr(rt70.crosscheck.robots, "load_robot", broken)
     loaded, failed = survey(["ur5"])
     assert loaded == []
     assert failed == {"ur5": "unexpected KeyError: 'boom'"}

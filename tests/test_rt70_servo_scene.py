@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rt70 import reference
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes import rt70_data
 from rt70.scenes.rt70_drives import NOMINAL_TORQUE
 from rt70.scenes.rt70_state import ELEVATION_COORDINATE

@@ -4,16 +4,16 @@ import control
 import numpy as np
 import pytest
 
+from rt70.control.scene_loop import closed_loop
 from rt70.linear import linearize as lin
-from rt70.linear.scene_loop import closed_loop
-from rt70.loads import Wrench
-from rt70.outputs import evaluate
-from rt70.scene import load_scene
-from rt70.scene_servo import SceneServoFactory, scene_equilibrium, scene_servos
+from rt70.model.outputs import evaluate
+from rt70.model.scene import load_scene
+from rt70.physics.loads import Wrench
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import rt70_pointing
-from rt70.simulate import simulate
-from rt70.states import StateComponent
+from rt70.simulation.simulate import simulate
+from rt70.simulation.states import StateComponent
+from rt70.telescope.scene_servo import SceneServoFactory, scene_equilibrium, scene_servos
 from rt70.testing import assert_close
 from rt70.textbook import points
 

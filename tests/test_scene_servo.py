@@ -1,23 +1,26 @@
-"""Servo scenarios on the scene's own drives (rt70/scene_servo.py): sector, start, hold, CLI."""
+"""Servo scenarios on the scene's own drives: sector, start, hold, command line.
+
+The module: rt70/telescope/scene_servo.py.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rt70 import scenarios as S
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.errors import Rt70Error
 from rt70.linear.linearize import equilibrium, static_force
-from rt70.scene import load_scene
-from rt70.scene_servo import (
+from rt70.model.scene import load_scene
+from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE
+from rt70.scenes.rt70_state import rt70_pointing
+from rt70.telescope import scenarios as S
+from rt70.telescope.scene_servo import (
     SceneServoFactory,
     choose_drives,
     scene_axis_gains,
     scene_equilibrium,
 )
-from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE
-from rt70.scenes.rt70_state import rt70_pointing
 from rt70.testing import assert_close
 
 #: The sector's force has these components besides base_rx (rt70_servo at 45°).

@@ -1,4 +1,4 @@
-"""The current-rate-position cascade (rt70.servo) closing a DC drive on a rotor."""
+"""The current-rate-position cascade (rt70.control.servo) closing a DC drive on a rotor."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from test_drives import J_L, PARAMS, ROTOR  # the same rotor and drive
 
+from rt70.control.servo import ServoDrive, cascade_gains
 from rt70.errors import Rt70Error
-from rt70.scene import scene_from_text
-from rt70.servo import ServoDrive, cascade_gains
-from rt70.simulate import simulate
+from rt70.model.scene import scene_from_text
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 STEP = np.radians(1.0)

@@ -1,4 +1,4 @@
-"""Servo loops around the linear RT-70 plant (rt70.linear.loops, lqg, servo_compare).
+"""Servo loops around the linear RT-70 plant (rt70.control.loops, lqg, servo_compare).
 
 The linear drive + structure is checked against two independent forms: the drive's
 Lagrange equations on a rigid rotor (rt70.bondgraph.lagrange) and, on the RT-70, an
@@ -16,12 +16,12 @@ import pytest
 from test_drives import J_L, PARAMS  # a rotor and a well-conditioned drive
 
 from rt70.bondgraph.lagrange import drive_lagrange
-from rt70.drives import DcDrive
+from rt70.control import loops, lqg
+from rt70.control.drives import DcDrive
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
-from rt70.linear import loops, lqg
+from rt70.model.scene import load_scene
 from rt70.reports import servo_loops as rs
-from rt70.scene import load_scene
 from rt70.testing import assert_close
 
 FREQS = np.array([0.013, 0.37, 1.1, 4.7, 23.0])  # Hz

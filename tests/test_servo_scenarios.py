@@ -1,4 +1,4 @@
-"""The RT-70 held, stepped and tracking with its servo drives (rt70.scenarios).
+"""The RT-70 held, stepped and tracking with its servo drives (rt70.telescope.scenarios).
 
 Short horizons here (the 60 s holds and the full 1° steps are in
 validation/servo_scenarios.py); every number below was measured on rt70_servo.
@@ -13,12 +13,12 @@ import pytest
 from test_drives import ROTOR
 from test_servo import STIFF
 
-from rt70 import scenarios as S
-from rt70.antiwindup import BackCalculationServo
+from rt70.control.antiwindup import BackCalculationServo
+from rt70.control.servo import ServoDrive, cascade_gains
 from rt70.errors import Rt70Error
-from rt70.scene import load_scene, scene_from_text
-from rt70.servo import ServoDrive, cascade_gains
-from rt70.states import MechanicsForces
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.simulation.states import MechanicsForces
+from rt70.telescope import scenarios as S
 from rt70.testing import assert_close
 
 

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.errors import Rt70Error
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import listing_initial_state, start_state
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 
@@ -126,7 +126,7 @@ def test_bad_simulation_input():
 def test_rhs_jacobian_for_implicit_methods_is_checked():
     """The Pinocchio backend's Jacobian (computeABADerivatives + ΣJᵀCJ, ΣJᵀDJ) against
     central differences of the textbook right-hand side (scipy's alternative)."""
-    from rt70.simulate import BACKENDS
+    from rt70.simulation.simulate import BACKENDS
 
     scene = load_scene("two_body_gravity")
     n = scene.textbook.nv

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from rt70.cli import main
-from rt70.closed_chains import assemble
+from rt70.cli.main import main
 from rt70.errors import SimulationError
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import listing_initial_state
-from rt70.simulate import DRIFT_FACTOR, METHODS, simulate
+from rt70.simulation.closed_chains import assemble
+from rt70.simulation.simulate import DRIFT_FACTOR, METHODS, simulate
 from rt70.testing import MIN_REL, assert_close
 
 PENDULUM_X0 = (np.array([1.0, -0.5]), np.zeros(2))
@@ -153,8 +153,8 @@ def test_each_integrator_family_is_imported_only_when_used():
 
     code = (
         "import sys\n"
-        "from rt70.scene import load_scene\n"
-        "from rt70.simulate import simulate\n"
+        "from rt70.model.scene import load_scene\n"
+        "from rt70.simulation.simulate import simulate\n"
         "loaded = lambda: ['scipy.integrate' in sys.modules, 'sksundae' in sys.modules]\n"
         "print(loaded())\n"
         "simulate(load_scene('double_pendulum'), (0, 0.01), method='CVODE')\n"

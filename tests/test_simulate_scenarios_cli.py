@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from rt70.cli import main
+from rt70.cli.main import main
 
 ALL_JOINTS = Path(__file__).resolve().parent / "data" / "all_joint_types.urdf"
 

@@ -6,14 +6,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rt70 import simulate as sim
 from rt70.errors import Rt70Error
+from rt70.model.scene import load_scene
 from rt70.reports import simulation_targets as st
 from rt70.reports import work_precision as wp
 from rt70.reports.work_precision_problems import PROBLEMS
 from rt70.reports.work_precision_worker import com_positions
-from rt70.scene import load_scene
 from rt70.scenes.rt70_state import listing_initial_state
+from rt70.simulation import simulate as sim
 from rt70.testing import MIN_REL, assert_close
 
 
@@ -46,14 +46,14 @@ def test_methods_come_from_simulate():
 
 
 def test_the_target_problem_is_the_commands_ten_second_transient():
-    (p,) = [p for p in PROBLEMS if p.name == st.TARGET_PROBLEM]
+    (p,) = [p for p in PROBLEMS if p.name == st.TRANSIENT_PROBLEM]
     assert p.t_end == 10.0 and p.stiff_only and p.rtols == (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
     assert {"rt70", "rt70_light"} <= {q.name for q in PROBLEMS}  # the 2 s problems stay
 
 
 def _row(method, rtol, status, com_error, time_s):
     return wp.Row(
-        st.TARGET_PROBLEM, 42, 10.0, method, rtol, 1e-3 * rtol, status,
+        st.TRANSIENT_PROBLEM, 42, 10.0, method, rtol, 1e-3 * rtol, status,
         status.startswith("over"), 1e-6, time_s, "", 0, 0, 0, 20.0, "", 1e-10, "", 1, "",
         com_error=com_error,
     )  # fmt: skip

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.testing import assert_close
 from rt70.textbook import forces
 from rt70.textbook.kinematics import frame_pose

@@ -1,4 +1,7 @@
-"""Extra states of the simulation (rt70/states.py): components integrated with the mechanics."""
+"""Extra states of the simulation: components integrated with the mechanics.
+
+The module: rt70/simulation/states.py.
+"""
 
 import numpy as np
 import pytest
@@ -6,9 +9,9 @@ from scipy.integrate import solve_ivp
 
 import rt70.reference as reference
 from rt70.errors import Rt70Error, ShapeError
-from rt70.scene import load_scene
-from rt70.simulate import BACKENDS, IMPLICIT, simulate
-from rt70.states import EnergyAudit, StateComponent
+from rt70.model.scene import load_scene
+from rt70.simulation.simulate import BACKENDS, IMPLICIT, simulate
+from rt70.simulation.states import EnergyAudit, StateComponent
 from rt70.testing import assert_close
 
 

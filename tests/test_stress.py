@@ -10,6 +10,7 @@ import pytest
 
 import rt70.urdf as rt70_urdf
 from rt70 import SingularConfigurationError, reference
+from rt70.model.scene import load_scene, scene_from_text
 from rt70.reports.stress.edits import (
     convert_units,
     free_floating_text,
@@ -32,9 +33,8 @@ from rt70.reports.stress.rt70_cases import (
 )
 from rt70.reports.stress.runs import count_bdf_steps, run_capped
 from rt70.reports.stress.scaling_cases import free_floating_state
-from rt70.scene import load_scene, scene_from_text
 from rt70.scenes.rt70_state import listing_initial_state
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import forces
 from rt70.textbook.spatial import GIMBAL_LOCK_COS

@@ -5,8 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rt70.model.scene import load_scene
 from rt70.reference import weight_moment
-from rt70.scene import load_scene
 from rt70.testing import assert_close
 from rt70.textbook import dynamics, structured
 
@@ -28,7 +28,7 @@ def test_structured_equals_dense(target):
     for k in range(4):
         A = dynamics.mass_matrix(m, d, Q[k])
         assert_close(A_batch[k], A, rel=1e-13, what="A")
-        # bias and gravity on the size of their terms (rt70.validate.natural_scales): the
+        # bias and gravity on the size of their terms (rt70.crosscheck.validate.natural_scales): the
         # velocity products ‖A‖ ‖q̇‖², the weights' moment G₀
         b = dynamics.bias_force(m, d, Q[k], Qd[k])
         b_scale = np.abs(A).max() * np.abs(Qd[k]).max() ** 2 + np.abs(b).max()
@@ -52,7 +52,7 @@ def test_data_of_another_model_or_size_is_refused():
 
 
 def test_all_joint_types_scene_agrees_with_pinocchio():
-    from rt70.validate import cross_check
+    from rt70.crosscheck.validate import cross_check
 
     for r in cross_check(load_scene(ALL_TYPES), samples=3, seed=1, repeat=1):
         # relative to the natural scale already: its scale is 1

@@ -1,7 +1,7 @@
 """rt70 sweep: grids, quantities, a real local Dask cluster against the serial path, resume.
 
 The Dask result must be bit-identical to the serial one: both run the same function
-(:func:`rt70.sweep.compute_chunk`) on the same chunks from the same scene text, with one
+(:func:`rt70.sweep.run.compute_chunk`) on the same chunks from the same scene text, with one
 BLAS thread (threadpoolctl) on both sides, and every point starts its Newton
 equilibrium from q = 0 — nothing depends on which process computed a chunk, or when.
 """
@@ -13,10 +13,10 @@ import json
 import numpy as np
 import pytest
 
-from rt70 import sweep as sw
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.errors import Rt70Error
-from rt70.sweep_quantities import Field, Quantity, scaled_scene
+from rt70.sweep import run as sw
+from rt70.sweep.quantities import Field, Quantity, scaled_scene
 from rt70.testing import assert_close
 
 SCENE = "rt70_servo"
@@ -138,7 +138,7 @@ def test_dask_cluster_equals_serial_bit_for_bit(small, serial_result, tmp_path):
     """A real LocalCluster: 2 worker processes over loopback, the same numbers."""
     from distributed import Client, LocalCluster
 
-    from rt70.sweep_dask import on_dask, workers_of
+    from rt70.sweep.cluster import on_dask, workers_of
 
     with (
         LocalCluster(
@@ -258,8 +258,8 @@ def no_work(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the options were checked")
 
-    monkeypatch.setattr("rt70.sweep.SceneSource.read", forbidden)
-    monkeypatch.setattr("rt70.sweep_dask.local_cluster", forbidden)
+    monkeypatch.setattr("rt70.sweep.run.SceneSource.read", forbidden)
+    monkeypatch.setattr("rt70.sweep.cluster.local_cluster", forbidden)
 
 
 @pytest.mark.parametrize(

@@ -25,11 +25,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70 import sweep as sw
-from rt70 import sweep_plan, sweep_store
-from rt70.cli import main
+from rt70.cli.main import main
 from rt70.errors import OutputError, ResourceError, Rt70Warning
-from rt70.sweep_quantities import QUANTITIES, Field, Quantity
+from rt70.sweep import plan as sweep_plan
+from rt70.sweep import run as sw
+from rt70.sweep import store as sweep_store
+from rt70.sweep.quantities import QUANTITIES, Field, Quantity
 
 SCENE = "rt70_servo"
 URDF = Path(__file__).resolve().parents[1] / "urdf" / "rt70_servo.urdf"
@@ -122,14 +123,14 @@ def no_work(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the options were checked")
 
-    monkeypatch.setattr("rt70.sweep.SceneSource.read", forbidden)
-    monkeypatch.setattr("rt70.sweep_dask.local_cluster", forbidden)
+    monkeypatch.setattr("rt70.sweep.run.SceneSource.read", forbidden)
+    monkeypatch.setattr("rt70.sweep.cluster.local_cluster", forbidden)
 
 
 @pytest.fixture
 def memory_8gb(monkeypatch):
     """This 'machine' has 8 GB available (the checks' verdicts do not depend on the host)."""
-    monkeypatch.setattr("rt70.resources.available_memory", lambda: 8_000_000_000)
+    monkeypatch.setattr("rt70.guards.resources.available_memory", lambda: 8_000_000_000)
 
 
 # --- sizes, checked before any work ------------------------------------------------------------
@@ -168,16 +169,16 @@ def test_the_estimate_counts_results_errors_and_chunks(monkeypatch):
     per_point = 3 * sweep_plan.BYTES_PER_NUMBER + sweep_plan.BYTES_PER_ERROR
     expected = 30 * per_point + 3 * 3 * sweep_plan.BYTES_PER_CHUNK
     assert sw.peak_bytes(grid, q, chunk=4) == expected  # ceil(10 / 4) = 3 chunks per azimuth
-    monkeypatch.setattr("rt70.resources.available_memory", lambda: 2 * expected)
+    monkeypatch.setattr("rt70.guards.resources.available_memory", lambda: 2 * expected)
     sw.check_size(grid, q, 4)  # exactly the share a run may use: accepted
-    monkeypatch.setattr("rt70.resources.available_memory", lambda: 2 * expected - 2)
+    monkeypatch.setattr("rt70.guards.resources.available_memory", lambda: 2 * expected - 2)
     with pytest.raises(ResourceError, match="--elevation × --azimuth: a grid of 30 points"):
         sw.check_size(grid, q, 4)
 
 
 def test_run_checks_the_size_itself(monkeypatch, tmp_path):
     """The library's run() refuses before computing a chunk, as plan() does."""
-    monkeypatch.setattr("rt70.resources.available_memory", lambda: 1_000)
+    monkeypatch.setattr("rt70.guards.resources.available_memory", lambda: 1_000)
     computed = []
     with pytest.raises(ResourceError, match="a grid of 4 points"):
         sw.run(cheap_sweep(), sw.serial, tmp_path / "s.npz", on_chunk=computed.append)
@@ -473,7 +474,7 @@ def test_a_result_from_the_executor_is_checked_too(tmp_path):
 HOLD_LOCK = """
 import sys
 from pathlib import Path
-from rt70.sweep_store import DirectoryLock
+from rt70.sweep.store import DirectoryLock
 DirectoryLock(Path(sys.argv[1])).acquire()
 print("held", flush=True)
 sys.stdin.read()
@@ -584,7 +585,7 @@ def test_a_full_disk_at_the_end_keeps_the_previous_files_and_the_chunks(
     (tmp_path / "s.json").write_text("previous json")
     argv = ["sweep", SCENE, "--elevation", "10,30,50,70", "--chunk", "1", "--quantity", "cheap"]
     argv += ["--workers", "0", "--out", str(out), "--no-progress"]
-    monkeypatch.setattr("rt70.sweep.np.savez", _no_space)
+    monkeypatch.setattr("rt70.sweep.run.np.savez", _no_space)
     assert cli(argv) == 2
     line = one_error_line(capsys.readouterr().err)
     assert "s.npz: cannot write (No space left on device)" in line
@@ -709,7 +710,7 @@ def test_killing_every_worker_is_survived(tmp_path):
     computed once."""
     from distributed import Client
 
-    from rt70.sweep_dask import on_dask
+    from rt70.sweep.cluster import on_dask
 
     gate = tmp_path / "gate"
     sweep = gated_sweep(gate)
@@ -734,7 +735,7 @@ def test_no_worker_left_stops_with_one_error_and_the_rerun_resumes(tmp_path):
     ClusterError naming the kept chunks; the rerun computes only the other three."""
     from distributed import Client
 
-    from rt70.sweep_dask import on_dask
+    from rt70.sweep.cluster import on_dask
 
     gate = tmp_path / "gate"
     sweep = gated_sweep(gate)
@@ -834,7 +835,7 @@ def test_a_worker_memory_limit_is_one_line_of_the_cli(tmp_path, capfd, monkeypat
     already forgotten' before)."""
     import dask
 
-    from rt70 import sweep_dask
+    from rt70.sweep import cluster as sweep_dask
 
     monkeypatch.setitem(QUANTITIES, "hog", HOG)
     real = sweep_dask.local_cluster

@@ -19,8 +19,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import rt70.cli
+import rt70.cli.main
 from rt70 import reference
+from rt70.crosscheck.validate import cross_check
 from rt70.errors import (
     DtdError,
     InertiaError,
@@ -32,13 +33,12 @@ from rt70.errors import (
     UrdfError,
     XacroError,
 )
-from rt70.scene import load_scene, scene_from_text
+from rt70.model.scene import load_scene, scene_from_text
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import massless
 from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
 from rt70.urdf import read_urdf_string
-from rt70.urdf.reader import MAX_MAGNITUDE
-from rt70.validate import cross_check
+from rt70.urdf.elements import MAX_MAGNITUDE
 
 TOL = 1e-10
 XACRO_NS = "http://www.ros.org/wiki/xacro"
@@ -268,7 +268,7 @@ def test_cli_prints_one_warning_line_each(tmp_path, capsys):
     path.write_text(
         robot(link("base", inertial(mass="0")), *PAIR, head='\n<?xml version="1.0"?>\n')
     )
-    assert rt70.cli.main(["validate", str(path), "--samples", "2"]) == 0
+    assert rt70.cli.main.main(["validate", str(path), "--samples", "2"]) == 0
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 2 and all(line.startswith(f"rt70: warning: {path}: ") for line in err)
 
@@ -325,9 +325,9 @@ def test_balance_inertia_cannot_repair_a_zero_trace():
 def test_cli_balance_inertia(tmp_path, capsys):
     path = tmp_path / "bad.urdf"
     path.write_text(BAD_MOVING)
-    assert rt70.cli.main(["validate", str(path)]) == 2
+    assert rt70.cli.main.main(["validate", str(path)]) == 2
     capsys.readouterr()
-    assert rt70.cli.main(["validate", str(path), "--balance-inertia", "--samples", "2"]) == 0
+    assert rt70.cli.main.main(["validate", str(path), "--balance-inertia", "--samples", "2"]) == 0
     captured = capsys.readouterr()
     (line,) = captured.err.splitlines()
     assert line.startswith(f"rt70: warning: {path}: link 'l2': inertia repaired")
@@ -578,7 +578,7 @@ def test_refused(name, tmp_path, capsys):
     for needle in case.needles:
         assert needle in message, f"{needle!r} not in {message!r}"
     capsys.readouterr()
-    assert rt70.cli.main(["validate", str(path)]) == 2
+    assert rt70.cli.main.main(["validate", str(path)]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.splitlines() == [f"rt70: error: {message}"]
 

@@ -23,10 +23,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rt70.cli
+import rt70.cli.main
 from rt70.errors import ExtensionError, Rt70Warning
+from rt70.model.scene import URDF_DIR, scene_from_text
 from rt70.reference import dynamics as reference
-from rt70.scene import URDF_DIR, scene_from_text
 from rt70.scenes import synthetic
 from rt70.textbook import dynamics
 from rt70.urdf import read_urdf, read_urdf_string
@@ -522,7 +522,7 @@ def test_cli_refuses_in_one_line_with_exit_2(name, tmp_path):
 def test_cli_warns_in_one_line_per_attribute_and_checks(tmp_path, capsys):
     path = tmp_path / "odd.urdf"
     path.write_text(odd_pendulum(), encoding="utf-8")
-    assert rt70.cli.main(["validate", str(path), "--samples", "1"]) == 0
+    assert rt70.cli.main.main(["validate", str(path), "--samples", "1"]) == 0
     err = capsys.readouterr().err.splitlines()
     assert len(err) == len(ODD)
     assert all(line.startswith(f"rt70: warning: {path}: ") for line in err)

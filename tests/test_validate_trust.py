@@ -3,7 +3,7 @@
 - a NaN or an infinity on either side of any compared quantity fails that row;
 - a run that checks no target, or a model with no degree of freedom, exits 2;
 - rounding is not disagreement: every quantity has a floor from the state's natural
-  scale (:func:`rt70.validate.natural_scales`), and the floor hides no real error.
+  scale (:func:`rt70.crosscheck.validate.natural_scales`), and the floor hides no real error.
 """
 
 from __future__ import annotations
@@ -18,12 +18,12 @@ import numpy as np
 import pybullet_data
 import pytest
 
-import rt70.validate as validate
+import rt70.crosscheck.validate as validate
 from rt70 import reference
-from rt70.cli import main
+from rt70.cli.main import main
+from rt70.crosscheck.validate import QUANTITIES, cross_check
 from rt70.errors import Rt70Error, SceneError
-from rt70.scene import load_scene, scene_from_text
-from rt70.validate import QUANTITIES, cross_check
+from rt70.model.scene import load_scene, scene_from_text
 
 PYBULLET = Path(pybullet_data.getDataPath())
 TOL = 1e-10
@@ -146,7 +146,7 @@ FIXED_ONLY = """<?xml version="1.0"?>
 
 def _run(*args: str, env: dict | None = None, cwd: str | None = None):
     return subprocess.run(
-        [sys.executable, "-m", "rt70.cli", *args],
+        [sys.executable, "-m", "rt70.cli.main", *args],
         capture_output=True,
         text=True,
         env=env,

@@ -1,4 +1,4 @@
-"""Wind loads (``<rt70:wind>``, rt70.wind): conventions, tables, both sides, refusals.
+"""Wind loads (``<rt70:wind>``, rt70.physics.aerodynamics): conventions, tables, refusals.
 
 The wind's generalised force is computed independently by the textbook side (book
 forward pass, S·W) and the reference side (Pinocchio placements, Jᵀf) from one shared
@@ -16,19 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rt70.cli
+import rt70.cli.main
 from rt70.errors import ExtensionError, UrdfError
-from rt70.reference import points as ref_points
-from rt70.reference import wind as ref_wind
-from rt70.scene import load_scene, scene_from_text
-from rt70.scenes import rt70_data
-from rt70.scenes.rt70_state import rt70_pointing
-from rt70.scenes.rt70_wind import solid_cylinder, thin_disc_radius, wind_elements
-from rt70.testing import MIN_REL, assert_close
-from rt70.textbook import points as tb_points
-from rt70.textbook import wind as tb_wind
-from rt70.urdf import read_urdf_string
-from rt70.wind import (
+from rt70.model.scene import load_scene, scene_from_text
+from rt70.physics.aerodynamics import (
     DEFAULT_AIR_DENSITY,
     CoefficientTable,
     WindCondition,
@@ -38,6 +29,15 @@ from rt70.wind import (
     horizontal_direction,
     wind_frame,
 )
+from rt70.reference import points as ref_points
+from rt70.reference import wind as ref_wind
+from rt70.scenes import rt70_data
+from rt70.scenes.rt70_state import rt70_pointing
+from rt70.scenes.rt70_wind import solid_cylinder, thin_disc_radius, wind_elements
+from rt70.testing import MIN_REL, assert_close
+from rt70.textbook import points as tb_points
+from rt70.textbook import wind as tb_wind
+from rt70.urdf import read_urdf_string
 
 TURRET = Path(__file__).parent / "data" / "turret_drives.urdf"
 TABLES = Path(__file__).resolve().parents[1] / "rt70" / "wind_tables"
@@ -368,7 +368,7 @@ def test_bad_table_is_refused_naming_the_file(name, tmp_path, capsys):
     message = str(excinfo.value)
     assert message.startswith(f"{path}: <rt70:wind name='dish'>: {table}") and needle in message
     capsys.readouterr()
-    assert rt70.cli.main(["validate", str(path)]) == 2
+    assert rt70.cli.main.main(["validate", str(path)]) == 2
     assert capsys.readouterr().err.splitlines() == [f"rt70: error: {message}"]
 
 
@@ -412,7 +412,7 @@ def test_bad_wind_element_is_refused_naming_file_and_element(name, tmp_path, cap
     message = str(excinfo.value)
     assert message.startswith(f"{path}: ") and needle in message, message
     capsys.readouterr()
-    assert rt70.cli.main(["validate", str(path)]) == 2
+    assert rt70.cli.main.main(["validate", str(path)]) == 2
     assert capsys.readouterr().err.splitlines() == [f"rt70: error: {message}"]
 
 
@@ -435,7 +435,7 @@ def test_bad_condition_is_refused(args, needle):
 
 
 def test_wind_load_is_exact_in_the_gust_speed(servo):
-    from rt70.wind_load import WindLoad
+    from rt70.wind.load import WindLoad
 
     q = _pointed(servo, 35.0, 10.0, np.random.default_rng(4), 1e-3)
     mean = WindCondition(10.0, 40.0)
@@ -458,7 +458,7 @@ def test_wind_load_is_exact_in_the_gust_speed(servo):
 
 def test_wind_load_refuses_what_it_cannot_use(servo):
     from rt70.errors import Rt70Error
-    from rt70.wind_load import WindLoad
+    from rt70.wind.load import WindLoad
 
     with pytest.raises(Rt70Error, match="no <rt70:wind> elements"):
         WindLoad(load_scene("two_body_gravity"), WindCondition(1.0, 0.0))
@@ -482,8 +482,8 @@ def _trapezoid_work(result, force) -> np.ndarray:
 @pytest.mark.slow
 def test_simulated_wind_power_is_its_input_work(servo):
     """RT-70 (no drives) in a 20 m/s front wind: W_u = ∫ q̇ᵀQ_w dt and the energy balances."""
-    from rt70.simulate import simulate
-    from rt70.wind_load import WindLoad
+    from rt70.simulation.simulate import simulate
+    from rt70.wind.load import WindLoad
 
     condition = WindCondition(20.0, 0.0)
     t = np.linspace(0.0, 0.1, 1001)
@@ -497,8 +497,8 @@ def test_simulated_wind_power_is_its_input_work(servo):
 
 @pytest.mark.slow
 def test_gusty_wind_on_the_textbook_backend(turret):
-    from rt70.simulate import simulate
-    from rt70.wind_load import WindLoad
+    from rt70.simulation.simulate import simulate
+    from rt70.wind.load import WindLoad
 
     mean = WindCondition(15.0, 60.0)
     gust = lambda t: 5.0 * math.sin(7.0 * t)  # noqa: E731

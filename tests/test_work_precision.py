@@ -13,10 +13,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from rt70.model.scene import load_scene, scene_from_text
 from rt70.reports import work_precision as wp
 from rt70.reports import work_precision_worker as wpw
 from rt70.reports.work_precision_problems import QUICK_PROBLEMS, build_problem, light_damping_text
-from rt70.scene import load_scene, scene_from_text
 from rt70.testing import MIN_REL, assert_close
 
 #: Cap of the quick run, s: its longest run takes ~0.3 s, so only a hang reaches it.

@@ -36,8 +36,8 @@ import numpy as np
 from rt70.reports.threads import single_threaded
 with single_threaded():
     import pinocchio as pin
-    from rt70 import simulate as sim
-    from rt70.scene import load_scene
+    from rt70.simulation import simulate as sim
+    from rt70.model.scene import load_scene
     from rt70.scenes.rt70_state import listing_initial_state
     method, rtol = sys.argv[1], float(sys.argv[2])
     scene = load_scene("rt70")
@@ -67,8 +67,8 @@ with single_threaded():
                 f()
             best = min(best, (time.perf_counter() - t) / n)
         out[name] = best
-    from rt70 import scenarios
-    from rt70.scene_servo import choose_drives
+    from rt70.telescope import scenarios
+    from rt70.telescope.scene_servo import choose_drives
     servo = load_scene("rt70_servo")
     sc = scenarios.scenario("step-elevation", 45.0, 0.0, 10.0)
     drives, _ = choose_drives(servo, None)

@@ -26,13 +26,13 @@ from pathlib import Path
 import numpy as np
 
 from rt70 import reference
-from rt70.atomic import atomic_write_text
-from rt70.baumgarte import DEFAULT_STABILIZATION
-from rt70.closed_chains import assemble
+from rt70.guards.atomic import atomic_write_text
+from rt70.model.scene import load_scene
+from rt70.physics.baumgarte import DEFAULT_STABILIZATION
 from rt70.reference import loops as ref_loops
 from rt70.reports.bench import compare
 from rt70.reports.threads import single_threaded
-from rt70.scene import load_scene
+from rt70.simulation.closed_chains import assemble
 from rt70.textbook import dynamics, forces
 from rt70.textbook import loops as tb_loops
 

@@ -9,7 +9,7 @@ minute); another ``--out DIR`` overrides the directory.
 import sys
 from pathlib import Path
 
-from rt70.cli import main
+from rt70.cli.main import main
 
 OUT = Path(__file__).resolve().parent / "results"
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
-from rt70.outputs import optical_point_outputs
-from rt70.scene import load_scene
+from rt70.model.outputs import optical_point_outputs
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import rt70_pointing
 

@@ -71,13 +71,13 @@ def build_reference(scene):
 
 
 def evaluate(scene):
-    from rt70.validate import cross_check
+    from rt70.crosscheck.validate import cross_check
 
     return cross_check(scene, samples=1, seed=0, repeat=0)
 
 
 def main() -> int:
-    from rt70.scene import scene_from_text
+    from rt70.model.scene import scene_from_text
     from rt70.textbook.model import build_model
     from rt70.urdf import read_urdf_string
 

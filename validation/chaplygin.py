@@ -22,12 +22,12 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from rt70 import chaplygin_cart as cart
-from rt70 import nonholonomic as nh
-from rt70 import nonholonomic_scene as ns
-from rt70.atomic import atomic_write_all
-from rt70.scene import load_scene
-from rt70.validate import cross_check, format_table
+from rt70.crosscheck.validate import cross_check, format_table
+from rt70.guards.atomic import atomic_write_all
+from rt70.mechanics import chaplygin_cart as cart
+from rt70.mechanics import nonholonomic_scene as ns
+from rt70.model.scene import load_scene
+from rt70.physics import nonholonomic as nh
 
 OUT = Path(__file__).resolve().parent / "results"
 GAINS = cart.Gains()

@@ -17,9 +17,9 @@ import argparse
 import numpy as np
 import pinocchio as pin
 
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import listing_initial_state
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
 
 T = np.linspace(0.0, 10.0, 201)
 

@@ -4,11 +4,11 @@ Run: ``python validation/foreign_urdfs.py [--jobs N] [--samples N] [OUT_DIR]`` (
 a test dependency: ``pip install -e '.[test]'``). Writes ``foreign_urdfs.md`` and
 ``foreign_urdfs.csv`` to ``OUT_DIR`` (default ``validation/results``).
 
-Each file is read as rt70 reads a scene (:func:`rt70.scene.load_scene`), both sides are
-built and :func:`rt70.validate.cross_check` compares them on a few random states, once
+Each file is read as rt70 reads a scene (:func:`rt70.model.scene.load_scene`), both sides are
+built and :func:`rt70.crosscheck.validate.cross_check` compares them on a few random states, once
 as is and once with ``balance_inertia=True``. A file is
 
-- **agree**: every quantity within :data:`rt70.validate.DEFAULT_TOLERANCE`;
+- **agree**: every quantity within :data:`rt70.crosscheck.validate.DEFAULT_TOLERANCE`;
 - **refused**: an :class:`rt70.errors.Rt70Error`, tabulated by kind (:data:`KINDS`); a
   model with no degree of freedom is its own kind (nothing to cross-check);
 - **disagree**: some quantity beyond the tolerance;
@@ -42,9 +42,9 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 from rt70 import errors
-from rt70.atomic import atomic_write_text
-from rt70.scene import load_scene
-from rt70.validate import DEFAULT_TOLERANCE, cross_check
+from rt70.crosscheck.validate import DEFAULT_TOLERANCE, cross_check
+from rt70.guards.atomic import atomic_write_text
+from rt70.model.scene import load_scene
 
 OUT = Path(__file__).resolve().parent / "results"
 
@@ -285,8 +285,8 @@ def write_report(
         f"tolerance {DEFAULT_TOLERANCE:g}; {meta['jobs']} worker(s), each file in its own "
         f"forked process; total run time {meta['seconds']:.0f} s.",
         "",
-        "Each file is read as a scene (`rt70.scene.load_scene`), both sides are built and "
-        "`rt70.validate.cross_check` compares them; 'with balance' repeats it with "
+        "Each file is read as a scene (`rt70.model.scene.load_scene`), both sides are built and "
+        "`rt70.crosscheck.validate.cross_check` compares them; 'with balance' repeats it with "
         "`balance_inertia=True` (`rt70 validate --balance-inertia`). Categories and kinds: "
         "see the script's docstring and docs/urdf-reader.md. 'Pinocchio alone' says, for a "
         "refused file, whether `pinocchio.buildModelFromXML` builds a model from the raw text.",

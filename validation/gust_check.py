@@ -3,7 +3,7 @@
 For one mean wind speed (front wind, elevation 45°, azimuth 0 on ``rt70_servo``) one
 Davenport gust record (seed 1) is run through the nonlinear model — structure, both drives
 with their servo cascades, the wind load exact in the speed — and through the budget's
-linear closed loop (:mod:`rt70.gust_run`). Writes
+linear closed loop (:mod:`rt70.telescope.gust_run`). Writes
 validation/results/gust_check_<speed>.json (rms values, statistical error, run time) and
 .npz (the records). ``--figure`` draws validation/results/gust_check.png from the files
 already written.
@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from rt70.atomic import atomic_write, atomic_write_text
-from rt70.gust_run import gust_run
-from rt70.pointing import PointingCase
-from rt70.scene import load_scene
+from rt70.guards.atomic import atomic_write, atomic_write_text
+from rt70.model.scene import load_scene
+from rt70.telescope.gust_run import gust_run
+from rt70.telescope.pointing import PointingCase
 
 OUT = Path(__file__).resolve().parent / "results"
 ELEVATION = 45.0

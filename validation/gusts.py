@@ -18,9 +18,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import scipy.integrate  # noqa: E402
 
-from rt70 import gusts  # noqa: E402
-from rt70.atomic import atomic_write, atomic_write_text  # noqa: E402
+from rt70.guards.atomic import atomic_write, atomic_write_text  # noqa: E402
 from rt70.linear.covariance import sample_variance_error  # noqa: E402
+from rt70.wind import gusts  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 SPEEDS = (5.0, 10.0, 15.0, 20.0)

@@ -1,8 +1,8 @@
 """Impacts (issue 12, part 3): the cross-check against Pinocchio and the RT-70 engaging a lock.
 
 1. On the scenes double_pendulum, three_masses, rt70 and rt70_servo, at N random states
-   (``rt70.validate.random_state``, seed 0): the brake and the stow pin of
-   ``rt70.impact_check.state_locks`` (random e), and the same locks plastic (e = 0);
+   (``rt70.crosscheck.validate.random_state``, seed 0): the brake and the stow pin of
+   ``rt70.crosscheck.impact_check.state_locks`` (random e), and the same locks plastic (e = 0);
    the textbook's KKT solve against ``pin.impulseDynamics``: the largest relative
    error (max-norm) of q̇⁺ and of Λ, q̇⁺'s error against its first-order rounding bound
    (in units of ε), Carnot's loss against T⁻ − T⁺, and the time per impact on each
@@ -29,13 +29,14 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from rt70 import reference
-from rt70.atomic import atomic_write_text
-from rt70.engagement import engage_after
-from rt70.impact import solve_impact
-from rt70.impact_check import impact_scales, state_locks
+from rt70.crosscheck.impact_check import impact_scales, state_locks
+from rt70.crosscheck.validate import random_state
+from rt70.guards.atomic import atomic_write_text
 from rt70.linear.linearize import equilibrium, static_force
-from rt70.locks import Brake, StowPin, constraint_rows, engage, labels
-from rt70.scene import load_scene
+from rt70.mechanics.engagement import engage_after
+from rt70.mechanics.locks import Brake, StowPin, constraint_rows, engage, labels
+from rt70.model.scene import load_scene
+from rt70.physics.impact import solve_impact
 from rt70.scenes.rt70_drives import TOP_SPEED
 from rt70.scenes.rt70_state import (
     AZIMUTH_COORDINATE,
@@ -44,7 +45,6 @@ from rt70.scenes.rt70_state import (
     rt70_pointing,
 )
 from rt70.textbook import dynamics
-from rt70.validate import random_state
 
 OUT = Path(__file__).resolve().parent / "results"
 SCENES = ("double_pendulum", "three_masses", "rt70", "rt70_servo")
@@ -91,7 +91,7 @@ def cross_check(name: str) -> dict:
                 # q̇⁺ against the larger of its own and q̇⁻'s size (a pin can stop everything)
                 worst["qd_after"] = max(worst["qd_after"], _rel(tb.qd_after, ref.qd_after, qd))
                 worst["impulses"] = max(worst["impulses"], _rel(tb.impulses, ref.impulses))
-                # rt70.kkt on Pinocchio's own A and rows against impulseDynamics: the
+                # rt70.physics.kkt on Pinocchio's own A and rows against impulseDynamics: the
                 # spread of two solvers on identical data
                 B_ref = constraint_rows(scene, q, locks, "reference")
                 same = solve_impact(A_ref, B_ref, qd, restitution)
@@ -196,10 +196,11 @@ def markdown(checks: list[dict], cases: list[dict]) -> str:
         "Per state: a random brake and a random stow pin, each with a random restitution and "
         "plastic (e = 0). Errors: max-norm, relative to Pinocchio's (q̇⁺: or to q̇⁻ if "
         "larger — a pin on a 2-DOF arm stops it, q̇⁺ = 0 up to rounding); also entry by "
-        "entry against the first-order rounding bounds of `rt70.impact_check.impact_scales` "
+        "entry against the first-order rounding bounds of "
+        "`rt70.crosscheck.impact_check.impact_scales` "
         "(random e, in units of ε); Carnot: |½Δq̇ᵀAΔq̇ − (T⁻ − T⁺)| / T⁻ for the plastic "
         "impacts; cond A: Pinocchio's mass matrix; A rel. diff: the two sides' A; same-data "
-        "KKT vs pin: `rt70.kkt` on Pinocchio's own A and rows against `impulseDynamics`; "
+        "KKT vs pin: `rt70.physics.kkt` on Pinocchio's own A and rows against `impulseDynamics`; "
         "times: medians per impact, one BLAS thread.",
         "",
         "| scene | nv | q̇⁺ rel. err | Λ rel. err | q̇⁺ err / (ε·bound) | Λ err / (ε·bound) "

@@ -4,7 +4,7 @@
   seed 0): the largest relative error and both sides' mean time per evaluation.
 - The two sides' time for the RT-70's reactions alone (rt70_servo, at the 45° calm
   equilibrium, with the wind's Wrenches at 20 m/s): median of 200 calls, one thread.
-- The RT-70's bearing and reducer loads (:mod:`rt70.bearing_loads`) at elevations 0–90°
+- The RT-70's bearing and reducer loads (:mod:`rt70.telescope.bearing_loads`) at elevations 0–90°
   every 15° — calm, 20 m/s front, back and from the side (azimuth 90°) — as the table
   of docs/reactions.md, and every 5° for the figure.
 
@@ -19,16 +19,16 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from rt70 import bearing_loads as bl
-from rt70.atomic import atomic_write, atomic_write_text
+from rt70.crosscheck.validate import cross_check
+from rt70.guards.atomic import atomic_write, atomic_write_text
+from rt70.model.scene import load_scene, scene_names
+from rt70.physics.aerodynamics import WindCondition
 from rt70.plotting.reactions import bearing_loads_figure
 from rt70.reference import reactions as ref_reactions
 from rt70.reference import wind as ref_wind
-from rt70.scene import load_scene, scene_names
+from rt70.telescope import bearing_loads as bl
 from rt70.textbook import reactions as tb_reactions
 from rt70.textbook import wind as tb_wind
-from rt70.validate import cross_check
-from rt70.wind import WindCondition
 
 OUT = Path(__file__).resolve().parent / "results"
 TABLE_ELEVATIONS = tuple(float(e) for e in range(0, 91, 15))
@@ -76,8 +76,8 @@ def validate_rows() -> list[dict]:
 
 def timing(scene) -> dict:
     case = bl.LoadCase(45.0)
-    from rt70.scene_servo import SceneServoFactory, scene_equilibrium
     from rt70.scenes.rt70_state import rt70_pointing
+    from rt70.telescope.scene_servo import SceneServoFactory, scene_equilibrium
 
     couplings = SceneServoFactory(side="reference").couplings(scene)
     q, _, _ = scene_equilibrium(scene, couplings, rt70_pointing(case.elevation_deg))

@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write_all
 from rt70.errors import Rt70Error
+from rt70.guards.atomic import atomic_write_all
 from rt70.linear import reduce as rd
 from rt70.linear.responses import StateSpace, frequency_response
 from rt70.reports.reduction_plants import reduction_plants

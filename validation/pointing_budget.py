@@ -23,13 +23,13 @@ from pathlib import Path
 import numpy as np
 from distributed import Client
 
-from rt70.atomic import atomic_write, atomic_write_text
+from rt70.guards.atomic import atomic_write, atomic_write_text
+from rt70.model.scene import load_scene
 from rt70.plotting.wind import error_vs_speed_figure, maps_figure, mode_shares_figure
-from rt70.pointing import PointingCase, pointing_budget
 from rt70.reports.pointing_budget import TARGET_ARCSEC, budget_table, format_table
-from rt70.scene import load_scene
-from rt70.sweep import make_grid, plan, run
-from rt70.sweep_dask import local_cluster, on_dask
+from rt70.sweep.cluster import local_cluster, on_dask
+from rt70.sweep.run import make_grid, plan, run
+from rt70.telescope.pointing import PointingCase, pointing_budget
 
 OUT = Path(__file__).resolve().parent / "results"
 SPEEDS = (2.0, 3.0, 5.0, 7.0, 10.0, 14.0, 20.0, 25.0)

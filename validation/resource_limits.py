@@ -1,4 +1,4 @@
-"""Measure the limits behind rt70.resources: memory of both sides, Pinocchio's parser depth.
+"""Measure the limits behind rt70.guards.resources: memory of both sides, Pinocchio's parser depth.
 
 Every measurement runs in a fresh subprocess (a model that is too large, or a parser
 that segfaults, cannot take this script down):
@@ -8,11 +8,11 @@ that segfaults, cannot take this script down):
   call of every dense textbook function on a fresh Data, and of the textbook's mass
   check (``rt70.textbook.massless``), for serial chains of
   revolute, planar and floating joints; printed beside the estimates of
-  ``rt70.resources`` with a least-squares fit ``a nv³ + b nv² + c`` of the reference side;
+  ``rt70.guards.resources`` with a least-squares fit ``a nv³ + b nv² + c`` of the reference side;
 - parser depth: the deepest chain of fixed joints Pinocchio's URDF parser survives, by
   bisection, on the main thread (the process's stack limit, ``ulimit -s``); and that a
-  chain ``rt70.resources.PARSER_MAX_DEPTH`` deep parses in a thread with
-  ``rt70.resources.PARSER_STACK_BYTES`` (one run: the parser's time grows with the
+  chain ``rt70.guards.resources.PARSER_MAX_DEPTH`` deep parses in a thread with
+  ``rt70.guards.resources.PARSER_STACK_BYTES`` (one run: the parser's time grows with the
   square of the frames, about 4.5 minutes for 40 000 levels).
 
     python validation/resource_limits.py [--quick]
@@ -33,7 +33,7 @@ import numpy as np
 _MEMORY_CHILD = r"""
 import json, sys
 import numpy as np
-from rt70.scene import scene_from_text
+from rt70.model.scene import scene_from_text
 from rt70.scenes.synthetic import serial_chain
 
 def status():  # resident memory: peak (VmHWM), anonymous, file-backed (libraries), shared
@@ -83,7 +83,7 @@ print(json.dumps({"nv": nv, "nb": nb, "peak": growth}))
 _PARSER_CHILD = r"""
 import sys
 import pinocchio as pin
-from rt70.resources import run_with_stack
+from rt70.guards.resources import run_with_stack
 
 n, where = int(sys.argv[1]), sys.argv[2]
 inertial = ('<inertial><mass value="1"/>'
@@ -128,7 +128,7 @@ def parser_limit(where: str, lo: int, hi: int) -> tuple[int, int]:
 
 
 def main() -> int:
-    from rt70 import resources
+    from rt70.guards import resources
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="small sizes only")

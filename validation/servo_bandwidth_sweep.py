@@ -1,7 +1,7 @@
 """Which position-loop bandwidth the RT-70's PI cascade survives: steps on the nonlinear model.
 
 Runs a small step (linear range) on one axis of rt70_servo at elevation 45° with
-:class:`rt70.servo.ServoDrive` on both axes (the other axis held at 0.2 Hz, ratio 4) for
+:class:`rt70.control.servo.ServoDrive` on both axes (the other axis held at 0.2 Hz, ratio 4) for
 several (position bandwidth, ratio) pairs and prints the settling time to 1″, the
 overshoot and the largest error of the last 5 s; an unstable loop ends in a solver
 failure or an exception. The numbers of docs/servo-scenarios.md §"Choosing the
@@ -15,12 +15,12 @@ import sys
 
 import numpy as np
 
-from rt70 import scenarios as S
+from rt70.control.servo import ServoDrive
 from rt70.linear.linearize import equilibrium, static_force
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import rt70_pointing
-from rt70.servo import ServoDrive
-from rt70.simulate import simulate
+from rt70.simulation.simulate import simulate
+from rt70.telescope import scenarios as S
 
 ARCSEC = S.ARCSEC
 

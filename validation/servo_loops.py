@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write, atomic_write_text
-from rt70.linear import loops, lqg
-from rt70.linear import servo_compare as sc
+from rt70.control import loops, lqg
+from rt70.control import servo_compare as sc
+from rt70.guards.atomic import atomic_write, atomic_write_text
+from rt70.model.scene import load_scene
 from rt70.plotting.servo_loops import plot_closed_loops, plot_open_loops
 from rt70.reports import servo_loops as rs
-from rt70.scene import load_scene
 
 OUT = Path(__file__).resolve().parent / "results"
 ELEVATIONS = (10.0, 45.0, 80.0)

@@ -1,12 +1,12 @@
 """The LQG closed around the nonlinear RT-70 model: against its linear loop and the PI cascade.
 
 Issue 10 item 4 (the simulation half of the model-based alternative). On ``rt70_servo``
-at elevation 45°, the LQG of :mod:`rt70.linear.lqg` on the azimuth
+at elevation 45°, the LQG of :mod:`rt70.control.lqg` on the azimuth
 (:func:`rt70.reports.servo_lqg.lqg_drives`, the PI cascade on elevation) against
 
 - its linear closed loop (full linear plant, elevation locked) on a 100″ azimuth step,
   small enough to stay off the voltage limit;
-- the PI cascade of :func:`rt70.scenarios.servo_drives` on the same step and on 1°;
+- the PI cascade of :func:`rt70.telescope.scenarios.servo_drives` on the same step and on 1°;
 
 and the LQG on a 1° step (voltage limit active), sidereal tracking and a short hold.
 Writes validation/results/servo_lqg.{json,png}. Run:
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write, atomic_write_text
+from rt70.guards.atomic import atomic_write, atomic_write_text
 
 OUT = Path(__file__).resolve().parent / "results"
 ELEVATION = 45.0
@@ -40,9 +40,9 @@ RUNS = (
 
 def _run(spec):
     """One scenario: its numbers and the curves the figure needs."""
+    from rt70.model.scene import load_scene
     from rt70.reports import servo_lqg as sl
-    from rt70.scenarios import run_scenario, scenario
-    from rt70.scene import load_scene
+    from rt70.telescope.scenarios import run_scenario, scenario
 
     name, controller, what, t_end = spec
     scene = load_scene("rt70_servo")
@@ -118,8 +118,8 @@ def _finite(x):
 
 
 def main(argv: list[str]) -> int:
+    from rt70.model.scene import load_scene
     from rt70.reports import servo_lqg as sl
-    from rt70.scene import load_scene
 
     start = time.perf_counter()
     OUT.mkdir(exist_ok=True)

@@ -1,8 +1,8 @@
 """The servo targets of issue 10 measured on the RT-70 held by its drives (rt70_servo).
 
-Runs :mod:`rt70.scenarios` with the drives ``rt70 simulate`` chooses for the scene: its
+Runs :mod:`rt70.telescope.scenarios` with the drives ``rt70 simulate`` chooses for the scene: its
 own ``<rt70:drive>`` elements, one servo cascade each, the elevation through its gear
-sector (:mod:`rt70.scene_servo`; ``--drives coordinate``: torques on the axis
+sector (:mod:`rt70.telescope.scene_servo`; ``--drives coordinate``: torques on the axis
 coordinates). The 60 s hold at elevations 10, 30, 45, 60, 80 and 90°, the 1° steps in
 azimuth and elevation and sidereal tracking (15″/s in azimuth) at 45°; writes
 validation/results/servo_scenarios.json (every metric, every target with its measured
@@ -20,11 +20,11 @@ import sys
 import time
 from pathlib import Path
 
-from rt70 import scenarios as S
-from rt70.atomic import atomic_write_all
 from rt70.errors import Rt70Error
-from rt70.scene import load_scene
-from rt70.scene_servo import choose_drives
+from rt70.guards.atomic import atomic_write_all
+from rt70.model.scene import load_scene
+from rt70.telescope import scenarios as S
+from rt70.telescope.scene_servo import choose_drives
 
 OUT = Path(__file__).resolve().parent / "results"
 HOLD_ELEVATIONS = (10.0, 30.0, 45.0, 60.0, 80.0, 90.0)

@@ -1,5 +1,5 @@
-"""Memory of ``rt70 sweep``: the constants of :func:`rt70.sweep.peak_bytes` and of
-:data:`rt70.sweep_dask.WORKER_BYTES`, measured.
+"""Memory of ``rt70 sweep``: the constants of :func:`rt70.sweep.run.peak_bytes` and of
+:data:`rt70.sweep.cluster.WORKER_BYTES`, measured.
 
 1. The sweep's own memory in the client, by tracemalloc (Python objects and numpy
    arrays), over a grid of ``--points`` points of a quantity with the fields of
@@ -9,7 +9,7 @@
    record per point and quantity), with chunks of 1 and of 8 points. The fit: bytes per
    number (the results), per error record and per chunk.
 2. One local Dask worker process after a chunk of ``rt70_servo`` (both quantities):
-   its resident set (psutil), the number :data:`rt70.sweep_dask.WORKER_BYTES` rounds up.
+   its resident set (psutil), the number :data:`rt70.sweep.cluster.WORKER_BYTES` rounds up.
 
 Run: ``python validation/sweep_memory.py [--points 9000]`` (5 min on a loaded 2-core
 machine); prints the numbers and writes validation/results/sweep_memory.json.
@@ -25,9 +25,9 @@ import tempfile
 import tracemalloc
 from pathlib import Path
 
-from rt70 import sweep as sw
 from rt70.errors import Rt70Error
-from rt70.sweep_quantities import Field, Quantity
+from rt70.sweep import run as sw
+from rt70.sweep.quantities import Field, Quantity
 
 RESULTS = Path(__file__).resolve().parent / "results" / "sweep_memory.json"
 
@@ -71,7 +71,7 @@ def worker_bytes() -> int:
     """Resident set of one local worker after a chunk of rt70_servo, bytes."""
     from distributed import Client
 
-    from rt70.sweep_dask import local_cluster, on_dask
+    from rt70.sweep.cluster import local_cluster, on_dask
 
     grid = sw.make_grid({"elevation": (30.0, 60.0)})
     sweep = sw.plan("rt70_servo", grid, ["first_frequency", "sag"], chunk=2)

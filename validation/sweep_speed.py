@@ -3,7 +3,7 @@
 The sweep: ``first_frequency`` of ``rt70_servo`` at 91 elevations (0…90° step 1°,
 azimuth 0), chunks of ``--chunk`` consecutive elevations. For 1 and then 2 workers a
 fresh ``LocalCluster`` of single-threaded worker processes (BLAS pinned to one thread,
-:mod:`rt70.sweep_dask`) is started, the sweep run and the cluster closed; printed:
+:mod:`rt70.sweep.cluster`) is started, the sweep run and the cluster closed; printed:
 the start-up, the sweep's wall time (workers importing rt70 and building the scene
 included: they start empty), the CPU seconds the workers spent on it (a measure of the
 work that the other users of a shared machine do not change much) and the total, the
@@ -31,10 +31,10 @@ import numpy as np
 from distributed import Client
 from threadpoolctl import threadpool_limits
 
-from rt70 import sweep as sw
 from rt70.linear.linearize import equilibrium
 from rt70.scenes.rt70_state import rt70_pointing
-from rt70.sweep_dask import local_cluster, on_dask, workers_of
+from rt70.sweep import run as sw
+from rt70.sweep.cluster import local_cluster, on_dask, workers_of
 
 RESULTS = Path(__file__).resolve().parent / "results" / "sweep_speed.json"
 ELEVATIONS = tuple(float(e) for e in range(91))

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write
+from rt70.guards.atomic import atomic_write
 
 OUT = Path(__file__).resolve().parents[1] / "rt70" / "wind_tables"
 

@@ -10,12 +10,12 @@ Run: ``python validation/wind_torques.py`` (a few seconds).
 
 import numpy as np
 
+from rt70.model.scene import load_scene
+from rt70.physics.aerodynamics import WindCondition
 from rt70.reference import wind as ref_wind
-from rt70.scene import load_scene
 from rt70.scenes.rt70_drives import KGF_M
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.textbook import wind as tb_wind
-from rt70.wind import WindCondition
 
 #: The book's nominal wind torque, N·m (5·10⁵ kgf·m).
 NOMINAL = 5.0e5 * KGF_M

@@ -2,7 +2,7 @@
 
 Problems: the RT-70's 10 s transient of issue 13 (stiff methods, rtol 1e-4 … 1e-8), the
 RT-70 over 2 s (listing damping and the book's ξ = 0.05 variant), the double pendulum
-and a 50-body chain; the methods of rt70.simulate.METHODS but RK23 over rtol 1e-3 … 1e-9,
+and a 50-body chain; the methods of rt70.simulation.simulate.METHODS but RK23 over rtol 1e-3 … 1e-9,
 each against a reference of another method at rtol 1e-12, with the state error and the
 centre-of-mass error in metres (see rt70/reports/work_precision.py); then the issue-13
 targets (rt70/reports/simulation_targets.py). Writes

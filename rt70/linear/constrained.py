@@ -1,12 +1,13 @@
 """Equilibrium, linearisation and modes of a system with holonomic constraints Φ(q) = 0.
 
-The chapter-3 elimination (:mod:`rt70.linear.holonomic`, :class:`rt70.constraints.HolonomicMap`)
-removes constraints that are linear in the coordinates, ``q = T q_r + q₀``, by
-``Tᵀ M T``. A closed chain (companion source 004 (14), ``B_c q̈ + C = 0``) is held by
-constraints Φ(q) = 0 that are nonlinear; this module generalises the elimination to
-them about an equilibrium on the constraint manifold (docs/constrained-modes.md).
+The chapter-3 elimination (:mod:`rt70.linear.holonomic`,
+:class:`rt70.physics.constraints.HolonomicMap`) removes constraints that are linear in the
+coordinates, ``q = T q_r + q₀``, by ``Tᵀ M T``. A closed chain (companion source 004 (14),
+``B_c q̈ + C = 0``) is held by constraints Φ(q) = 0 that are nonlinear; this module
+generalises the elimination to them about an equilibrium on the constraint manifold
+(docs/constrained-modes.md).
 
-Convention (that of :mod:`rt70.kkt`): the reactions enter the equations of motion as
+Convention (that of :mod:`rt70.physics.kkt`): the reactions enter the equations of motion as
 ``A q̈ + B q̇ = Q + B_cᵀ λ`` with ``B_c = ∂Φ/∂q``; K = −∂Q/∂q is the stiffness of the
 static forces (springs and gravity), D = −∂Q/∂q̇ the damping.
 
@@ -53,7 +54,7 @@ from rt70.linear import modal
 Vector = Callable[[np.ndarray], np.ndarray]
 
 #: Singular values of B_c below this fraction of the largest count as zero (dependent
-#: constraint rows, as in :data:`rt70.kkt.RANK_RTOL`).
+#: constraint rows, as in :data:`rt70.physics.kkt.RANK_RTOL`).
 RANK_RTOL = 1e-10
 #: Central-difference step per coordinate of the stiffness matrices (m or rad): the
 #: truncation error is O(h²) ≈ 1e-12 relative, the rounding O(ε/h) ≈ 1e-10 relative.

@@ -34,7 +34,7 @@ from rt70.errors import Rt70Error
 from rt70.linear import constrained as cm
 from rt70.linear import linearize as lin
 from rt70.linear import modal, mode_table
-from rt70.scene import Scene
+from rt70.model.scene import Scene
 from rt70.textbook import dynamics
 
 #: A side's loop function: ``(model, data, q) → Φ`` or ``→ B_c``.

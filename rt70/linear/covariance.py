@@ -7,7 +7,7 @@ number as the frequency-domain integral ``(1/2π) ∫ G(jω) W G(jω)ᴴ dω`` w
 frequency grid. This module gives:
 
 - :func:`state_covariance` and :func:`output_covariance` (the Lyapunov route);
-- :func:`cascade_with_filter`: a shaping filter (e.g. :class:`rt70.gusts.GustFilter`)
+- :func:`cascade_with_filter`: a shaping filter (e.g. :class:`rt70.wind.gusts.GustFilter`)
   in series with one named input of a plant, so that the plant's outputs are driven by
   coloured noise through an augmented system driven by white noise;
 - :func:`mode_contributions`: one output's variance split over the modes of the
@@ -202,7 +202,7 @@ def cascade_with_filter(
     plant : control.StateSpace, rt70 StateSpace or tuple
         The plant, with named inputs and outputs.
     filter : control.StateSpace, rt70 StateSpace or tuple
-        The shaping filter (one output), e.g. ``rt70.gusts.GustFilter(...).system``.
+        The shaping filter (one output), e.g. ``rt70.wind.gusts.GustFilter(...).system``.
     input_name : str or sequence of str
         The plant input(s) the filter output feeds.
     gain : float or sequence of float

@@ -44,7 +44,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rt70.constraints import HolonomicMap, rigid_link_map
 from rt70.errors import TopologyError
 from rt70.linear.topology import (
     Edge,
@@ -54,6 +53,7 @@ from rt70.linear.topology import (
     check_edges,
     edges_from_topology,
 )
+from rt70.physics.constraints import HolonomicMap, rigid_link_map
 
 #: Kinds of tree rows: the book's central vertex (free relative to the ground), a tree
 #: link that is elastic (free relative motion) or rigid (locked).
@@ -342,7 +342,7 @@ class Reduction:
     dropped_rigid_edges : tuple of (int, int)
         Rigid links left out of the tree because they close a rigid loop.
     constraint : HolonomicMap
-        The rigid links as a constraint map ``α = S*ᵀ α**`` (:mod:`rt70.constraints`),
+        The rigid links as a constraint map ``α = S*ᵀ α**`` (:mod:`rt70.physics.constraints`),
         which reduces A*, C*, D*.
     """
 

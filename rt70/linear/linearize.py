@@ -32,10 +32,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from rt70.constraints import HolonomicMap, locking
 from rt70.errors import Rt70Error
-from rt70.loads import Wrench
-from rt70.scene import Scene
+from rt70.model.scene import Scene
+from rt70.physics.constraints import HolonomicMap, locking
+from rt70.physics.loads import Wrench
 from rt70.textbook import dynamics, forces, points
 
 #: Newton in :func:`equilibrium` stops when its step is below this (relative, m or rad).
@@ -83,7 +83,7 @@ def _check_side(side: str) -> None:
 def negative_jacobian(force, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
     """``−∂force/∂q`` by central differences with step h per coordinate, as it is.
 
-    Not symmetrised: a non-conservative force (the wind's, :mod:`rt70.pointing`) has a
+    Not symmetrised: a non-conservative force (the wind's, :mod:`rt70.telescope.pointing`) has a
     non-symmetric stiffness.
     """
     q = np.asarray(q, dtype=float)
@@ -145,7 +145,7 @@ def coordinate_indices(scene: Scene, names: list[str] | tuple[str, ...]) -> np.n
 def locking_map(scene: Scene, locked: dict[str, float] | list[str]) -> HolonomicMap:
     """The coordinates held or locked by the drives as a constraint map (chapter 3).
 
-    :func:`rt70.constraints.locking`, with the scene's name in the error for an
+    :func:`rt70.physics.constraints.locking`, with the scene's name in the error for an
     unknown coordinate.
     """
     try:
@@ -248,7 +248,7 @@ def linearize(
 
     Locking a coordinate of the pair structure is the book's holonomic constraint in 3-D:
     its column of the mobility matrix f is deleted, so its rows and columns of A, K and
-    D are deleted — ``Tᵀ M T`` of :func:`locking_map` (:mod:`rt70.constraints`).
+    D are deleted — ``Tᵀ M T`` of :func:`locking_map` (:mod:`rt70.physics.constraints`).
     ``side`` is whose static forces K is differenced from (:func:`stiffness_matrix`);
     M and D are the textbook's.
     """
@@ -352,7 +352,7 @@ def force_input(
 ) -> np.ndarray:
     """Input column of a unit force (or torque) on ``link`` along a ground-axis ``direction``.
 
-    The generalised force of the wrench (:class:`rt70.loads.Wrench`, applied at ``xyz``
+    The generalised force of the wrench (:class:`rt70.physics.loads.Wrench`, applied at ``xyz``
     in the link frame) is ``Q_u = S U`` (4.129)–(4.131),
     :func:`rt70.textbook.points.generalized_force`. Rows follow ``lm.coordinates``.
     """

@@ -6,13 +6,13 @@ One call, :func:`plant`, linearises a scene about a static equilibrium
 
 - inputs are generalised forces: a torque or force on a named coordinate
   (:class:`CoordinateInput`, what a drive applies to its axis), a load
-  (:class:`LoadInput`, a :class:`rt70.loads.Wrench` per unit input — a force on the
+  (:class:`LoadInput`, a :class:`rt70.physics.loads.Wrench` per unit input — a force on the
   counterweight), whose column is the load's generalised force ``S·U`` (4.129)–(4.131)
   on the textbook side, or any column (:class:`ForceInput`: a wind gust's ``∂Q_w/∂v``
-  on each exposed body, :func:`rt70.pointing.wind_inputs`);
+  on each exposed body, :func:`rt70.telescope.pointing.wind_inputs`);
 - outputs are coordinates (:class:`CoordinateOutput`, an axis angle) or any
-  :class:`rt70.outputs.Output` (the optical points, the mirror system's quantities),
-  linearised on the textbook side by :func:`rt70.outputs.output_matrix` (the exact point
+  :class:`rt70.model.outputs.Output` (the optical points, the mirror system's quantities),
+  linearised on the textbook side by :func:`rt70.model.outputs.output_matrix` (the exact point
   Jacobians through the output's formula).
 
 :func:`to_control` hands the result to python-control as a ``StateSpace`` with its
@@ -34,9 +34,9 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.linear.responses import StateSpace, state_space
-from rt70.loads import Wrench
-from rt70.outputs import Output, column_labels, output_matrix
-from rt70.scene import Scene
+from rt70.model.outputs import Output, column_labels, output_matrix
+from rt70.model.scene import Scene
+from rt70.physics.loads import Wrench
 from rt70.textbook import points
 
 
@@ -61,7 +61,7 @@ class ForceInput:
     """A generalised-force column per unit input (rows: all the scene's coordinates).
 
     For loads that are not one fixed wrench: a wind gust's ``∂Q_w/∂v`` on the exposed
-    bodies (:func:`rt70.pointing.wind_inputs`), computed by the caller at q0.
+    bodies (:func:`rt70.telescope.pointing.wind_inputs`), computed by the caller at q0.
     """
 
     name: str
@@ -135,9 +135,9 @@ def plant(
         A static equilibrium (:func:`rt70.linear.linearize.equilibrium`).
     inputs : sequence of CoordinateInput, LoadInput or ForceInput
         The inputs, in order (their names label B's columns).
-    outputs : sequence of CoordinateOutput or rt70.outputs.Output
+    outputs : sequence of CoordinateOutput or rt70.model.outputs.Output
         The outputs, in order; an Output with several components gives one row each
-        (``name:x``, ``name:y``, … as in :func:`rt70.outputs.column_labels`).
+        (``name:x``, ``name:y``, … as in :func:`rt70.model.outputs.column_labels`).
     locked : sequence of str
         Coordinates removed from the model (held rigidly).
 

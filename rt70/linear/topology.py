@@ -28,7 +28,7 @@ import numpy as np
 from rt70.errors import NonFiniteError, Rt70Error, TopologyError
 
 if TYPE_CHECKING:
-    from rt70.scene import Scene
+    from rt70.model.scene import Scene
 
 #: An elastic (or rigid) link: ``(i, j)``, 1-based node numbers, 0 = the ground.
 Edge = tuple[int, int]
@@ -405,8 +405,8 @@ def from_scene(scene: Scene) -> LinearModel:
 
     Parameters
     ----------
-    scene : rt70.scene.Scene
-        A loaded scene (``rt70.scene.load_scene("rt70_elevation")``); only its
+    scene : rt70.model.scene.Scene
+        A loaded scene (``rt70.model.scene.load_scene("rt70_elevation")``); only its
         ``description`` is used.
 
     Returns

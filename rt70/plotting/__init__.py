@@ -3,7 +3,7 @@
 - :mod:`rt70.plotting.modal` — Bode diagram, step responses and mode shapes of the
   linear analyses (:mod:`rt70.linear.modal`, :mod:`rt70.linear.responses`);
 - :mod:`rt70.plotting.simulation` — coordinates, energies and the energy-balance
-  residual of a simulation (:mod:`rt70.simulate`).
+  residual of a simulation (:mod:`rt70.simulation.simulate`).
 
 Every helper returns a :class:`matplotlib.figure.Figure` (no pyplot state, safe with the
 Agg backend); saving files is left to the caller. The analyses themselves never import

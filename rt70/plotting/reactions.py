@@ -1,6 +1,6 @@
 """The figure of the RT-70's bearing and reducer loads against elevation.
 
-Four panels from plain arrays (:mod:`rt70.bearing_loads` computes them): the azimuth
+Four panels from plain arrays (:mod:`rt70.telescope.bearing_loads` computes them): the azimuth
 bearing's axial force and overturning moment, the elevation bearings' radial force
 (the sector's mesh force taken out) and the elevation reducer's torque, one line per
 wind case. Agg-safe: the figure is returned, never shown.
@@ -27,7 +27,7 @@ def bearing_loads_figure(
 ) -> Figure:
     """The four loads against elevation (degrees), one line per case of ``rows``.
 
-    ``rows[label]`` holds one :meth:`rt70.bearing_loads.BearingLoads.row` per elevation.
+    ``rows[label]`` holds one :meth:`rt70.telescope.bearing_loads.BearingLoads.row` per elevation.
     """
     e = np.asarray(elevations, dtype=float)
     fig = Figure(figsize=(10, 7), constrained_layout=True)

@@ -1,6 +1,6 @@
 """The figure of a servo scenario: what a servo engineer reads off a run.
 
-Four panels over time (a :class:`rt70.scenarios.ScenarioRun`): each axis angle against
+Four panels over time (a :class:`rt70.telescope.scenarios.ScenarioRun`): each axis angle against
 its reference (as the offset from the start pointing, arc seconds); the drives' torque on
 their axes against the nominal and the peak limits; the pointing error of the main
 mirror's axis in arc seconds (cross-elevation, elevation) with the ±1″ band; and the
@@ -97,7 +97,7 @@ def servo_figure(run) -> Figure:
 def summary_figure(runs: dict, drift_target: float = 1.0) -> Figure:
     """The servo targets at a glance: hold drift vs elevation, steps, tracking error.
 
-    ``runs`` maps names to :class:`rt70.scenarios.ScenarioRun` (holds at several
+    ``runs`` maps names to :class:`rt70.telescope.scenarios.ScenarioRun` (holds at several
     elevations, the steps, the tracking run), as validation/servo_scenarios.py makes them.
     """
     fig = Figure(figsize=(11, 8), constrained_layout=True)

@@ -1,7 +1,7 @@
 """The figure of a simulation: coordinates, energies and the energy-balance residual.
 
 Agg-safe: the figure is returned, never shown; the caller saves it (``rt70 simulate
---out``, :mod:`rt70.cli`).
+--out``, :mod:`rt70.cli.main`).
 """
 
 from __future__ import annotations

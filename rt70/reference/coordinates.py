@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from rt70.arrays import check_vector
+from rt70.guards.arrays import check_vector
 from rt70.reference.model import ReferenceModel
 
 

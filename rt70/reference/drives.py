@@ -7,7 +7,7 @@ The same quantities as :mod:`rt70.textbook.drives`, from Pinocchio's own kinemat
   (:func:`rt70.reference.coordinates.to_pinocchio`); θ_d is Pinocchio's joint
   configuration (an angle, or atan2 of the cos/sin of a continuous joint);
 - a gear sector (4.150): the link's and the stator's placements ``oMi · placement``
-  (``pin.forwardKinematics``) give the mesh angle of :class:`rt70.loads.SectorMesh`;
+  (``pin.forwardKinematics``) give the mesh angle of :class:`rt70.physics.loads.SectorMesh`;
   the mesh Wrenches become ``Q = Jᵀ f`` by :func:`rt70.reference.points.generalized_force`.
 
 Independent of the textbook side.
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from rt70.loads import Pose, SectorMesh
+from rt70.physics.loads import Pose, SectorMesh
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import ReferenceData, ReferenceModel
 from rt70.reference.points import generalized_force, link_point

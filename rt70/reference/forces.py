@@ -24,8 +24,8 @@ from functools import cached_property
 import numpy as np
 import pinocchio as pin
 
-from rt70.arrays import check_vector
 from rt70.errors import SingularConfigurationError
+from rt70.guards.arrays import check_vector
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import FrameStack, ReferenceData, ReferenceModel
 
@@ -229,7 +229,7 @@ def spring_damper_magnitudes(
     The same sums as :func:`spring_damper_force` with every term taken by its absolute
     value (joint springs ``|k q|``, bushings ``|∂δ/∂q|ᵀ |C δ|`` and
     ``|∂δ/∂q|ᵀ |D δ̇|``): forces of elements that oppose each other cancel in the sum
-    but not here. The natural scale of :func:`rt70.validate.natural_scales`.
+    but not here. The natural scale of :func:`rt70.crosscheck.validate.natural_scales`.
     """
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     nv = model.pin_model.nv

@@ -21,12 +21,12 @@ space ``v``, independently of the textbook side (:mod:`rt70.textbook.locks`):
 KKT matrix, which needs independent rows: dependent ones (a pin on a planar mechanism,
 two locks that overlap) are first reduced to an orthonormal basis of the row space,
 ``Ĵ = U_rᵀ J_c`` (SVD, :data:`RANK_RTOL`), and ``Λ = U_r Λ̂`` is then the least-norm
-impulse, as the textbook's :func:`rt70.kkt.solve_kkt`. Where the book's coordinates
+impulse, as the textbook's :func:`rt70.physics.kkt.solve_kkt`. Where the book's coordinates
 are Pinocchio's ``v = J q̇`` with J square (continuous, floating, planar joints, a
 reordering), Pinocchio solves in ``v`` and ``q̇⁺ = J⁻¹ v⁺``; with mimic joints (J tall)
 the reduced equations are solved in the book's coordinates with Pinocchio's CRBA, as
 the forward dynamics does (:func:`_reduced_impact`). Known impulses Γ (book coordinates,
-the sign of :mod:`rt70.impact`) come in by linearity: a second ``impulseDynamics`` from
+the sign of :mod:`rt70.physics.impact`) come in by linearity: a second ``impulseDynamics`` from
 ``v⁻ = J A⁻¹ Γ`` with e = 0.
 """
 
@@ -37,8 +37,8 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from rt70.arrays import check_vector
 from rt70.errors import Rt70Error
+from rt70.guards.arrays import check_vector
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.dynamics import mass_matrix
 from rt70.reference.model import ReferenceData, ReferenceModel

@@ -27,9 +27,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from rt70.arrays import check_vector
-from rt70.baumgarte import Baumgarte
 from rt70.errors import Rt70Error
+from rt70.guards.arrays import check_vector
+from rt70.physics.baumgarte import Baumgarte
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.forces import element_torques
 from rt70.reference.model import ReferenceData, ReferenceModel

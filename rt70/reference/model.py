@@ -17,8 +17,8 @@ import numpy as np
 import pinocchio as pin
 
 from rt70.errors import Rt70Error
+from rt70.reference.limits import check_reference
 from rt70.reference.parse import parse_urdf
-from rt70.resources import check_reference
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
 from rt70.urdf.inertia import balanced_text

@@ -10,7 +10,7 @@ import warnings
 import pinocchio as pin
 
 from rt70.errors import Rt70Warning, UrdfError
-from rt70.resources import run_with_stack
+from rt70.guards.resources import run_with_stack
 
 
 def parse_urdf(text: str, source: str) -> pin.Model:

@@ -18,8 +18,8 @@ from collections.abc import Iterable
 import numpy as np
 import pinocchio as pin
 
-from rt70.arrays import check_vector
-from rt70.loads import Wrench
+from rt70.guards.arrays import check_vector
+from rt70.physics.loads import Wrench
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import ReferenceData, ReferenceModel
 from rt70.reference.points import link_point

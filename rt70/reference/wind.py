@@ -2,21 +2,21 @@
 
 The same quantities as :mod:`rt70.textbook.wind`, from Pinocchio's own kinematics: each
 exposed body's link pose is its placement ``oMi · placement`` (``pin.forwardKinematics``,
-:func:`rt70.reference.drives.link_pose`); the shared :func:`rt70.wind.wind_wrench` gives
-the wind's Wrench, and ``Q = Jᵀ f`` with the point's ``LOCAL_WORLD_ALIGNED`` Jacobian in
-book coordinates (:func:`rt70.reference.points.generalized_force`). Independent of the
-textbook side.
+:func:`rt70.reference.drives.link_pose`); the shared
+:func:`rt70.physics.aerodynamics.wind_wrench` gives the wind's Wrench, and ``Q = Jᵀ f`` with
+the point's ``LOCAL_WORLD_ALIGNED`` Jacobian in book coordinates
+(:func:`rt70.reference.points.generalized_force`). Independent of the textbook side.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rt70.loads import Wrench
+from rt70.physics.aerodynamics import WindCondition, wind_wrench
+from rt70.physics.loads import Wrench
 from rt70.reference.drives import link_pose
 from rt70.reference.model import ReferenceData, ReferenceModel
 from rt70.reference.points import generalized_force, link_point
-from rt70.wind import WindCondition, wind_wrench
 
 
 def wind_wrenches(
@@ -53,7 +53,7 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
     Each exposed body's pose and the Jacobian of its load point come from the compiled
     joint walk from the ground to the link (:class:`rt70.reference.element_kernels.
     RelativePoints`, frame 1 the ground) instead of Pinocchio's placements and point
-    Jacobians per body and evaluation; :func:`rt70.wind.wind_wrench` gives the same
+    Jacobians per body and evaluation; :func:`rt70.physics.aerodynamics.wind_wrench` gives the same
     Wrench from the same pose, and ``Q = J_vᵀ F + J_ωᵀ M`` (tested equal to
     :func:`wind_force`). Mapped coordinates or an unsupported path keep
     :func:`wind_force`.

@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write_all
+from rt70.guards.atomic import atomic_write_all
+from rt70.model.scene import Scene, load_scene, scene_from_text
 from rt70.reports.targets import TargetCheck
 from rt70.reports.threads import single_threaded
-from rt70.scene import Scene, load_scene, scene_from_text
 from rt70.textbook import dynamics, mass_kernel, structured
 
 
@@ -248,7 +248,7 @@ def run(
     progress: Callable[[str], None] | None = None,
 ) -> list[Row]:
     """All mass-matrix benchmarks: per call, batched, and growth with size."""
-    from rt70.robots import load_robot
+    from rt70.crosscheck.robots import load_robot
 
     say = progress or (lambda _msg: None)
     scenes = [load_scene("rt70")] + [load_robot(name) for name in robots]
@@ -306,7 +306,7 @@ def write_results(rows: list[Row], directory: Path) -> list[Path]:
     Raises
     ------
     OutputError
-        The directory cannot take them (:func:`rt70.atomic.atomic_write_all`); neither
+        The directory cannot take them (:func:`rt70.guards.atomic.atomic_write_all`); neither
         file is changed.
     """
     import matplotlib

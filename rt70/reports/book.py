@@ -12,9 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.atomic import atomic_write, atomic_write_text
+from rt70.guards.atomic import atomic_write, atomic_write_text
 from rt70.linear import linearize as lin
 from rt70.linear import modal, responses
+from rt70.model.scene import Scene, load_scene
 from rt70.plotting.modal import plot_bode
 from rt70.reports.book_azimuth import azimuth_section
 from rt70.reports.book_format import (
@@ -23,7 +24,6 @@ from rt70.reports.book_format import (
     relative_difference,
     spectrum_table,
 )
-from rt70.scene import Scene, load_scene
 from rt70.scenes import rt70_chapter2, rt70_data, rt70_state
 
 #: Bodies of the listing in the order of the chapter-2 azimuth nodes (Table 2.1).

@@ -6,9 +6,9 @@ One job: build the single-axis rig of docs/drive-train.md from the RT-70's drive
 - ``regularisation``: the cost (RHS evaluations, Jacobians, LU decompositions, wall time)
   of scipy's BDF and Radau against the width ω_ε of the friction's regularisation, and
   the position error it leaves against the exact switched (stick–slip) motion
-  (:func:`rt70.friction.switched_rigid_axis`): a rigid axis of the azimuth's total
+  (:func:`rt70.control.friction.switched_rigid_axis`): a rigid axis of the azimuth's total
   inertia under a torque ``1.5 F_s sin(2π·0.5 t)`` that makes it stick and slip;
-- ``rig``: the servo-closed axis (:class:`rt70.geartrains.TwoTrainServo`, 0.5 Hz
+- ``rig``: the servo-closed axis (:class:`rt70.control.geartrains.TwoTrainServo`, 0.5 Hz
   position loop) holding a 2″ step and tracking at the sidereal rate, with and without
   backlash, friction, the counter-torque bias and a wind gust; the error in arc seconds
   over the second half of each run.
@@ -27,11 +27,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
-from rt70.friction import AxisFriction, switched_rigid_axis
-from rt70.geartrains import TwoTrainServo, train_gains
-from rt70.scene import Scene, scene_from_text
+from rt70.control.friction import AxisFriction, switched_rigid_axis
+from rt70.control.geartrains import TwoTrainServo, train_gains
+from rt70.model.scene import Scene, scene_from_text
 from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, FRICTION, MOTOR, TRAINS, WIND_TORQUE
-from rt70.simulate import SimulationResult, simulate
+from rt70.simulation.simulate import SimulationResult, simulate
 
 #: Sidereal rate, rad/s (15.04″/s).
 SIDEREAL = 7.2921e-5

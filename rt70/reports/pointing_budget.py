@@ -1,6 +1,6 @@
 """The RT-70's wind pointing budget over wind speeds and elevations, and its figures.
 
-One job: run :func:`rt70.pointing.pointing_budget` over the issue's table (wind 5, 10,
+One job: run :func:`rt70.telescope.pointing.pointing_budget` over the issue's table (wind 5, 10,
 15, 20 m/s × elevation 15°, 45°, 90°, front wind) and over a finer grid for the figure
 of error against speed, and turn the results into a table (Markdown) and the figures of
 :mod:`rt70.plotting.wind`. Used by validation/pointing_budget.py and the notebook.
@@ -10,8 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from rt70.pointing import BUDGET_OUTPUTS, TITLES, PointingBudget, PointingCase, pointing_budget
-from rt70.scene import Scene
+from rt70.model.scene import Scene
+from rt70.telescope.pointing import (
+    BUDGET_OUTPUTS,
+    TITLES,
+    PointingBudget,
+    PointingCase,
+    pointing_budget,
+)
 
 #: The issue's table.
 TABLE_SPEEDS = (5.0, 10.0, 15.0, 20.0)

@@ -17,8 +17,8 @@ from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
 from rt70.linear import reduce as rd
 from rt70.linear.responses import StateSpace
-from rt70.loads import Wrench
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
+from rt70.physics.loads import Wrench
 from rt70.scenes.rt70_drives import ARCSEC
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import rt70_pointing

@@ -1,7 +1,7 @@
 """The RT-70's servo loops in frequency analysis: its axis plants, PI cascade against LQG.
 
-One job: put the RT-70 into the generic servo analyses (:mod:`rt70.linear.loops`,
-:mod:`rt70.linear.lqg`, :mod:`rt70.linear.servo_compare`): its axis plants at a
+One job: put the RT-70 into the generic servo analyses (:mod:`rt70.control.loops`,
+:mod:`rt70.control.lqg`, :mod:`rt70.control.servo_compare`): its axis plants at a
 pointing on the ``rt70_servo`` scene, its drives (docs/drives.md), its wind torque, and
 the designs compared (:func:`compare`, used by validation/servo_loops.py).
 
@@ -23,13 +23,13 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
+from rt70.control import loops, lqg
+from rt70.control.geartrains import parallel_drive
+from rt70.control.servo_compare import performance
 from rt70.errors import Rt70Error
-from rt70.geartrains import parallel_drive
 from rt70.linear import linearize as lin
-from rt70.linear import loops, lqg
-from rt70.linear.servo_compare import performance
-from rt70.loads import Wrench
-from rt70.scene import Scene
+from rt70.model.scene import Scene
+from rt70.physics.loads import Wrench
 from rt70.scenes.rt70_drives import DRIVES, WIND_TORQUE, AxisDrive
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE, rt70_pointing
@@ -115,7 +115,7 @@ def compare(
 ) -> dict:
     """Cascade and LQG on one plant: margins, bandwidths, step and wind numbers (a dict).
 
-    The LQG is designed on :func:`rt70.linear.lqg.reduce_plant` of the plant and checked
+    The LQG is designed on :func:`rt70.control.lqg.reduce_plant` of the plant and checked
     on the full plant; its margins are at the plant input (the armature voltage). The
     wind step is the book's nominal wind torque (``WIND_TORQUE``, 5·10⁵ kgf·m).
     """

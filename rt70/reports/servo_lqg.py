@@ -1,23 +1,23 @@
 """The RT-70's LQG servo closed around the nonlinear model: factory, runs, linear prediction.
 
-One job: put the LQG of :mod:`rt70.linear.lqg` (designed for an RT-70 axis at a
+One job: put the LQG of :mod:`rt70.control.lqg` (designed for an RT-70 axis at a
 pointing by :mod:`rt70.reports.servo_loops`: plant reduced to 16–20 states, the other
-axis locked) into the servo scenarios of :mod:`rt70.scenarios` as a
-:class:`rt70.lqg_drive.LqgDrive`, and compare it with its linear closed loop and with
+axis locked) into the servo scenarios of :mod:`rt70.telescope.scenarios` as a
+:class:`rt70.control.lqg_drive.LqgDrive`, and compare it with its linear closed loop and with
 the PI cascade (issue 10 item 4, "closed around the nonlinear model in simulation").
 
-- :func:`lqg_drives`: a :data:`rt70.scenarios.DriveFactory` with the LQG on the azimuth
+- :func:`lqg_drives`: a :data:`rt70.telescope.scenarios.DriveFactory` with the LQG on the azimuth
   (where the PI cascade is held to 0.2 Hz) and the default factory's PI cascade on the
   elevation. The drive is the one the LQG was designed on
   (:func:`rt70.reports.servo_loops.drive_parameters`: the two motors' armatures in
   parallel, clamped at their rated voltage U_n; the PI factory takes them in series at
-  2 U_n — the same machine, see :func:`rt70.scenarios.drive_parameters`). It starts
+  2 U_n — the same machine, see :func:`rt70.telescope.scenarios.drive_parameters`). It starts
   holding the gravity torque with the controller at rest
-  (:meth:`rt70.lqg_drive.LqgDrive.steady_controller`: the integral state carries the
+  (:meth:`rt70.control.lqg_drive.LqgDrive.steady_controller`: the integral state carries the
   holding voltage).
 - :func:`step_scenario`: an azimuth step of any size (small: the loop stays linear).
 - :func:`linear_step`: the linear LQG closed loop's response to the same step
-  (:func:`rt70.linear.lqg.lqg_system` on the full linear plant).
+  (:func:`rt70.control.lqg.lqg_system` on the full linear plant).
 """
 
 from __future__ import annotations
@@ -25,13 +25,13 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from rt70.linear import lqg
-from rt70.lqg_drive import LqgDrive
+from rt70.control import lqg
+from rt70.control.lqg_drive import LqgDrive
 from rt70.reports import servo_loops as rs
-from rt70.scenarios import DriveFactory, Scenario, servo_drives, servo_tolerances
 from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE
-from rt70.servo_metrics import settling_time
+from rt70.telescope.scenarios import DriveFactory, Scenario, servo_drives, servo_tolerances
+from rt70.telescope.servo_metrics import settling_time
 
 #: Tracking time of the integral state's back-calculation, s: the LQR's integral time
 #: (:data:`rt70.reports.servo_loops.LQG_WEIGHTS`).
@@ -42,7 +42,7 @@ def controller_parts(ctrl: lqg.LqgController) -> dict:
     """The LQG's matrices and anti-windup vectors for :class:`LqgDrive`.
 
     ``matrices`` ``(A_c, B_c, C_c, D_c)`` of ``ctrl.controller`` (inputs reference,
-    :data:`rt70.linear.lqg.MEASURED`); ``observer_input`` ``[B − L D; 0]`` of the
+    :data:`rt70.control.lqg.MEASURED`); ``observer_input`` ``[B − L D; 0]`` of the
     (scaled) reduced plant at the voltage: how the voltage enters the Kalman filter;
     ``integral_states`` the last state, the integral of the angle error.
     """
@@ -67,7 +67,7 @@ def lqg_drives(
 ) -> DriveFactory:
     """LQG on the azimuth (designed at the pointing), the default PI cascade on elevation.
 
-    The LQG is designed by :func:`rt70.linear.lqg.design` on
+    The LQG is designed by :func:`rt70.control.lqg.design` on
     :func:`rt70.reports.servo_loops.axis_plant` ``(scene, "azimuth", elevation_deg)``
     when the factory is called (about 1 s).
     """

@@ -15,7 +15,7 @@ Whole command
     (imports, URDF, Pinocchio) and what follows the integration (energies, printing).
 Right-hand side and Jacobian
     The reference backend's ``accelerations`` and ``jacobian``
-    (:class:`rt70.simulate._PinocchioBackend`) at the RT-70 listing's initial state,
+    (:class:`rt70.simulation.simulate._PinocchioBackend`) at the RT-70 listing's initial state,
     timed interleaved with ``pin.aba`` and ``pin.computeABADerivatives`` on the same
     state and the same generalized forces, BLAS/OpenMP pinned to one thread
     (:func:`rt70.reports.threads.single_threaded`); the median per-round ratio must be
@@ -40,14 +40,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from rt70.reports.targets import TargetCheck
+from rt70.reports.targets import COM_TARGET_M, REAL_TIME_TARGET, TRANSIENT_PROBLEM, TargetCheck
 
-#: The target problem of the work–precision report (the 10 s transient, axes free).
-TARGET_PROBLEM = "rt70_10s"
-#: Accuracy of the targets: centre-of-mass position error, m.
-COM_TARGET_M = 1e-5
-#: Integration speed of the free-axes transient, × real time.
-REAL_TIME_TARGET = 50.0
 #: Whole command, s.
 COMMAND_TARGET_S = 1.0
 #: Attempts of the whole command (best wall time).
@@ -62,7 +56,7 @@ SERVO_T_END = 10.0
 #: Tolerances tried on the servo scenario (the fastest meeting the accuracy counts).
 SERVO_RTOLS = (1e-5, 1e-6, 1e-7)
 #: Reference of the servo scenario: LSODA, the scenarios' method
-#: (:func:`rt70.scenarios.run_scenario`), at this tolerance: 1e-9 took 19 s, 1e-10 did
+#: (:func:`rt70.telescope.scenarios.run_scenario`), at this tolerance: 1e-9 took 19 s, 1e-10 did
 #: not finish in 150 s (measured), so the ladder stops two decades above it.
 SERVO_REFERENCE_RTOL = 1e-9
 
@@ -79,21 +73,21 @@ def integration_target(rows) -> tuple[TargetCheck, object | None]:
     Returns
     -------
     (TargetCheck, Row or None)
-        The check and the fastest row of :data:`TARGET_PROBLEM` with
+        The check and the fastest row of :data:`TRANSIENT_PROBLEM` with
         ``com_error ≤ COM_TARGET_M`` (None when no row reached it, or the problem was
         not run).
     """
     from rt70.reports.work_precision import time_to_reach
 
-    mine = [r for r in rows if r.problem == TARGET_PROBLEM]
+    mine = [r for r in rows if r.problem == TRANSIENT_PROBLEM]
     goal = (
         f"RT-70 10 s transient, axes free, centre-of-mass error ≤ {COM_TARGET_M:g} m: "
         f"integration ≤ {10.0 / REAL_TIME_TARGET:g} s (≥ {REAL_TIME_TARGET:g}× real time)"
     )
     if not mine:
-        return TargetCheck(goal, f"— ({TARGET_PROBLEM} not in this run)", None), None
+        return TargetCheck(goal, f"— ({TRANSIENT_PROBLEM} not in this run)", None), None
     methods = dict.fromkeys(r.method for r in mine)
-    reach = [time_to_reach(rows, TARGET_PROBLEM, m, COM_TARGET_M, "com_error") for m in methods]
+    reach = [time_to_reach(rows, TRANSIENT_PROBLEM, m, COM_TARGET_M, "com_error") for m in methods]
     best = [b for b in reach if b is not None]
     if not best:
         done = [r for r in mine if r.status == "ok"]
@@ -157,12 +151,12 @@ def kernel_ratios(rounds: int = 7, budget_s: float = 0.05) -> dict[str, tuple[fl
     """
     import pinocchio as pin
 
+    from rt70.model.scene import load_scene
     from rt70.reference import element_torques
     from rt70.reports.bench import compare
     from rt70.reports.threads import single_threaded
-    from rt70.scene import load_scene
     from rt70.scenes.rt70_state import listing_initial_state
-    from rt70.simulate import _PinocchioBackend
+    from rt70.simulation.simulate import _PinocchioBackend
 
     scene = load_scene("rt70")
     backend = _PinocchioBackend(scene)
@@ -214,7 +208,7 @@ def servo_runs(
 ) -> list[dict]:
     """``rt70 simulate rt70_servo --scenario step-elevation --t-end T`` per method and rtol.
 
-    Every run goes through :func:`rt70.scenarios.run_scenario` as the command does (the
+    Every run goes through :func:`rt70.telescope.scenarios.run_scenario` as the command does (the
     scene's drives and the servo closed, the default pointing), BLAS pinned; its
     centre-of-mass error (m) and the error of its mirror-axis pointing (arc seconds,
     the optical output of the servo scene) are taken against a reference run of LSODA
@@ -226,13 +220,13 @@ def servo_runs(
         Per run: ``method``, ``rtol``, ``wall_s``, ``t_end``, ``com_error`` (m),
         ``pointing_error`` (″), ``nfev``, ``njev``, ``status``; the reference first.
     """
-    from rt70 import scenarios
+    from rt70.model.scene import load_scene
     from rt70.reports.threads import single_threaded
     from rt70.reports.work_precision import com_error
     from rt70.reports.work_precision_worker import com_positions
-    from rt70.scene import load_scene
-    from rt70.scene_servo import choose_drives
-    from rt70.simulate import METHODS
+    from rt70.simulation.simulate import METHODS
+    from rt70.telescope import scenarios
+    from rt70.telescope.scene_servo import choose_drives
 
     say = progress or _quiet
     scene = load_scene("rt70_servo")

@@ -28,3 +28,16 @@ class TargetCheck:
         """``target … — measured … — met`` (or ``NOT met``, or ``not judged``)."""
         verdict = {True: "met", False: "NOT met", None: "not judged"}[self.met]
         return f"target {self.target} — measured {self.measured} — {verdict}"
+
+
+#: The problem the simulation targets are judged on: the work–precision report's 10 s
+#: transient of the RT-70 with its axes free.
+TRANSIENT_PROBLEM = "rt70_10s"
+
+
+#: Accuracy of the simulation targets: centre-of-mass position error, m.
+COM_TARGET_M = 1e-5
+
+
+#: Integration speed of the free-axes transient, × real time.
+REAL_TIME_TARGET = 50.0

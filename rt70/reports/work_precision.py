@@ -1,4 +1,4 @@
-"""Work–precision report of the integrators of :func:`rt70.simulate.simulate`.
+"""Work–precision report of the integrators of :func:`rt70.simulation.simulate.simulate`.
 
 For each test problem and each ``solve_ivp`` method the run is repeated over a ladder
 of relative tolerances; every run gives one point (run time, error) of the method's
@@ -85,22 +85,22 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70 import simulate as _simulate
-from rt70.atomic import atomic_write_all
 from rt70.errors import Rt70Error
-from rt70.reports import simulation_targets
+from rt70.guards.atomic import atomic_write_all
+from rt70.reports import targets
 from rt70.reports.targets import TargetCheck
 from rt70.reports.work_precision_problems import PROBLEMS, QUICK_PROBLEMS, Problem
 from rt70.reports.work_precision_worker import Attempt, Worker
+from rt70.simulation import simulate as _simulate
 
-#: Methods measured: every method of :data:`rt70.simulate.METHODS` (the compiled
+#: Methods measured: every method of :data:`rt70.simulation.simulate.METHODS` (the compiled
 #: integrators such as CVODE included once they are there) but RK23, which is RK45's
 #: lower order and adds nothing to the comparison.
 METHODS = tuple(m for m in _simulate.METHODS if m != "RK23")
 #: Methods that need no cap against stiffness: the implicit ones (scipy's and SUNDIALS').
 STIFF_METHODS = tuple(m for m in METHODS if m in _simulate.IMPLICIT or m.startswith("CVODE"))
 #: The tolerance ladder (relative tolerance; ``atol`` is the default of
-#: :func:`~rt70.simulate.simulate`).
+#: :func:`~rt70.simulation.simulate.simulate`).
 RTOLS = tuple(10.0**-k for k in range(3, 10))
 #: Relative tolerance of the references.
 REFERENCE_RTOL = 1e-12
@@ -511,15 +511,14 @@ def write_results(rows: list[Row], directory: str | Path) -> list[Path]:
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.axvline(cap, color="0.5", ls="--", lw=1, label=f"time cap {cap:g} s")
-        if problem == simulation_targets.TARGET_PROBLEM:  # the issue-13 target region
-            ax.axhline(simulation_targets.COM_TARGET_M, color="C3", ls="-.", lw=1)
+        if problem == targets.TRANSIENT_PROBLEM:  # the issue-13 target region
+            ax.axhline(targets.COM_TARGET_M, color="C3", ls="-.", lw=1)
             ax.axvline(
-                mine[0].t_end / simulation_targets.REAL_TIME_TARGET,
+                mine[0].t_end / targets.REAL_TIME_TARGET,
                 color="C3",
                 ls="-.",
                 lw=1,
-                label=f"target: ≤ {simulation_targets.COM_TARGET_M:g} m in ≤ T/"
-                f"{simulation_targets.REAL_TIME_TARGET:g}",
+                label=f"target: ≤ {targets.COM_TARGET_M:g} m in ≤ T/{targets.REAL_TIME_TARGET:g}",
             )
         floor = mine[0].com_floor
         if floor > 0:

@@ -66,7 +66,8 @@ class Problem:
         Primary and alternate reference methods: a run of the primary method is
         measured against the alternate one, every other run against the primary.
     reference_atol : float or None
-        ``atol`` of the reference runs (None: the default of :func:`~rt70.simulate.simulate`).
+        ``atol`` of the reference runs (None: the default of
+        :func:`~rt70.simulation.simulate.simulate`).
     chain_bodies : int
         Bodies of the chain (``chain`` only).
     stiff_only : bool
@@ -203,7 +204,7 @@ def build_problem(problem: Problem) -> tuple[object, tuple[np.ndarray, np.ndarra
     x0 : (q0, q̇0)
     notes : str
     """
-    from rt70.scene import load_scene, scene_from_text
+    from rt70.model.scene import load_scene, scene_from_text
     from rt70.scenes import synthetic
     from rt70.scenes.rt70_state import listing_initial_state
 

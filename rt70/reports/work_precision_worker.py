@@ -81,7 +81,7 @@ def _worker_main(conn: multiprocessing.connection.Connection) -> None:
 def _serve(conn: multiprocessing.connection.Connection, unpinned: str) -> None:
     """The request loop of :func:`_worker_main` (thread pools already pinned)."""
     from rt70.reports.threads import max_threads
-    from rt70.simulate import simulate
+    from rt70.simulation.simulate import simulate
 
     while True:
         try:
@@ -133,7 +133,10 @@ class Attempt:
 
 
 class Worker:
-    """A worker process that runs :func:`~rt70.simulate.simulate`, abandoned at a time cap."""
+    """A worker process that runs a simulation, abandoned at a time cap.
+
+    The simulation is :func:`~rt70.simulation.simulate.simulate`.
+    """
 
     def __init__(self) -> None:
         self.process: multiprocessing.process.BaseProcess | None = None

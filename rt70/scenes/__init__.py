@@ -7,22 +7,4 @@ chapter-2 tables) and :mod:`rt70.scenes.mechanisms` (small test mechanisms);
 What the analyses are told about the RT-70 is built here too:
 :mod:`rt70.scenes.rt70_chapter2` (the chapter-2 models from the tables) and
 :mod:`rt70.scenes.rt70_state` (pointing axes, the listing's start state).
-
-``SCENES`` and ``write_all`` are re-exported lazily, so that running the generator
-with ``python -m`` does not import it twice.
 """
-
-from __future__ import annotations
-
-from typing import Any
-
-__all__ = ["SCENES", "write_all"]
-
-
-def __getattr__(name: str) -> Any:
-    """Import ``SCENES`` and ``write_all`` from :mod:`rt70.scenes.generate` on first use."""
-    if name in __all__:
-        from rt70.scenes import generate
-
-        return getattr(generate, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

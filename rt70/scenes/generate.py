@@ -17,8 +17,8 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from rt70.atomic import atomic_write_text
-from rt70.geartrains import parallel_drive
+from rt70.control.geartrains import parallel_drive
+from rt70.guards.atomic import atomic_write_text
 from rt70.scenes import mechanisms, rt70_data, rt70_drives, rt70_wind
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene

@@ -7,7 +7,7 @@ along −z, normal to its plane, carried by the joints and doing no work), so th
 crank, started at 10 rad/s, keeps turning — in a vertical plane the rod's weight would
 stop it and swing it back. Each is a tree plus one ``<rt70:loop type="point">``: three
 rows, of which two are independent (the z row is identically zero in a planar
-mechanism — rt70.kkt and Pinocchio's proximal solver take the dependent row). The
+mechanism — rt70.physics.kkt and Pinocchio's proximal solver take the dependent row). The
 scenes are written by :mod:`rt70.scenes.generate` like every other scene.
 """
 
@@ -131,10 +131,10 @@ def start_state(scene) -> tuple[np.ndarray, np.ndarray] | None:
     """The closed start of a mechanism of this module (crank at 10 rad/s), else None.
 
     The crank–slider starts at crank angle 0 turning at 10 rad/s, the four-bar at rest
-    with the crank vertical; both closed by :func:`rt70.closed_chains.assemble` keeping
+    with the crank vertical; both closed by :func:`rt70.simulation.closed_chains.assemble` keeping
     the crank.
     """
-    from rt70.closed_chains import assemble
+    from rt70.simulation.closed_chains import assemble
 
     guess = STARTS.get(scene.name)
     if guess is None or not scene.description.loops:

@@ -282,8 +282,8 @@ class AxisDrive:
         """ONE of the axis's motors with the axis's reducer (its totals, axis-referred).
 
         The caller lumps the ``motors_per_axis`` motors as the drive needs:
-        :func:`rt70.geartrains.parallel_drive` (armatures on one voltage, the scene's
-        ``<rt70:drive>``) or :func:`rt70.geartrains.equivalent_drive` (in series).
+        :func:`rt70.control.geartrains.parallel_drive` (armatures on one voltage, the scene's
+        ``<rt70:drive>``) or :func:`rt70.control.geartrains.equivalent_drive` (in series).
         """
         m = self.motor
         return DriveParameters(

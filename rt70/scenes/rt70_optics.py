@@ -1,6 +1,6 @@
 """The RT-70's mirror system: which of its points and frames the book's outputs use.
 
-What :mod:`rt70.optics` (generic) needs to know of the RT-70 (book 4.1.8, rt70-data):
+What :mod:`rt70.model.optics` (generic) needs to know of the RT-70 (book 4.1.8, rt70-data):
 
 - the four ``<rt70:optical_point>`` elements by name (the listing's R5f, R5v, R7f, R7v);
 - the reference ring (OK) frame: the mirror base (body 4); the pointing axes: the
@@ -18,12 +18,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.optics import MirrorSystem, mirror_outputs, source_direction
+from rt70.model.optics import MirrorSystem, mirror_outputs, source_direction
 from rt70.scenes import rt70_data
 
 if TYPE_CHECKING:
-    from rt70.outputs import Output
-    from rt70.scene import Scene
+    from rt70.model.outputs import Output
+    from rt70.model.scene import Scene
 
 #: Names of the optical points in urdf/rt70.urdf: main focus, main vertex, CR focus, CR vertex.
 OPTICAL_POINTS = (
@@ -63,7 +63,7 @@ DESIGN_FOCAL_OFFSET = tuple(float(x) for x in _design_focal_offset())
 
 
 def rt70_mirror_system(scene: Scene) -> MirrorSystem:
-    """The RT-70's :class:`rt70.optics.MirrorSystem`, its points read from the scene.
+    """The RT-70's :class:`rt70.model.optics.MirrorSystem`, its points read from the scene.
 
     Raises
     ------

@@ -7,7 +7,7 @@ them as arguments by whoever chooses the RT-70 (the command line, the reports):
   :data:`ELEVATION_COORDINATE`, rt70-data §D) and :func:`rt70_pointing`, the held
   coordinates of a pointing (``held`` of :func:`rt70.linear.linearize.equilibrium`);
 - the listing's initial state Q_NU, dQ_NU (:func:`listing_initial_state`, ``x0`` of
-  :func:`rt70.simulate.simulate`), and :func:`start_state`, the one the command line
+  :func:`rt70.simulation.simulate.simulate`), and :func:`start_state`, the one the command line
   starts a scene from.
 """
 
@@ -22,7 +22,7 @@ from rt70.scenes import rt70_data
 from rt70.scenes.pairs import pair_joint_names
 
 if TYPE_CHECKING:
-    from rt70.scene import Scene
+    from rt70.model.scene import Scene
 
 #: RT-70 pointing axes: the coordinates the drives turn (rt70-data §D).
 AZIMUTH_COORDINATE = "platform_rz"
@@ -56,7 +56,7 @@ def listing_initial_state(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    scene : rt70.scene.Scene
+    scene : rt70.model.scene.Scene
         A scene with the listing's 42 coordinates, in any order.
 
     Returns
@@ -86,7 +86,7 @@ def start_state(scene: Scene) -> tuple[np.ndarray, np.ndarray] | None:
         :func:`listing_initial_state` when the scene has the listing's coordinates,
         the assembled start of the four-bar and the crank–slider
         (:func:`rt70.scenes.loop_scenes.start_state`), else None
-        (:func:`rt70.simulate.simulate` then starts at rest).
+        (:func:`rt70.simulation.simulate.simulate` then starts at rest).
     """
     from rt70.scenes.loop_scenes import start_state as loop_start
 
@@ -97,3 +97,8 @@ def start_state(scene: Scene) -> tuple[np.ndarray, np.ndarray] | None:
         return listing_initial_state(scene)
     except Rt70Error:
         return None
+
+
+#: Range of the RT-70's elevation axis, degrees: horizon to zenith (the book's tables
+#: are given at 0° and 90°; :func:`rt70_pointing`).
+ELEVATION_RANGE = (0.0, 90.0)

@@ -53,7 +53,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rt70.rotations import rpy_matrix, rpy_of_matrix
+from rt70.physics.rotations import rpy_matrix, rpy_of_matrix
 from rt70.scenes.pairs import PAIR_JOINTS
 from rt70.scenes.urdf_writer import ROOT_LINK, RT70_NS, fmt, fmt_vec
 

@@ -6,7 +6,7 @@ generalised force ``Q = K ∂θ_d/∂q`` through the angle θ_d(q) its reducer t
 
 - a torque drive on a joint (4.143): θ_d is the joint's coordinate, found in this
   model's own coordinates; ``Q = K e_k``;
-- a gear sector (4.150): θ_d is the mesh angle of :class:`rt70.loads.SectorMesh`, from
+- a gear sector (4.150): θ_d is the mesh angle of :class:`rt70.physics.loads.SectorMesh`, from
   the link's and the stator's poses of the book's forward pass (4.5)–(4.7); the force
   is the pair of mesh Wrenches turned into ``Q = S U`` (4.129)–(4.131), each as
   :func:`rt70.textbook.points.generalized_force` does, from one structure matrix S.
@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from rt70.arrays import check_vector
 from rt70.errors import UnknownLinkError
-from rt70.loads import Pose, SectorMesh
+from rt70.guards.arrays import check_vector
+from rt70.physics.loads import Pose, SectorMesh
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import (
     forward_kinematics,

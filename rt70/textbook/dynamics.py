@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from rt70.arrays import check_vector
 from rt70.errors import Rt70Error
+from rt70.guards.arrays import check_vector
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import pair_motion_rate, update_structure
 from rt70.textbook.model import Model

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rt70.arrays import check_vector
 from rt70.errors import SingularConfigurationError
+from rt70.guards.arrays import check_vector
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import (
     frame_jacobian,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rt70.arrays import check_vector
+from rt70.guards.arrays import check_vector
 from rt70.textbook.data import Data
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import (

@@ -1,7 +1,7 @@
 """Rows of sudden constraints (locks) on the textbook side: a brake, a stow pin.
 
 The constraint ``B_c q̇ = 0`` that engages in an impact (companion source 004 (15),
-:mod:`rt70.impact`), from the book's own matrices:
+:mod:`rt70.physics.impact`), from the book's own matrices:
 
 - a **brake** holds a 1-DOF joint: its row is the joint's row of the mimic map
   ``q̇_full = G q̇`` (``Model.G``; the unit row of the coordinate without mimic joints);

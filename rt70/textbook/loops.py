@@ -16,9 +16,9 @@ kinematics — frame poses of the forward pass, frame Jacobians ``(T(r)[c])ᵀ (
   acceleration is ``R ω̇``.
 
 The constrained equations (14), ``A q̈ = f + B_cᵀ λ``, ``B_c q̈ = g``, are solved by
-:func:`rt70.kkt.solve_kkt` (range-space method), ``f = Q_g + Q_c + Q_d + Q − B q̇``
+:func:`rt70.physics.kkt.solve_kkt` (range-space method), ``f = Q_g + Q_c + Q_d + Q − B q̇``
 (gravity, the scene's springs and dampers, further forces Q) and ``g`` from
-:mod:`rt70.baumgarte`. λ are the reactions of the loop joints in ground axes: the
+:mod:`rt70.physics.baumgarte`. λ are the reactions of the loop joints in ground axes: the
 force on frame 1 (and its moment for ``frame``); frame 2 takes −λ. The reference side
 (:mod:`rt70.reference.loops`) computes the same from Pinocchio.
 """
@@ -28,9 +28,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from rt70.arrays import check_vector
-from rt70.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
-from rt70.kkt import solve_kkt
+from rt70.guards.arrays import check_vector
+from rt70.physics.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
+from rt70.physics.kkt import solve_kkt
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import (
     _bias_matrix,
@@ -141,11 +141,11 @@ def constrained_forward_dynamics(
     Q: np.ndarray | None = None,
     stabilization: Baumgarte | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(q̈, λ)`` of the constrained equations (14), solved by :func:`rt70.kkt.solve_kkt`.
+    """``(q̈, λ)`` of the constrained equations (14), solved by :func:`rt70.physics.kkt.solve_kkt`.
 
     ``A q̈ = Q_g + Q_c + Q_d + Q − B q̇ + B_cᵀ λ`` and ``B_c q̈ = g``, g = −C or the
-    perturbation equations (2.2) of :class:`rt70.baumgarte.Baumgarte`, projected onto
-    the range of B_c when rows are dependent (:func:`rt70.baumgarte.consistent_rhs`).
+    perturbation equations (2.2) of :class:`rt70.physics.baumgarte.Baumgarte`, projected onto
+    the range of B_c when rows are dependent (:func:`rt70.physics.baumgarte.consistent_rhs`).
 
     Parameters
     ----------

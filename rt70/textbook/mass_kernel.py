@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from rt70.arrays import check_vector
+from rt70.guards.arrays import check_vector
 from rt70.textbook.model import Model
 from rt70.textbook.structured import _check_batch, _data_for
 

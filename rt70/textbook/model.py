@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rt70.constraints import mimic_map
+from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY
+from rt70.physics.constraints import mimic_map
 from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
 from rt70.urdf.description import Joint, RobotDescription, Wind
-from rt70.wind import DEFAULT_AIR_DENSITY
 
 PAIR_KINDS = ("euler6", "revolute", "prismatic", "planar")
 _NDOF = {"euler6": 6, "revolute": 1, "prismatic": 1, "planar": 3}
@@ -346,7 +346,7 @@ def _mimic_constraints(
 ) -> tuple[np.ndarray | None, np.ndarray | None, list[str]]:
     """``q_full = G q + q_offset`` from the URDF ``<mimic>`` elements (chapter 3).
 
-    Built by :func:`rt70.constraints.mimic_map`, where every eliminated constraint is
+    Built by :func:`rt70.physics.constraints.mimic_map`, where every eliminated constraint is
     defined. Returns G, q_offset (None, None without mimics) and the independent
     coordinates.
     """

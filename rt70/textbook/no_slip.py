@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rt70.arrays import check_vector
+from rt70.guards.arrays import check_vector
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import body_velocities, structure_matrix_rate
 from rt70.textbook.kinematics import update_structure

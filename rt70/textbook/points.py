@@ -16,9 +16,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rt70.arrays import check_vector
 from rt70.errors import UnknownLinkError
-from rt70.loads import Wrench
+from rt70.guards.arrays import check_vector
+from rt70.physics.loads import Wrench
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import (
     forward_kinematics,

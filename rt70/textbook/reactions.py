@@ -40,8 +40,8 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from rt70.arrays import check_vector
-from rt70.loads import Wrench
+from rt70.guards.arrays import check_vector
+from rt70.physics.loads import Wrench
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import body_velocities, structure_matrix_rate
 from rt70.textbook.kinematics import update_structure
@@ -73,7 +73,7 @@ def joint_reactions(
         The textbook model and its work buffers.
     q, qd, qdd : numpy.ndarray
         State and accelerations in the model's coordinates (nv,).
-    wrenches : iterable of rt70.loads.Wrench
+    wrenches : iterable of rt70.physics.loads.Wrench
         Loads on links (ground axes, at a point of the link); a load on the ground
         link acts on no pair and is ignored.
     gravity : bool

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from rt70.errors import SingularConfigurationError
-from rt70.rotations import c1, c2, c3, rpy_matrix, rpy_of_matrix  # noqa: F401 (the book's (1.23))
+from rt70.physics.rotations import c1, c2, c3, rpy_matrix, rpy_of_matrix  # noqa: F401 (the book's (1.23))
 
 #: Gimbal-lock threshold: configurations with ``|cos θ|`` below this raise
 #: :class:`~rt70.errors.SingularConfigurationError` wherever Euler-angle rates are needed.

@@ -32,8 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rt70.arrays import check_vector
 from rt70.errors import NonFiniteError, ShapeError
+from rt70.guards.arrays import check_vector
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import placement
 

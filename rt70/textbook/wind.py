@@ -2,9 +2,9 @@
 
 For every ``<rt70:wind>`` of the model (:attr:`rt70.textbook.model.Model.winds`) the
 link's pose comes from the book's forward pass (4.5)–(4.7); the shared
-:func:`rt70.wind.wind_wrench` gives the wind's force at the reference point and its free
-moment in ground axes; the generalised force is ``Q_w = S W`` (4.129)–(4.131), i.e.
-``J_vᵀ F + J_ωᵀ M`` with the point's Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63) turned to
+:func:`rt70.physics.aerodynamics.wind_wrench` gives the wind's force at the reference point
+and its free moment in ground axes; the generalised force is ``Q_w = S W`` (4.129)–(4.131),
+i.e. ``J_vᵀ F + J_ωᵀ M`` with the point's Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63) turned to
 ground axes, all from one structure matrix S. The reference side computes the same from
 Pinocchio (:mod:`rt70.reference.wind`); ``rt70 validate`` compares them (row ``wind``).
 """
@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from rt70.arrays import check_vector
-from rt70.loads import Wrench
+from rt70.guards.arrays import check_vector
+from rt70.physics.aerodynamics import WindCondition, wind_wrench
+from rt70.physics.loads import Wrench
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import frame_pose, update_structure
 from rt70.textbook.model import Model
 from rt70.textbook.points import ground_jacobian, link_point
-from rt70.wind import WindCondition, wind_wrench
 
 
 def _force(model: Model, data: Data, wrench: Wrench) -> np.ndarray:

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rt70.wind import DEFAULT_AIR_DENSITY, CoefficientTable
+from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY, CoefficientTable
 
 #: Joint types of the URDF standard.
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -259,8 +259,8 @@ class Wind:
     shape : str
         The built-in table's name (``dish``, ``cylinder``) or the ``coefficients`` file
         as written in the URDF.
-    table : rt70.wind.CoefficientTable
-        The coefficients C_A, C_N, C_M against θ (:mod:`rt70.wind`).
+    table : rt70.physics.aerodynamics.CoefficientTable
+        The coefficients C_A, C_N, C_M against θ (:mod:`rt70.physics.aerodynamics`).
     """
 
     name: str

@@ -9,16 +9,13 @@ Called by :mod:`rt70.urdf.reader` once the joints and links are known.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rt70.errors import ExtensionError
 from rt70.urdf.description import DRIVE_PARAMETERS, Drive, DriveSector, Joint, RobotDescription
+from rt70.urdf.elements import ElementReader
 from rt70.urdf.text import RT70_NS
-
-if TYPE_CHECKING:  # the reader passes itself; no import cycle at run time
-    from rt70.urdf.reader import _Reader
 
 #: Parameters that must be positive (the others, D_m and D_r, may be zero).
 POSITIVE = ("L_a", "R_a", "c_m", "c_e", "J_m", "i_r", "C_r")
@@ -28,7 +25,7 @@ ORTHOGONALITY = 1e-9
 
 
 def read_drive(
-    reader: _Reader, elem: ET.Element, desc: RobotDescription, joints: dict[str, Joint]
+    reader: ElementReader, elem: ET.Element, desc: RobotDescription, joints: dict[str, Joint]
 ) -> Drive:
     """The :class:`Drive` of one ``<rt70:drive>`` element.
 
@@ -71,7 +68,9 @@ def read_drive(
     return Drive(name, jname, **values, sector=sector)
 
 
-def _sector(reader: _Reader, sub: ET.Element, desc: RobotDescription, name: str) -> DriveSector:
+def _sector(
+    reader: ElementReader, sub: ET.Element, desc: RobotDescription, name: str
+) -> DriveSector:
     """The sector of drive ``name``: link, mesh point, tangent, axis, radius, stator."""
     where = f"<rt70:drive name='{name}'> <rt70:sector>"
     owner = f"drive '{name}'"

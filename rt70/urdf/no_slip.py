@@ -12,22 +12,19 @@ element. Each side builds the constraint row ``A(q)`` from its own kinematics
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rt70.errors import ExtensionError
 from rt70.urdf.description import NoSlip, RobotDescription
-
-if TYPE_CHECKING:  # the reader passes itself; no import cycle at run time
-    from rt70.urdf.reader import _Reader
+from rt70.urdf.elements import ElementReader
 
 #: Shortest direction or normal vector accepted (they are normalised).
 MIN_NORM = 1e-9
 
 
 def read_no_slip(
-    reader: _Reader, elem: ET.Element, desc: RobotDescription, seen: list[NoSlip]
+    reader: ElementReader, elem: ET.Element, desc: RobotDescription, seen: list[NoSlip]
 ) -> NoSlip:
     """The :class:`NoSlip` of one ``<rt70:no_slip>`` element.
 
@@ -61,7 +58,7 @@ def read_no_slip(
     return NoSlip(name, link, xyz, direction, frame, radius, normal)
 
 
-def _unit(reader: _Reader, v: np.ndarray, where: str, attr: str) -> np.ndarray:
+def _unit(reader: ElementReader, v: np.ndarray, where: str, attr: str) -> np.ndarray:
     norm = float(np.linalg.norm(v))
     if norm < MIN_NORM:
         raise reader.fail(ExtensionError, f"{where}: {attr} {v.tolist()} has no length")

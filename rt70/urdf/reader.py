@@ -16,12 +16,10 @@ from rt70.errors import (
     ExtensionError,
     InertiaError,
     JointTypeError,
-    MagnitudeError,
-    NonFiniteError,
     TopologyError,
     UrdfError,
 )
-from rt70.rotations import rpy_matrix, rpy_of_matrix
+from rt70.physics.rotations import rpy_matrix, rpy_of_matrix
 from rt70.urdf.description import (
     URDF_JOINT_TYPES,
     Bushing,
@@ -37,6 +35,7 @@ from rt70.urdf.description import (
     RobotDescription,
 )
 from rt70.urdf.drives import read_drive
+from rt70.urdf.elements import ONE_DOF_JOINT_TYPES, ZERO3, ElementReader
 from rt70.urdf.inertia import balanced_moments, inertia_defect, principal_moments
 from rt70.urdf.no_slip import read_no_slip
 from rt70.urdf.schema import check_scene
@@ -54,17 +53,8 @@ from rt70.urdf.wind import read_air, read_wind
 #: Joint types rt70 models on both sides (the others are rejected with a clear error).
 SUPPORTED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
-#: Joint types with one coordinate (the only ones a ``<mimic>`` or a joint spring may use).
-ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
-
-#: Largest magnitude of any number rt70 reads from a URDF (docs/urdf-reader.md): a product
-#: of ten such numbers stays below the largest double (1.8e308), far more factors than
-#: any term of the equations of motion multiplies, so no evaluation can overflow.
-MAX_MAGNITUDE = 1e30
-
 #: Kinds of ``<rt70:loop>`` and their number of constraint rows.
 LOOP_TYPES = {"point": 3, "frame": 6}
-_ZERO3 = np.zeros(3)
 
 
 def read_urdf(path: str | Path, balance_inertia: bool = False) -> RobotDescription:
@@ -108,7 +98,7 @@ def read_urdf_string(
     return _Reader(source, balance_inertia, prefixes).robot(root)
 
 
-class _Reader:
+class _Reader(ElementReader):
     """One pass over the XML tree, with the source name for messages."""
 
     def __init__(
@@ -117,65 +107,13 @@ class _Reader:
         balance_inertia: bool = False,
         prefixes: dict[str, set[str]] | None = None,
     ) -> None:
-        self.source = source
+        super().__init__(source)
         self.balance_inertia = balance_inertia
         #: per namespace URI, the prefixes the document binds to it
         self.prefixes = prefixes or {}
         #: per link: what is wrong with its <inertial>, decided once the tree is known
         self.defects: dict[str, str] = {}
 
-    # --- small helpers -------------------------------------------------------------
-    def fail(self, cls: type[UrdfError], what: str) -> UrdfError:
-        return cls(f"{self.source}: {what}")
-
-    def numbers(
-        self, elem: ET.Element, attr: str, count: int, default=None, owner: str = ""
-    ) -> np.ndarray:
-        raw = elem.get(attr)
-        tag = f"{owner} <{_tag(elem)}" if owner else f"<{_tag(elem)}"
-        bad = ExtensionError if _tag(elem).startswith("rt70:") else UrdfError
-        if raw is None:
-            if default is None:
-                raise self.fail(bad, f"{tag}> lacks attribute '{attr}'")
-            return np.array(default, dtype=float)
-        try:
-            values = np.array([float(tok) for tok in raw.split()], dtype=float)
-        except ValueError:
-            raise self.fail(bad, f'{tag} {attr}="{raw}">: not a list of numbers') from None
-        if values.size != count:
-            raise self.fail(
-                bad, f'{tag} {attr}="{raw}">: expected {count} numbers, got {values.size}'
-            )
-        if not np.all(np.isfinite(values)):
-            raise self.fail(NonFiniteError, f'{tag} {attr}="{raw}">: NaN or infinite value')
-        if np.any(np.abs(values) > MAX_MAGNITUDE):
-            raise self.fail(
-                MagnitudeError,
-                f'{tag} {attr}="{raw}">: magnitude above {MAX_MAGNITUDE:g}, the largest number '
-                "rt70 reads (docs/urdf-reader.md)",
-            )
-        return values
-
-    def number(
-        self, elem: ET.Element, attr: str, default: float | None = None, owner: str = ""
-    ) -> float:
-        value = self.numbers(elem, attr, 1, None if default is None else [default], owner)
-        return float(value[0])
-
-    def name_of(self, elem: ET.Element) -> str:
-        name = elem.get("name")
-        if not name:
-            bad = ExtensionError if _tag(elem).startswith("rt70:") else UrdfError
-            raise self.fail(bad, f"<{_tag(elem)}> without a name")
-        return name
-
-    def origin(self, elem: ET.Element, owner: str) -> tuple[np.ndarray, np.ndarray]:
-        o = elem.find("origin")
-        if o is None:
-            return _ZERO3.copy(), _ZERO3.copy()
-        return self.numbers(o, "xyz", 3, _ZERO3, owner), self.numbers(o, "rpy", 3, _ZERO3, owner)
-
-    # --- the document --------------------------------------------------------------
     def robot(self, root: ET.Element) -> RobotDescription:
         refuse_xacro(root, self.source)
         if root.tag != "robot":
@@ -473,43 +411,6 @@ class _Reader:
                     raise self.fail(ExtensionError, f"two {kind} elements named '{element.name}'")
                 seen.add(element.name)
 
-    def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
-        link = elem.get(attr)
-        if not link:
-            raise self.fail(ExtensionError, f"{where} lacks attribute '{attr}'")
-        if link not in desc.links:
-            raise self.fail(ExtensionError, f"{where}: link '{link}' does not exist")
-        return link
-
-    def gains(self, elem: ET.Element, count: int, where: str) -> tuple[np.ndarray, np.ndarray]:
-        out = []
-        for attr in ("stiffness", "damping"):
-            values = self.numbers(elem, attr, count, np.zeros(count))
-            if np.any(values < 0.0):
-                raise self.fail(ExtensionError, f"{where}: negative {attr}")
-            out.append(values)
-        return out[0], out[1]
-
-    def one_dof_joint(self, elem: ET.Element, joints: dict[str, Joint], where: str) -> Joint:
-        """The 1-DOF joint an extension element names in its ``joint`` attribute.
-
-        Raises
-        ------
-        ExtensionError
-            If the attribute is missing, names no joint, or a joint that is not 1-DOF.
-        """
-        jname = elem.get("joint")
-        if not jname:
-            raise self.fail(ExtensionError, f"{where} lacks attribute 'joint'")
-        joint = joints.get(jname)
-        if joint is None:
-            raise self.fail(ExtensionError, f"{where}: joint '{jname}' does not exist")
-        if joint.type not in ONE_DOF_JOINT_TYPES:
-            raise self.fail(
-                ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"
-            )
-        return joint
-
     def joint_spring(self, elem: ET.Element, joints: dict[str, Joint]) -> JointSpring:
         name = self.name_of(elem)
         where = f"<rt70:joint_spring name='{name}'>"
@@ -521,7 +422,7 @@ class _Reader:
         sub = elem.find(f"{{{RT70_NS}}}{tag}")  # exactly one (RT70)
         link = self.link_ref(sub, "link", desc, f"{where} <rt70:{tag}>")
         return FrameRef(
-            link, self.numbers(sub, "xyz", 3, _ZERO3), self.numbers(sub, "rpy", 3, _ZERO3)
+            link, self.numbers(sub, "xyz", 3, ZERO3), self.numbers(sub, "rpy", 3, ZERO3)
         )
 
     def bushing(self, elem: ET.Element, desc: RobotDescription) -> Bushing:
@@ -548,7 +449,7 @@ class _Reader:
         sub = elem.find(f"{{{RT70_NS}}}frame2")
         if sub is not None and sub.get("link") == "world" and "world" not in desc.links:
             f2 = FrameRef(  # the ground: the root link, whatever its name
-                desc.root, self.numbers(sub, "xyz", 3, _ZERO3), self.numbers(sub, "rpy", 3, _ZERO3)
+                desc.root, self.numbers(sub, "xyz", 3, ZERO3), self.numbers(sub, "rpy", 3, ZERO3)
             )
         else:
             f2 = self.frame(elem, "frame2", desc, where)
@@ -563,13 +464,13 @@ class _Reader:
         where = f"<rt70:strut_package name='{name}'>"
         parent = self.link_ref(elem, "parent", desc, where)
         child = self.link_ref(elem, "child", desc, where)
-        origin_xyz = self.numbers(elem, "xyz", 3, _ZERO3)
-        origin_rot = rpy_matrix(self.numbers(elem, "rpy", 3, _ZERO3))
+        origin_xyz = self.numbers(elem, "xyz", 3, ZERO3)
+        origin_rot = rpy_matrix(self.numbers(elem, "rpy", 3, ZERO3))
         struts = []
         for sub in elem.findall(f"{{{RT70_NS}}}strut"):
             sname = self.name_of(sub)
-            r_s = self.numbers(sub, "xyz", 3, _ZERO3)
-            rpy_s = self.numbers(sub, "rpy", 3, _ZERO3)
+            r_s = self.numbers(sub, "xyz", 3, ZERO3)
+            rpy_s = self.numbers(sub, "rpy", 3, ZERO3)
             k, d = self.gains(sub, 6, f"{where} <rt70:strut name='{sname}'>")
             # frame 1 = package origin ∘ (r_s, c_s), expressed in the parent link
             f1_xyz = origin_xyz + origin_rot @ r_s
@@ -608,10 +509,3 @@ def _rigid_bodies(links: dict[str, Link], joints: list[Joint], root: str) -> dic
         for welded in path:
             body[welded] = body[link]
     return body
-
-
-def _tag(elem: ET.Element) -> str:
-    tag = elem.tag
-    if tag.startswith("{" + RT70_NS + "}"):
-        return "rt70:" + tag[len(RT70_NS) + 2 :]
-    return tag

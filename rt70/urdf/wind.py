@@ -4,7 +4,7 @@ One job: turn the XML of an exposed body — its link, reference point, symmetry
 reference area and length, and coefficient table — into a
 :class:`~rt70.urdf.description.Wind`, or the scene's air density, or refuse it with an
 :class:`~rt70.errors.ExtensionError` naming the file and the element. The coefficient
-table is read and checked here (:class:`rt70.wind.CoefficientTable`): a built-in
+table is read and checked here (:class:`rt70.physics.aerodynamics.CoefficientTable`): a built-in
 ``shape`` or a ``coefficients`` CSV file, relative to the URDF file's directory.
 Called by :mod:`rt70.urdf.reader`.
 """
@@ -13,19 +13,18 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rt70.errors import ExtensionError
+from rt70.physics.aerodynamics import BUILTIN_TABLES, CoefficientTable, WindError, builtin_table
 from rt70.urdf.description import RobotDescription, Wind
-from rt70.wind import BUILTIN_TABLES, CoefficientTable, WindError, builtin_table
-
-if TYPE_CHECKING:  # the reader passes itself; no import cycle at run time
-    from rt70.urdf.reader import _Reader
+from rt70.urdf.elements import ElementReader
 
 
-def read_wind(reader: _Reader, elem: ET.Element, desc: RobotDescription, seen: list[Wind]) -> Wind:
+def read_wind(
+    reader: ElementReader, elem: ET.Element, desc: RobotDescription, seen: list[Wind]
+) -> Wind:
     """The :class:`Wind` of one ``<rt70:wind>`` element.
 
     Raises
@@ -34,7 +33,7 @@ def read_wind(reader: _Reader, elem: ET.Element, desc: RobotDescription, seen: l
         If the name is missing or repeated, the link does not exist, the axis is zero,
         the area or length is not positive, not exactly one of ``shape`` and
         ``coefficients`` is given, the shape is not built in, or the coefficient file
-        is missing or malformed (:meth:`rt70.wind.CoefficientTable.from_text`).
+        is missing or malformed (:meth:`rt70.physics.aerodynamics.CoefficientTable.from_text`).
     NonFiniteError, MagnitudeError
         If a number is NaN, infinite or too large (as anywhere in the file).
     """
@@ -59,7 +58,7 @@ def read_wind(reader: _Reader, elem: ET.Element, desc: RobotDescription, seen: l
     return Wind(name, link, xyz, axis / norm, values["area"], values["length"], shape, table)
 
 
-def _table(reader: _Reader, elem: ET.Element, where: str) -> tuple[str, CoefficientTable]:
+def _table(reader: ElementReader, elem: ET.Element, where: str) -> tuple[str, CoefficientTable]:
     """The element's coefficient table: a built-in ``shape`` or a ``coefficients`` file."""
     shape, file = elem.get("shape"), elem.get("coefficients")
     if (shape is None) == (file is None):
@@ -84,7 +83,7 @@ def _table(reader: _Reader, elem: ET.Element, where: str) -> tuple[str, Coeffici
         raise reader.fail(ExtensionError, f"{where}: {exc}") from None
 
 
-def read_air(reader: _Reader, elem: ET.Element) -> float:
+def read_air(reader: ElementReader, elem: ET.Element) -> float:
     """The air density of ``<rt70:air density="...">``, kg/m³ (positive).
 
     Raises

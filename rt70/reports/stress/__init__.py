@@ -6,8 +6,8 @@ Every case is a variant of a scene built from URDF text in memory and reports
   case's initial state (``numpy.linalg.cond`` of the dense textbook A; for nv > 2000 the
   LAPACK ``dpocon`` 1-norm estimate from a Cholesky factor, marked ``≈``);
 - the cross-check error: the largest relative error over the ten quantities of
-  :func:`rt70.validate.cross_check` (textbook against Pinocchio) on a few random states;
-- a short simulation (:func:`rt70.simulate.simulate`, Pinocchio backend, BDF,
+  :func:`rt70.crosscheck.validate.cross_check` (textbook against Pinocchio) on a few random states;
+- a short simulation (:func:`rt70.simulation.simulate.simulate`, Pinocchio backend, BDF,
   ``rtol = 1e-6`` unless stated) with its outcome, accepted and rejected steps, the
   number of right-hand-side evaluations, the relative drift of the energy balance
   ``T + U_g + U_c + E_ψ`` and the wall time of the integration, capped in wall time.

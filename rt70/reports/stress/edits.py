@@ -12,7 +12,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.scene import load_scene
+from rt70.model.scene import load_scene
 from rt70.scenes.urdf_writer import fmt_vec
 
 #: Namespace of the rt70 URDF extension elements (docs/urdf-extensions.md).

@@ -4,7 +4,7 @@
   case's initial state (``numpy.linalg.cond`` of the dense textbook A; for nv > 2000 the
   LAPACK ``dpocon`` 1-norm estimate from a Cholesky factor, marked ``≈``);
 - the cross-check error: the largest relative error over the ten quantities of
-  :func:`rt70.validate.cross_check` (textbook against Pinocchio) on a few random states;
+  :func:`rt70.crosscheck.validate.cross_check` (textbook against Pinocchio) on a few random states;
 - the eigenfrequencies of the springs-only stiffness, and the linear and angular momentum
   of the structure on both sides.
 """
@@ -17,10 +17,10 @@ import numpy as np
 import scipy
 import scipy.linalg
 
-from rt70.scene import Scene
+from rt70.crosscheck.validate import cross_check, random_state
+from rt70.model.scene import Scene
 from rt70.textbook import dynamics, forces, structured
 from rt70.textbook.kinematics import update_structure
-from rt70.validate import cross_check, random_state
 
 #: Random states of each cross-check.
 CROSS_CHECK_SAMPLES = 3
@@ -77,7 +77,7 @@ def frequencies_hz(scene: Scene, q: np.ndarray | None = None) -> np.ndarray:
 
 
 def cross_check_error(scene: Scene, samples: int = CROSS_CHECK_SAMPLES, seed: int = 0):
-    """Largest relative error of :func:`rt70.validate.cross_check` and its quantity."""
+    """Largest relative error of :func:`rt70.crosscheck.validate.cross_check` and its quantity."""
     records = cross_check(scene, samples=samples, seed=seed, repeat=0)
     worst = max(records, key=lambda r: r.max_rel_err)
     return worst.max_rel_err, worst.quantity, {r.quantity: r.max_rel_err for r in records}

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import scipy
 
-from rt70.atomic import atomic_write_text
+from rt70.guards.atomic import atomic_write_text
 from rt70.reports.stress.rt70_cases import (
     gimbal_mass_matrix_cases,
     gimbal_spring_cases,
@@ -136,7 +136,7 @@ def write_report(
         "",
         "Conventions (details in the `rt70.reports.stress` docstrings): cond(A) is the 2-norm "
         "condition number of the textbook mass matrix at the case's initial state; the "
-        "cross-check error is the largest relative error of `rt70.validate.cross_check` "
+        "cross-check error is the largest relative error of `rt70.crosscheck.validate.cross_check` "
         "(textbook against Pinocchio, ten quantities) over random states (q ±0.5, "
         "q̇ ±1); 'energy drift' is the largest |T + U_g + U_c + E_ψ − const| over the "
         "run relative to the energy exchanged; 'rejected' counts rejected step attempts "

@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from rt70.errors import Rt70Error, SingularConfigurationError
+from rt70.model.scene import Scene, load_scene, scene_from_text
 from rt70.reports.stress.edits import (
     remove_spring,
     rt70_text,
@@ -29,9 +30,8 @@ from rt70.reports.stress.measures import (
 )
 from rt70.reports.stress.runs import SIM_RTOL, RunOutcome, Settings, run_capped
 from rt70.reports.stress.tables import SIM_COLUMNS, Table, short_error, sim_fields, worst_value
-from rt70.scene import Scene, load_scene, scene_from_text
 from rt70.scenes.rt70_state import listing_initial_state
-from rt70.simulate import BACKENDS
+from rt70.simulation.simulate import BACKENDS
 from rt70.textbook import dynamics, forces
 from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, GIMBAL_LOCK_COS, euler_matrix
 
@@ -310,7 +310,7 @@ def gimbal_mass_matrix_cases(quick: bool = False) -> Table:
         "falls freely under gravity) so that only the mass matrix can fail. Three "
         "forward-dynamics paths: the dense textbook `dynamics.forward_dynamics` "
         "(Cholesky, raises Rt70Error when it fails), the structured textbook backend and "
-        "the Pinocchio (ABA) backend of `rt70.simulate`. 'spread' is the largest "
+        "the Pinocchio (ABA) backend of `rt70.simulation.simulate`. 'spread' is the largest "
         "difference of q̈ between the paths that returned, relative to the largest |q̈|.",
         [
             ("k", "k"),
@@ -414,7 +414,7 @@ def gimbal_mass_matrix_cases(quick: bool = False) -> Table:
     table.notes.append(
         f"Every forward-dynamics path refuses a pair within |cos θ| < {DYNAMICS_GIMBAL_COS:g} "
         "of gimbal lock (`rt70.textbook.spatial.DYNAMICS_GIMBAL_COS`, checked by "
-        "`dynamics.forward_dynamics` and both backends of `rt70.simulate`) with "
+        "`dynamics.forward_dynamics` and both backends of `rt70.simulation.simulate`) with "
         "`SingularConfigurationError` naming the pair: k = "
         + (", ".join(refused) or "none")
         + ". Where q̈ is still returned, the paths agree (spread column); no path returns "

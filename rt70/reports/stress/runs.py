@@ -1,6 +1,6 @@
 """Capped simulations of the stress cases, with accepted and rejected steps counted.
 
-A short simulation (:func:`rt70.simulate.simulate`, Pinocchio backend, BDF,
+A short simulation (:func:`rt70.simulation.simulate.simulate`, Pinocchio backend, BDF,
 ``rtol = 1e-6`` unless stated) gives its outcome, accepted and rejected steps, the
 number of right-hand-side evaluations, the relative drift of the energy balance
 ``T + U_g + U_c + E_ψ`` and the wall time of the integration. :class:`Settings` holds the
@@ -8,7 +8,7 @@ sizes of the full report and of the quick smoke test.
 
 **Rejected steps.** ``scipy.integrate.solve_ivp`` does not report them. They are counted
 from the times at which the right-hand side is evaluated, observed through the
-``inputs`` hook of :func:`~rt70.simulate.simulate` (which returns ``Q_u = 0``, so the
+``inputs`` hook of :func:`~rt70.simulation.simulate.simulate` (which returns ``Q_u = 0``, so the
 equations are unchanged). For BDF every attempt of a step evaluates the right-hand side
 at its end time ``t + h`` (Newton iterations, Jacobian updates), so consecutive equal
 times form one attempt, and an attempt is rejected exactly when the next attempt ends
@@ -36,9 +36,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.model.scene import Scene
 from rt70.reports.stress.measures import CROSS_CHECK_SAMPLES
-from rt70.scene import Scene
-from rt70.simulate import SimulationResult, simulate
+from rt70.simulation.simulate import SimulationResult, simulate
 
 #: Simulated time of each run, s (the quick report uses :data:`QUICK_SPAN_S`).
 SIM_SPAN_S = 0.5
@@ -104,12 +104,12 @@ def run_capped(
     t_eval: np.ndarray | None = None,
     clock: Callable[[], float] = time.perf_counter,
 ) -> RunOutcome:
-    """:func:`rt70.simulate.simulate` with a wall-time cap and step/rejection counts.
+    """:func:`rt70.simulation.simulate.simulate` with a wall-time cap and step/rejection counts.
 
     Parameters
     ----------
     scene, t_span, x0, backend, method, rtol, t_eval
-        As for :func:`rt70.simulate.simulate`.
+        As for :func:`rt70.simulation.simulate.simulate`.
     cap_s : float
         The cap, s of ``clock``: checked at every right-hand-side evaluation, the first
         one past it ends the run as ``over cap`` (``math.inf``: no cap).

@@ -14,6 +14,8 @@ import numpy as np
 import scipy
 import scipy.linalg
 
+from rt70.crosscheck.validate import random_state
+from rt70.model.scene import Scene, load_scene, scene_from_text
 from rt70.reports.stress.edits import convert_units, free_floating_text, rt70_text
 from rt70.reports.stress.measures import (
     condition_number,
@@ -26,10 +28,8 @@ from rt70.reports.stress.measures import (
 )
 from rt70.reports.stress.runs import Settings, run_capped
 from rt70.reports.stress.tables import SIM_COLUMNS, Table, sim_fields, worst_value
-from rt70.scene import Scene, load_scene, scene_from_text
 from rt70.scenes.rt70_state import listing_initial_state
 from rt70.textbook import dynamics, forces, structured
-from rt70.validate import random_state
 
 #: Largest nv for which the Pinocchio side is built. Pinocchio 4.1's ``Data`` allocates
 #: O(nv³) memory (four nv × nv × nv second-order-derivative tensors, upstream issue

@@ -1,0 +1,4 @@
+"""Mechanics on scenes beyond the open tree.
+
+Nonholonomic constraints, the Chaplygin cart, locks that engage and their impacts.
+"""

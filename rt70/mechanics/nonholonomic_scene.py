@@ -1,0 +1,258 @@
+"""A scene's ``<rt70:no_slip>`` constraints, reduced or with multipliers, on either side.
+
+Joins the sides' constraint rows (:mod:`rt70.textbook.no_slip`,
+:mod:`rt70.reference.no_slip`) and dynamics to the plain algebra of
+:mod:`rt70.physics.nonholonomic` (Algorithm 002-A of companion source 002):
+
+- textbook side: ``A* = 𝔅ᵀ A 𝔅`` and ``a = 𝔅ᵀ (A 𝔅̇ q̇_ind + B q̇)`` from the book's
+  mass matrix and velocity-product force (:mod:`rt70.textbook.dynamics`);
+- reference side: ``𝔅ᵀ crba 𝔅`` and ``𝔅ᵀ rnea(q, 𝔅 q̇_ind, 𝔅̇ q̇_ind)``;
+
+each with its own ``𝔅`` (from its own A(q)) and ``𝔅̇ q̇`` (from its own ``Ȧ q̇``).
+``rt70 validate`` compares the two (rows ``no_slip`` and ``reduced_dynamics``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.model.scene import Scene
+from rt70.physics.kkt import KKTSolution
+from rt70.physics.nonholonomic import (
+    Projection,
+    ReducedSystem,
+    constrained_dynamics,
+    partition,
+    reduce,
+)
+from rt70.urdf.description import NoSlip
+
+SIDES = ("textbook", "reference")
+
+
+def elements(scene: Scene, names: Sequence[str] | None = None) -> list[NoSlip]:
+    """The scene's ``<rt70:no_slip>`` elements, all or those called ``names`` (in that order).
+
+    Raises
+    ------
+    Rt70Error
+        If the scene has none, or a name is not one of them.
+    """
+    found = {e.name: e for e in scene.description.no_slips}
+    if not found:
+        raise Rt70Error(f"{scene.path}: the scene has no <rt70:no_slip> constraint")
+    if names is None:
+        return list(found.values())
+    missing = [n for n in names if n not in found]
+    if missing:
+        raise Rt70Error(
+            f"{scene.path}: no <rt70:no_slip> called {', '.join(missing)} "
+            f"(there are: {', '.join(found)})"
+        )
+    return [found[n] for n in names]
+
+
+def _side(side: str) -> None:
+    if side not in SIDES:
+        raise Rt70Error(f"side must be one of {', '.join(SIDES)}, got '{side}'")
+
+
+def constraint_rows(
+    scene: Scene, side: str, q: np.ndarray, qd: np.ndarray, names: Sequence[str] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """``A(q)`` and ``Ȧ q̇`` of the constraints on one side."""
+    _side(side)
+    els = elements(scene, names)
+    if side == "textbook":
+        from rt70.textbook import no_slip
+
+        m, d = scene.textbook, scene.textbook_data
+    else:
+        from rt70.reference import no_slip
+
+        m, d = scene.reference, scene.reference_data
+    return no_slip.constraint_matrix(m, d, q, els), no_slip.constraint_bias(m, d, q, qd, els)
+
+
+@dataclass(frozen=True)
+class SideDynamics:
+    """One side's ``M``, velocity-product force ``h = B q̇`` and gravity force ``Q_g``."""
+
+    M: np.ndarray
+    h: np.ndarray
+    gravity: np.ndarray
+
+
+def side_dynamics(scene: Scene, side: str, q: np.ndarray, qd: np.ndarray) -> SideDynamics:
+    """``M(q)``, ``B(q, q̇) q̇`` and ``Q_g(q)`` on one side (gravity on the right-hand side)."""
+    _side(side)
+    if side == "textbook":
+        from rt70.textbook import dynamics
+
+        m, d = scene.textbook, scene.textbook_data
+    else:
+        from rt70 import reference as dynamics
+
+        m, d = scene.reference, scene.reference_data
+    return SideDynamics(
+        dynamics.mass_matrix(m, d, q),
+        dynamics.bias_force(m, d, q, qd),
+        dynamics.gravity_force(m, d, q),
+    )
+
+
+def reduced_system(
+    scene: Scene,
+    side: str,
+    q: np.ndarray,
+    qd_ind: np.ndarray,
+    independent: Sequence[int],
+    Q: np.ndarray | None = None,
+    names: Sequence[str] | None = None,
+) -> tuple[Projection, ReducedSystem]:
+    """Algorithm 002-A on one side: the projection and ``A* q̈_ind + a = Q*``.
+
+    ``Q`` is the generalised force in full coordinates besides gravity (default zero);
+    ``Q*`` includes gravity, ``𝔅ᵀ (Q + Q_g)``.
+    """
+    _side(side)
+    q = np.asarray(q, dtype=float)
+    A, _ = constraint_rows(scene, side, q, np.zeros(q.size), names)
+    proj = partition(A, independent)
+    qd = proj.basis @ np.asarray(qd_ind, dtype=float)
+    _, A_dot_qd = constraint_rows(scene, side, q, qd, names)
+    rate = proj.rate(A, A_dot_qd)
+    Q = np.zeros(q.size) if Q is None else np.asarray(Q, dtype=float)
+    if side == "textbook":
+        dyn = side_dynamics(scene, side, q, qd)
+        return proj, reduce(dyn.M, dyn.h, Q + dyn.gravity, proj.basis, rate)
+    from rt70 import reference
+    from rt70.reference import no_slip
+
+    A_star, a = no_slip.reduced_terms(
+        scene.reference, scene.reference_data, q, qd, proj.basis, rate
+    )
+    g = reference.gravity_force(scene.reference, scene.reference_data, q)
+    return proj, ReducedSystem(A_star, a, proj.basis.T @ (Q + g))
+
+
+def reduced_forward_dynamics(
+    scene: Scene,
+    side: str,
+    q: np.ndarray,
+    qd_ind: np.ndarray,
+    independent: Sequence[int],
+    Q: np.ndarray | None = None,
+    names: Sequence[str] | None = None,
+) -> np.ndarray:
+    """``q̈_ind = A*⁻¹ (Q* − a)`` of the reduced system on one side."""
+    return reduced_system(scene, side, q, qd_ind, independent, Q, names)[1].acceleration()
+
+
+def constrained_forward_dynamics(
+    scene: Scene,
+    side: str,
+    q: np.ndarray,
+    qd: np.ndarray,
+    Q: np.ndarray | None = None,
+    names: Sequence[str] | None = None,
+) -> KKTSolution:
+    """``q̈`` and the contact forces λ of the full equations with the constraints' multipliers.
+
+    ``M q̈ + B q̇ = Q_g + Q + Aᵀ λ``, ``A q̈ + Ȧ q̇ = 0``
+    (:func:`rt70.physics.nonholonomic.constrained_dynamics`).
+    """
+    q = np.asarray(q, dtype=float)
+    A, A_dot_qd = constraint_rows(scene, side, q, qd, names)
+    dyn = side_dynamics(scene, side, q, qd)
+    Q = np.zeros(q.size) if Q is None else np.asarray(Q, dtype=float)
+    return constrained_dynamics(dyn.M, dyn.h, Q + dyn.gravity, A, A_dot_qd)
+
+
+def choose_independent(A: np.ndarray) -> np.ndarray:
+    """Independent coordinates for :func:`rt70.physics.nonholonomic.partition`.
+
+    The dependent ones are the first pivots of a column-pivoted QR of A (the
+    best-conditioned ``A₂``).
+    """
+    import scipy.linalg
+
+    _, _, piv = scipy.linalg.qr(np.atleast_2d(A), pivoting=True, mode="economic")
+    return np.sort(piv[np.atleast_2d(A).shape[0] :])
+
+
+# --- rt70 validate's rows (rt70.crosscheck.validate: quantities(), _pairs(), natural_scales())
+#: Rows compared for a scene with ``<rt70:no_slip>`` elements.
+ROWS = ("no_slip", "reduced_dynamics")
+
+
+def validate_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict:
+    """Per row: (textbook evaluation, reference evaluation) at the random state (q, q̇).
+
+    ``no_slip``: ``A(q)`` and ``Ȧ q̇`` stacked. ``reduced_dynamics``: the reduced
+    ``q̈_ind`` (002-A; the independent coordinates by :func:`choose_independent` of
+    Pinocchio's A, the independent velocities those of q̇) and the multipliers λ of the
+    full equations at the admissible ``q̇ = 𝔅 q̇_ind``.
+    """
+    from rt70.reference import no_slip as ref_no_slip
+
+    els = elements(scene)
+    A_ref = ref_no_slip.constraint_matrix(scene.reference, scene.reference_data, q, els)
+    ind = choose_independent(A_ref)
+    qd_ind = qd[ind]
+
+    def rows(side: str) -> np.ndarray:
+        return np.concatenate([x.ravel() for x in constraint_rows(scene, side, q, qd)])
+
+    def reduced(side: str) -> np.ndarray:
+        proj, red = reduced_system(scene, side, q, qd_ind, ind)
+        lam = constrained_forward_dynamics(scene, side, q, proj.basis @ qd_ind).lam
+        return np.concatenate([red.acceleration(), lam])
+
+    return {
+        "no_slip": (lambda: rows("textbook"), lambda: rows("reference")),
+        "reduced_dynamics": (lambda: reduced("textbook"), lambda: reduced("reference")),
+    }
+
+
+def simulate_constrained(
+    scene: Scene,
+    side: str,
+    q0: np.ndarray,
+    qd0: np.ndarray,
+    times: np.ndarray,
+    baumgarte: float = 0.0,
+    rtol: float = 1e-12,
+    atol: float = 1e-13,
+):
+    """Integrate ``M q̈ + B q̇ = Q_g + Aᵀ λ`` with all the scene's ``<rt70:no_slip>`` rows.
+
+    The acceleration-level constraint is stabilised by a first-order perturbation
+    equation (2.2): ``d/dt (A q̇) = −k (A q̇)``, k = ``baumgarte`` (0: none). The state
+    is ``[q, q̇]``; returns scipy's solution (DOP853) at ``times``.
+    """
+    from scipy.integrate import solve_ivp
+
+    n = len(q0)
+
+    def rhs(_t, s):
+        q, qd = s[:n], s[n:]
+        A, A_dot_qd = constraint_rows(scene, side, q, qd)
+        dyn = side_dynamics(scene, side, q, qd)
+        sol = constrained_dynamics(dyn.M, dyn.h, dyn.gravity, A, A_dot_qd + baumgarte * A @ qd)
+        return np.concatenate([qd, sol.x])
+
+    times = np.asarray(times, dtype=float)
+    return solve_ivp(
+        rhs,
+        (0.0, float(times[-1])),
+        np.concatenate([q0, qd0]),
+        method="DOP853",
+        t_eval=times,
+        rtol=rtol,
+        atol=atol,
+    )

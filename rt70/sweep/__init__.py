@@ -1,0 +1,1 @@
+"""Parameter sweeps over grids of pointings, winds and scene parameters, on Dask."""

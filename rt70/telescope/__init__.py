@@ -1,0 +1,4 @@
+"""The RT-70's own studies.
+
+Servo scenarios, the wind pointing budget, gust runs and bearing loads.
+"""

@@ -1,0 +1,264 @@
+"""Servo scenarios of the RT-70: hold, 1° steps and sidereal tracking, closed on the model.
+
+One job: run the telescope with its drives closed around the nonlinear model
+(:func:`rt70.simulation.simulate.simulate` with :class:`rt70.control.servo.ServoDrive` components
+on the pointing axes ``platform_rz`` = azimuth and ``base_rx`` = π/2 − elevation) and measure
+what a servo engineer asks of it: settling time to 1″, overshoot, peak motor torque
+against its limit, pointing error in arc seconds and the tracking error after settling
+(issue 10, item 6 and the simulation half of item 4).
+
+The run starts at rest in the static equilibrium of the pointing with the drives holding
+(:func:`rt70.linear.linearize.equilibrium`): the motors' states hold the gravity torque
+(:meth:`rt70.control.drives.DcDrive.holding`) and the cascade's integrators are preset to the
+current and voltage that hold it, so a hold has no start-up transient.
+
+The drives are built by a *drive factory* (:data:`DriveFactory`): the default,
+:func:`servo_drives`, puts one :class:`~rt70.control.servo.ServoDrive` (with
+back-calculation anti-windup, :class:`rt70.control.antiwindup.BackCalculationServo`) per axis on the
+coordinates with the parameters of :mod:`rt70.scenes.rt70_drives` (the two motors of an
+axis lumped, see :func:`drive_parameters`). Another factory (drives with friction and
+backlash, or acting through the gear sector) is passed to :func:`run_scenario` in its
+place; the measurements use only the trajectory, the axis coordinates and, where a
+component has them, its ``reducer_torque`` and motor current.
+
+Pointing error: the main mirror's focal axis ``n5`` (from its focus and vertex, (4.155),
+ground axes) against the axis the structure has in static equilibrium at the
+*reference* pointing — the source direction (4.153) less the gravity sag, which a
+pointing model calibrates (:attr:`ScenarioRun.static_misalignment` reports it, (4.157)).
+Its two components are the cross-elevation and elevation errors (:func:`sky_error`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.guards.resources import check_time_series
+from rt70.linear.linearize import equilibrium, static_force
+from rt70.model.outputs import evaluate
+from rt70.model.scene import Scene
+from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE
+from rt70.scenes.rt70_optics import rt70_mirror_outputs
+from rt70.scenes.rt70_state import (
+    AZIMUTH_COORDINATE,
+    ELEVATION_COORDINATE,
+    missing_axes,
+    rt70_pointing,
+)
+from rt70.simulation.simulate import sample_channels, simulate
+from rt70.simulation.states import StateComponent
+from rt70.telescope.scenario import (  # noqa: F401  (re-exported: the scenarios' API)
+    DEFAULT_ELEVATION,
+    DEFAULT_T_END,
+    MIRROR_AXIS,
+    SCENARIOS,
+    SIDEREAL_ARCSEC_PER_S,
+    STEP_DEG,
+    Reference,
+    Scenario,
+    ScenarioRun,
+    choose,
+    elevation_azimuth,
+    mirror_axis_output,
+    scenario,
+    sky_error,
+)
+from rt70.telescope.servo_metrics import (  # noqa: F401  (re-exported: the scenario's numbers)
+    BAND_ARCSEC,
+    measure,
+    predicted_settling,
+    settling_time,
+    summary_lines,
+)
+from rt70.telescope.servo_tuning import (  # noqa: F401  (re-exported: the scenarios' API)
+    AXIS_TUNING,
+    EQUILIBRIUM_TOL,
+    DriveFactory,
+    axis_gains,
+    drive_parameters,
+    holding_excess,
+    preset_servo_state,
+    servo_drives,
+    servo_tolerances,
+    tuning_text,
+)
+
+#: Integration method of the scenarios (see :func:`run_scenario`).
+METHOD = "LSODA"
+
+
+def run_scenario(
+    scene: Scene,
+    sc: Scenario,
+    drives: DriveFactory | None = None,
+    rtol: float = 1e-6,
+    samples_per_s: float = 20.0,
+    backend: str = "pinocchio",
+    method: str | None = None,
+    progress: bool = False,
+) -> ScenarioRun:
+    """Simulate a scenario with the drives closed on the structure, and measure it.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with the RT-70's pointing axes and main-mirror optical points
+        (``rt70_servo``: the listing with its counterweight below the elevation axis).
+    sc : Scenario
+        From :func:`scenario`.
+    drives : DriveFactory, optional
+        Builds the drive components; default :func:`servo_drives`. A factory with a
+        ``start(scene, held)`` method returns the start state and the holding torques
+        itself (``(q0, {coordinate: torque})``, e.g. the equilibrium with a gear
+        sector's force, :mod:`rt70.telescope.scene_servo`); otherwise the start is the
+        equilibrium with the axes held by torques on their coordinates.
+    rtol, backend, progress
+        As :func:`rt70.simulation.simulate.simulate`.
+    method : str, optional
+        The integration method; default :data:`METHOD` (LSODA). scipy's BDF and Radau
+        stop at random on a hold ("Required step size is less than spacing between
+        numbers": measured at 30° and 90°, 60 s): at rest every Newton correction is
+        rounding noise, their ratio reaches 1 and the iteration is declared diverging at
+        any step size; LSODA's own test does not (60 s hold at 30°: 3.9e-7″, 17 s wall).
+    samples_per_s : float
+        Output samples per second of simulated time.
+    """
+    names = scene.coordinate_names
+    missing = missing_axes(names)
+    if missing:
+        raise Rt70Error(f"{scene.name}: no RT-70 pointing axis '{missing[0]}': no servo scenario")
+    drives = servo_drives() if drives is None else drives
+    ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
+    held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)
+    start = getattr(drives, "start", None)
+    if start is None:
+        q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
+        Q0 = static_force(scene, q0)
+        torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
+    else:  # a factory whose drives do not push on the coordinates alone
+        q0, torques = start(scene, held)
+    # references in coordinate radians: platform_rz = A, base_rx = π/2 − E
+    a0, e0 = q0[ia], q0[ie]
+    refs = {
+        AZIMUTH_COORDINATE: lambda t: a0 + np.radians(sc.azimuth(t)),
+        ELEVATION_COORDINATE: lambda t: e0 - np.radians(sc.elevation(t)),
+    }
+    components = drives(scene, q0, torques, refs)
+    if sc.t_end * samples_per_s < 1.0:
+        raise Rt70Error(
+            f"{scene.name}: --t-end {sc.t_end:g}: a scenario is measured on samples every "
+            f"{1 / samples_per_s:g} s; it must last at least that long"
+        )
+    n_t = np.ceil(sc.t_end * samples_per_s) + 1
+    check_time_series(
+        n_t,
+        sample_channels(
+            len(names), 2 + sum(len(c.names) for c in components), [mirror_axis_output(scene)]
+        ),
+        f"scenario '{sc.name}' sampled {samples_per_s:g} times a second",
+        f"{scene.name}: --t-end {sc.t_end:g}",
+    )
+    n_t = int(n_t)
+    t_eval = np.linspace(0.0, sc.t_end, n_t)
+    result = simulate(
+        scene,
+        (0.0, sc.t_end),
+        (q0, np.zeros(scene.textbook.nv)),
+        backend=backend,
+        method=METHOD if method is None else method,
+        rtol=rtol,
+        t_eval=t_eval,
+        outputs=[mirror_axis_output(scene)],
+        components=components,
+        progress=progress,
+    )
+    if not result.success:
+        raise Rt70Error(f"{scene.name}: scenario '{sc.name}': {result.message}")
+    t = result.t
+    reference = {
+        "azimuth": np.array([refs[AZIMUTH_COORDINATE](x) for x in t]),
+        "elevation": np.array([refs[ELEVATION_COORDINATE](x) for x in t]),
+    }
+    error = {
+        "azimuth": (reference["azimuth"] - result.q[:, ia]) / ARCSEC,
+        # elevation = π/2 − base_rx: its error is the coordinate's with the sign turned
+        "elevation": -(reference["elevation"] - result.q[:, ie]) / ARCSEC,
+    }
+    e_ref = sc.elevation_deg + np.array([sc.elevation(x) for x in t])
+    a_ref = sc.azimuth_deg + np.array([sc.azimuth(x) for x in t])
+    rest = None if start is None else (lambda held: start(scene, held)[0])
+    target = _target_axes(scene, q0, t, e_ref, a_ref, rest)
+    n = result.outputs[MIRROR_AXIS]
+    pointing = sky_error(n, target)
+    cosang = np.clip((n * target).sum(1), -1.0, 1.0)
+    total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / ARCSEC
+    torque, current, limits = _drive_torques(components, result, names)
+    static = _static_misalignment(scene, q0, sc)
+    run = ScenarioRun(
+        sc,
+        result,
+        reference,
+        error,
+        torque,
+        limits,
+        current,
+        pointing,
+        total,
+        static,
+        torques,
+        list(components),
+    )
+    run.metrics = measure(run)
+    return run
+
+
+def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
+    """The main mirror's axis in equilibrium at the reference pointing, per sample.
+
+    Equilibria at the distinct reference pointings of a few knots (first, last, and
+    where the reference changes), linearly interpolated in between and normalised.
+    ``rest(held)`` gives the equilibrium when the drive factory has its own start (the
+    drives' forces in it); default the axes held by torques on their coordinates.
+    """
+    out = mirror_axis_output(scene)
+    knots = np.unique(np.r_[0, np.linspace(0, len(t) - 1, 5).astype(int), len(t) - 1])
+    cache: dict[tuple[float, float], np.ndarray] = {}
+    axes = []
+    for k in knots:
+        key = (round(float(e_ref[k]), 12), round(float(a_ref[k]), 12))
+        if key not in cache:
+            held = rt70_pointing(*key)
+            q = equilibrium(scene, held, tol=EQUILIBRIUM_TOL) if rest is None else rest(held)
+            cache[key] = evaluate(scene, q, [out], "reference")[MIRROR_AXIS]
+        axes.append(cache[key])
+    axes = np.array(axes)
+    # between knots, a step reference is constant after t = 0: interpolation is exact
+    target = np.column_stack([np.interp(np.arange(len(t)), knots, axes[:, i]) for i in range(3)])
+    return target / np.linalg.norm(target, axis=1, keepdims=True)
+
+
+def _static_misalignment(scene: Scene, q0: np.ndarray, sc: Scenario) -> float:
+    """(4.157) of the main mirror at the start equilibrium: the gravity sag, arc seconds."""
+    outs = [o for o in rt70_mirror_outputs(scene, sc.elevation_deg, sc.azimuth_deg)]
+    outs = [o for o in outs if o.name == "main_mirror_misalignment"]
+    return float(evaluate(scene, q0, outs, "reference")["main_mirror_misalignment"][0])
+
+
+def _drive_torques(components: Sequence[StateComponent], result, names):
+    """Axis-side reducer torque and motor current of each drive that has them."""
+    torque, current, limits = {}, {}, {}
+    for c in components:
+        if not hasattr(c, "reducer_torque"):
+            continue
+        axis = c.names[0].split(":")[0]
+        s = np.column_stack([result.states[n] for n in c.names])
+        torque[axis] = np.array(
+            [c.reducer_torque(q, qd, x) for q, qd, x in zip(result.q, result.qd, s, strict=True)]
+        )
+        current[axis] = s[:, 0]
+        table = AZIMUTH_DRIVE if c.index == names.index(AZIMUTH_COORDINATE) else ELEVATION_DRIVE
+        peak = getattr(getattr(c, "g", None), "current_limit", np.inf) * c.p.c_m * c.p.i_r
+        limits[axis] = (table.nominal_torque, float(peak))
+    return torque, current, limits

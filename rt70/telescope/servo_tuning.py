@@ -1,0 +1,170 @@
+"""The servo tuning of the RT-70's axes: drive parameters, cascade gains, tolerances, holding.
+
+One job: say how the scenarios' servos are built from the RT-70's drive data
+(:mod:`rt70.scenes.rt70_drives`): the cascade gains of each axis at the chosen position-loop
+bandwidth (:data:`AXIS_TUNING`, docs/servo-scenarios.md), the state a servo starts in when
+it already holds the structure, the integration tolerances of its states, and whether the
+drives can hold the telescope at a pointing at all.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from rt70.bondgraph.parameters import DriveParameters
+from rt70.control.antiwindup import BackCalculationServo
+from rt70.control.geartrains import equivalent_drive
+from rt70.control.servo import CascadeGains, ServoDrive, cascade_gains
+from rt70.linear.linearize import equilibrium, static_force
+from rt70.model.scene import Scene
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE, AxisDrive
+from rt70.scenes.rt70_state import (
+    AZIMUTH_COORDINATE,
+    ELEVATION_COORDINATE,
+    rt70_pointing,
+)
+from rt70.simulation.states import StateComponent
+
+#: Position-loop bandwidths (Hz) and the ratio between nested loops chosen for the
+#: RT-70 (see docs/servo-scenarios.md): the azimuth loops sit below the 0.92 Hz
+#: locked-rotor resonance, the elevation loops below its 2.77 Hz one.
+AXIS_TUNING = {"azimuth": (0.2, 5.0), "elevation": (0.5, 5.0)}
+
+
+#: Force tolerance of the static equilibria (relative): rt70_servo's Newton residual
+#: stalls at its rounding floor, 1.2e-10 at elevation 30° (above equilibrium's default
+#: 1e-10); 1e-9 of the ~1e7 N·m gravity torque is 0.01 N·m, nothing to the pointing.
+EQUILIBRIUM_TOL = 1e-9
+
+
+#: Builds the drive components: (scene, q0, held torques by coordinate, references in
+#: coordinate radians by coordinate) -> components.
+DriveFactory = Callable[
+    [Scene, np.ndarray, dict[str, float], dict[str, Callable[[float], float]]],
+    list[StateComponent],
+]
+
+
+def drive_parameters(axis: AxisDrive) -> DriveParameters:
+    """One :class:`DcDrive`'s parameters for an axis's motors, lumped.
+
+    The axis's ``n`` identical motors turn the same gear at the same speed; taken with
+    their armatures in series (one current), they are one motor with ``n`` times the
+    inductance, resistance, torque and back-EMF constants, rotor inertia and viscous
+    friction (the time constants L_a/R_a and J_m R_a/(c_m c_e) are unchanged). The
+    counter-torque between the two gear trains is not modelled here (a factory with the
+    gear trains takes its place). ``J_l`` is the table's reference inertia of the axis.
+    """
+    p = axis.motor_parameters(axis.reference_inertia)
+    return equivalent_drive(p, axis.motors_per_axis)
+
+
+def axis_gains(axis: AxisDrive, position_hz: float, ratio: float) -> CascadeGains:
+    """The cascade of one axis with the table's limits (:func:`rt70.control.servo.cascade_gains`).
+
+    Current reference clamped to the peak torque (2 I_n per motor), axis rate to the
+    table's rate limit, armature voltage to the motors' rated voltage (n U_n lumped).
+    """
+    p = drive_parameters(axis)
+    return cascade_gains(
+        p,
+        axis.reference_inertia,
+        position_hz=position_hz,
+        ratio=ratio,
+        current_limit=axis.motor.peak_torque / axis.motor.torque_constant,
+        rate_limit=axis.servo.rate_limit,
+        voltage_limit=axis.motors_per_axis * axis.motor.rated_voltage,
+    )
+
+
+def preset_servo_state(p: DriveParameters, gains: CascadeGains, angle: float, torque: float):
+    """States of a :class:`ServoDrive` holding ``torque`` at ``angle`` at rest, loops settled.
+
+    ``[I, α_m, ω_m]`` of :meth:`DcDrive.holding`, the position integral 0 (no rate
+    asked), the rate integral giving the holding current ``I = K_i,v ∫e_v`` and the
+    current integral the voltage ``R_a I = K_i,i ∫e_i``.
+    """
+    hold = ServoDrive.holding(p, angle, torque)
+    return np.concatenate([hold, [0.0, hold[0] / gains.ki_v, p.R_a * hold[0] / gains.ki_i]])
+
+
+def servo_tolerances(p: DriveParameters, axis_atol: float = 1e-9) -> np.ndarray:
+    """Absolute tolerances of a ServoDrive's states matching ``axis_atol`` on its axis.
+
+    Motor-side angles and speeds (and the rate integral) are ``i_r`` times the axis's,
+    so their tolerance is ``i_r · axis_atol``; currents (and the current integral) get
+    ``axis_atol · C_r / (c_m i_r)`` — the current whose torque twists the reducer by
+    ``axis_atol``. The drive's default 1e-9 on every state asks the motor angle for
+    1e-14 rad on the axis, below the rounding of the axis angle: at the zenith, where
+    the motor angle is near zero and the relative tolerance does not help, BDF's step
+    collapsed ("Required step size is less than spacing between numbers", 60 s hold at
+    90°).
+    """
+    motor = p.i_r * axis_atol
+    amp = axis_atol * p.C_r / (p.c_m * p.i_r)
+    return np.array([amp, motor, motor, axis_atol, motor, amp])
+
+
+def servo_drives(tuning: dict[str, tuple[float, float]] | None = None) -> DriveFactory:
+    """The default factory: one ServoDrive per axis, on the coordinates, holding at start.
+
+    Parameters
+    ----------
+    tuning : dict, optional
+        ``{"azimuth": (position_hz, ratio), "elevation": (...)}``; default
+        :data:`AXIS_TUNING`.
+    """
+    tuning = {**AXIS_TUNING, **(tuning or {})}
+
+    def build(scene, q0, torques, references):
+        names = scene.coordinate_names
+        out: list[StateComponent] = []
+        for coordinate, axis in (
+            (AZIMUTH_COORDINATE, AZIMUTH_DRIVE),
+            (ELEVATION_COORDINATE, ELEVATION_DRIVE),
+        ):
+            p = drive_parameters(axis)
+            gains = axis_gains(axis, *tuning[axis.name])
+            k = names.index(coordinate)
+            initial = preset_servo_state(p, gains, q0[k], torques[coordinate])
+            ref = references[coordinate]
+            atol = servo_tolerances(p)
+            out.append(
+                BackCalculationServo(axis.name, names, coordinate, p, gains, ref, initial, atol)
+            )
+        return out
+
+    return build
+
+
+def tuning_text(tuning: dict[str, tuple[float, float]] | None = None) -> str:
+    """The position-loop bandwidths in one phrase, e.g. ``position loops az 0.2 Hz, el 0.5 Hz``."""
+    t = {**AXIS_TUNING, **(tuning or {})}
+    return f"position loops az {t['azimuth'][0]:g} Hz, el {t['elevation'][0]:g} Hz"
+
+
+def holding_excess(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> str | None:
+    """Why the drives cannot hold ``scene`` at a pointing, or None if they can.
+
+    The static torque the drives must supply on each axis at the equilibrium of the
+    pointing, against the table's nominal (continuous) drive torque. The RT-70 listing
+    as printed needs 2.66× it on elevation at the horizon (docs/rt70-errata.md item 12).
+    """
+    held = rt70_pointing(elevation_deg, azimuth_deg)
+    q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
+    Q0 = static_force(scene, q0)
+    names = scene.coordinate_names
+    for coordinate, axis in (
+        (AZIMUTH_COORDINATE, AZIMUTH_DRIVE),
+        (ELEVATION_COORDINATE, ELEVATION_DRIVE),
+    ):
+        torque = abs(float(Q0[names.index(coordinate)]))
+        if torque > axis.nominal_torque:
+            return (
+                f"gravity torque {torque:.3g} N·m on {axis.name} at elevation {elevation_deg:g}° "
+                f"exceeds the drive's nominal {axis.nominal_torque:.3g} N·m "
+                "(docs/rt70-errata.md item 12)"
+            )
+    return None

@@ -1,0 +1,164 @@
+"""What every element reader of a URDF file needs: numbers, names, links, joints, errors.
+
+:class:`ElementReader` is the part of the reader (:mod:`rt70.urdf.reader`) that the readers
+of single extension elements (:mod:`rt70.urdf.drives`, :mod:`rt70.urdf.no_slip`,
+:mod:`rt70.urdf.wind`) use: each error it raises names the file, the element and the
+attribute (docs/urdf-reader.md).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from rt70.errors import ExtensionError, MagnitudeError, NonFiniteError, UrdfError
+from rt70.urdf.description import Joint, RobotDescription
+from rt70.urdf.text import RT70_NS
+
+#: Largest magnitude of any number rt70 reads from a URDF (docs/urdf-reader.md): a product
+#: of ten such numbers stays below the largest double (1.8e308), far more factors than
+#: any term of the equations of motion multiplies, so no evaluation can overflow.
+MAX_MAGNITUDE = 1e30
+
+#: Joint types with one coordinate (the only ones a ``<mimic>`` or a joint spring may use).
+ONE_DOF_JOINT_TYPES = ("revolute", "continuous", "prismatic")
+
+#: The zero vector an absent ``<origin>`` stands for.
+ZERO3 = np.zeros(3)
+
+
+class ElementReader:
+    """Reads the attributes of the elements of one file, with the file's name for messages.
+
+    Parameters
+    ----------
+    source : str
+        The file (or the text's label) that every error names.
+    """
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, cls: type[UrdfError], what: str) -> UrdfError:
+        """The error ``cls`` with the file's name in front of ``what`` (to be raised)."""
+        return cls(f"{self.source}: {what}")
+
+    def numbers(
+        self, elem: ET.Element, attr: str, count: int, default=None, owner: str = ""
+    ) -> np.ndarray:
+        """The ``count`` numbers of attribute ``attr`` of ``elem``.
+
+        Parameters
+        ----------
+        elem : xml.etree.ElementTree.Element
+            The element that carries the attribute.
+        attr : str
+            The attribute's name.
+        count : int
+            How many numbers the attribute must hold.
+        default : array_like, optional
+            The value of an absent attribute; None: the attribute is required.
+        owner : str, optional
+            The element that holds ``elem``, for messages (``<joint name='j'>``).
+
+        Raises
+        ------
+        UrdfError
+            (ExtensionError for an rt70 element) if the attribute is missing and required,
+            is not a list of ``count`` numbers; NonFiniteError for a NaN or infinity;
+            MagnitudeError beyond :data:`MAX_MAGNITUDE`.
+        """
+        raw = elem.get(attr)
+        tag = f"{owner} <{tag_of(elem)}" if owner else f"<{tag_of(elem)}"
+        bad = ExtensionError if tag_of(elem).startswith("rt70:") else UrdfError
+        if raw is None:
+            if default is None:
+                raise self.fail(bad, f"{tag}> lacks attribute '{attr}'")
+            return np.array(default, dtype=float)
+        try:
+            values = np.array([float(tok) for tok in raw.split()], dtype=float)
+        except ValueError:
+            raise self.fail(bad, f'{tag} {attr}="{raw}">: not a list of numbers') from None
+        if values.size != count:
+            raise self.fail(
+                bad, f'{tag} {attr}="{raw}">: expected {count} numbers, got {values.size}'
+            )
+        if not np.all(np.isfinite(values)):
+            raise self.fail(NonFiniteError, f'{tag} {attr}="{raw}">: NaN or infinite value')
+        if np.any(np.abs(values) > MAX_MAGNITUDE):
+            raise self.fail(
+                MagnitudeError,
+                f'{tag} {attr}="{raw}">: magnitude above {MAX_MAGNITUDE:g}, the largest number '
+                "rt70 reads (docs/urdf-reader.md)",
+            )
+        return values
+
+    def number(
+        self, elem: ET.Element, attr: str, default: float | None = None, owner: str = ""
+    ) -> float:
+        """The one number of attribute ``attr`` (:meth:`numbers` with ``count`` = 1)."""
+        value = self.numbers(elem, attr, 1, None if default is None else [default], owner)
+        return float(value[0])
+
+    def name_of(self, elem: ET.Element) -> str:
+        """The element's ``name`` attribute; an element without one is an error."""
+        name = elem.get("name")
+        if not name:
+            bad = ExtensionError if tag_of(elem).startswith("rt70:") else UrdfError
+            raise self.fail(bad, f"<{tag_of(elem)}> without a name")
+        return name
+
+    def origin(self, elem: ET.Element, owner: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(xyz, rpy)`` of the element's ``<origin>``, zeros where it is absent."""
+        o = elem.find("origin")
+        if o is None:
+            return ZERO3.copy(), ZERO3.copy()
+        return self.numbers(o, "xyz", 3, ZERO3, owner), self.numbers(o, "rpy", 3, ZERO3, owner)
+
+    def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
+        """The link that attribute ``attr`` names; a missing or unknown link is an error."""
+        link = elem.get(attr)
+        if not link:
+            raise self.fail(ExtensionError, f"{where} lacks attribute '{attr}'")
+        if link not in desc.links:
+            raise self.fail(ExtensionError, f"{where}: link '{link}' does not exist")
+        return link
+
+    def gains(self, elem: ET.Element, count: int, where: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(stiffness, damping)``, ``count`` numbers each (zero when absent, never negative)."""
+        out = []
+        for attr in ("stiffness", "damping"):
+            values = self.numbers(elem, attr, count, np.zeros(count))
+            if np.any(values < 0.0):
+                raise self.fail(ExtensionError, f"{where}: negative {attr}")
+            out.append(values)
+        return out[0], out[1]
+
+    def one_dof_joint(self, elem: ET.Element, joints: dict[str, Joint], where: str) -> Joint:
+        """The 1-DOF joint an extension element names in its ``joint`` attribute.
+
+        Raises
+        ------
+        ExtensionError
+            If the attribute is missing, names no joint, or a joint that is not 1-DOF.
+        """
+        jname = elem.get("joint")
+        if not jname:
+            raise self.fail(ExtensionError, f"{where} lacks attribute 'joint'")
+        joint = joints.get(jname)
+        if joint is None:
+            raise self.fail(ExtensionError, f"{where}: joint '{jname}' does not exist")
+        if joint.type not in ONE_DOF_JOINT_TYPES:
+            raise self.fail(
+                ExtensionError, f"{where}: joint '{jname}' is {joint.type}, not a 1-DOF joint"
+            )
+        return joint
+
+
+def tag_of(elem: ET.Element) -> str:
+    """The element's tag as written in a file: ``rt70:name`` for rt70's namespace."""
+    tag = elem.tag
+    if tag.startswith("{" + RT70_NS + "}"):
+        return "rt70:" + tag[len(RT70_NS) + 2 :]
+    return tag

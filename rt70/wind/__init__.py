@@ -1,0 +1,1 @@
+"""The wind as a load in time: the steady wind component and Davenport gusts."""
