@@ -395,7 +395,7 @@ _SIGTERM_BETWEEN_RENAMES = r"""
 import os, signal, sys
 from pathlib import Path
 from rt70.guards.atomic import atomic_write_all
-from rt70.cli.options import sigterm_exits
+from rt70.cli.options import stop_signals
 
 real_replace = os.replace
 def replace_then_sigterm(src, dst):  # SIGTERM right after the first rename
@@ -403,7 +403,7 @@ def replace_then_sigterm(src, dst):  # SIGTERM right after the first rename
     os.kill(os.getpid(), signal.SIGTERM)
 os.replace = replace_then_sigterm
 d = Path(sys.argv[1])
-with sigterm_exits(143):
+with stop_signals(143):
     atomic_write_all({d / "a.csv": lambda t: t.write_text("new"),
                       d / "a.png": lambda t: t.write_text("new")})
     print("not reached: SIGTERM is delivered once the renames are done")

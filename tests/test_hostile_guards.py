@@ -189,7 +189,55 @@ def test_the_budget_counts_evaluations():
         with pytest.raises(SimulationError, match="stopped after 15 right-hand"):
             rhs(0.0, np.ones(1))
     assert len(calls) == 15
-    assert integrators.budgeted(np.negative, 5.0) is np.negative  # no budget outside
+    unlimited = integrators.budgeted(lambda t, x: -x, 5.0)  # no budget outside: no count
+    assert all(unlimited(0.0, np.ones(1)) == -1.0 for _ in range(10**4))
+
+
+@pytest.mark.parametrize("limited", [True, False])
+def test_a_lost_stop_is_raised_again_at_the_next_evaluation(limited):
+    """A Ctrl-C swallowed where it was raised (a finaliser, a library's broad except) is
+    not lost: the right-hand side raises the recorded stop until the command is over."""
+    from rt70.guards import stop
+
+    budget = integrators.EvaluationBudget(10**6, 1.0) if limited else None
+    with integrators.evaluation_budget(budget):
+        rhs = integrators.budgeted(lambda t, x: -x, 5.0)
+        assert rhs(0.0, np.ones(1))[0] == -1.0
+        try:
+            stop.request(KeyboardInterrupt)
+        except KeyboardInterrupt:
+            pass  # swallowed, as a library might
+        try:
+            for _ in range(2):
+                with pytest.raises(KeyboardInterrupt):
+                    rhs(0.0, np.ones(1))
+        finally:
+            stop.clear()
+        assert rhs(0.0, np.ones(1))[0] == -1.0 and not stop.requested()
+
+
+def test_stop_signals_record_and_raise_and_clear(monkeypatch):
+    """The command line's SIGINT and SIGTERM handlers raise, record, and forget on exit."""
+    import signal
+
+    from rt70.cli.options import stop_signals
+    from rt70.guards import stop
+
+    with stop_signals(143):
+        with pytest.raises(KeyboardInterrupt):
+            signal.raise_signal(signal.SIGINT)
+        assert stop.requested()
+        with pytest.raises(KeyboardInterrupt):
+            stop.check()
+    assert not stop.requested()
+    with stop_signals(143):
+        with pytest.raises(SystemExit) as exc:
+            signal.raise_signal(signal.SIGTERM)
+        assert exc.value.code == 143
+        with pytest.raises(SystemExit):
+            stop.check()
+    assert not stop.requested()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_a_run_kept_step_by_step_checks_its_pace_against_memory():

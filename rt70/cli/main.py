@@ -484,7 +484,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
     guards = options.warning_guards(args.command)  # module docstring
     with (
-        options.sigterm_exits(EXIT_TERMINATED),
+        options.stop_signals(EXIT_TERMINATED),
         options.checked_stdout(),  # '> file' on a full disk: one line, exit 2
         warnings.catch_warnings(),
         guards,

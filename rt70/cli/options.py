@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from rt70.errors import OutputError, Rt70Error, Rt70Warning
+from rt70.guards import stop
 from rt70.scenes.rt70_state import ELEVATION_RANGE
 
 #: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
@@ -456,21 +457,33 @@ def _numerical(exc: RuntimeWarning) -> str:
 
 # --- signals -----------------------------------------------------------------------------
 @contextmanager
-def sigterm_exits(code: int) -> Iterator[None]:
-    """Inside the block, SIGTERM raises ``SystemExit(code)``: ``finally`` blocks run.
+def stop_signals(code: int) -> Iterator[None]:
+    """Inside the block SIGTERM raises ``SystemExit(code)`` and SIGINT ``KeyboardInterrupt``.
 
-    Temporary output files are removed that way (:mod:`rt70.guards.atomic`). The previous
-    handler is restored afterwards; outside the main thread nothing changes.
+    ``finally`` blocks run, so temporary output files are removed
+    (:mod:`rt70.guards.atomic`). Each stop is recorded as well
+    (:func:`rt70.guards.stop.request`), so one raised where it gets lost is raised again
+    at the integrators' next right-hand side (:func:`rt70.guards.stop.check`). The previous
+    handlers are restored afterwards and the record cleared; outside the main thread
+    nothing changes.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def terminate(signum: int, _frame: object) -> NoReturn:
-        raise SystemExit(code)
+        stop.request(lambda: SystemExit(code))
 
-    previous = signal.signal(signal.SIGTERM, terminate)
+    def interrupt(signum: int, _frame: object) -> NoReturn:
+        stop.request(KeyboardInterrupt)
+
+    previous = {
+        signal.SIGTERM: signal.signal(signal.SIGTERM, terminate),
+        signal.SIGINT: signal.signal(signal.SIGINT, interrupt),
+    }
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        stop.clear()

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rt70.errors import SimulationError
+from rt70.guards import stop
 
 #: scipy.integrate.solve_ivp methods.
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
@@ -107,7 +108,9 @@ def budgeted(rhs: Rhs, span: float, limit: int | None = None, t0: float = 0.0) -
     """``rhs`` counting its calls; past the limit it raises :class:`SimulationError`.
 
     The limit is the smaller of ``limit`` and the budget in force
-    (:func:`evaluation_budget`); with neither, ``rhs`` is returned unchanged.
+    (:func:`evaluation_budget`); with neither, only the stop check remains. Every call
+    first raises a stop the command line recorded (:func:`rt70.guards.stop.check`): a
+    Ctrl-C or SIGTERM lost inside a library is raised again at the next evaluation.
 
     ``limit`` is the most samples a run without output times may keep (one per step,
     each step at least one evaluation: :func:`rt70.guards.resources.time_series_samples`). Such
@@ -125,11 +128,17 @@ def budgeted(rhs: Rhs, span: float, limit: int | None = None, t0: float = 0.0) -
     budget = _BUDGET.get()
     limits = [x for x in (limit, None if budget is None else budget.limit(span)) if x is not None]
     if not limits:
-        return rhs
+
+        def stoppable(t: float, x: np.ndarray) -> np.ndarray:
+            stop.check()
+            return rhs(t, x)
+
+        return stoppable
     most = min(limits)
     calls = [0]
 
     def counted(t: float, x: np.ndarray) -> np.ndarray:
+        stop.check()
         calls[0] += 1
         if calls[0] == PACE_CHECK and limit is not None:
             _check_pace(t - t0, span, limit)
