@@ -87,3 +87,15 @@ def test_installed_package_ships_the_wind_tables(installed, tmp_path):
     )
     proc = _run([str(installed / "python"), "-c", code], tmp_path)
     assert proc.stdout.split()[:2] == ["1.42", "1.2"]
+
+
+def test_installed_package_is_typed_and_knows_its_version(installed, tmp_path):
+    """The PEP 561 marker ships in the wheel; --version reads the wheel's metadata."""
+    code = "from importlib.resources import files; print(files('rt70').joinpath('py.typed'))"
+    proc = _run([str(installed / "python"), "-c", code], tmp_path)
+    marker = Path(proc.stdout.strip())
+    assert marker.is_file() and marker.stat().st_size == 0
+    assert not str(marker).startswith(str(ROOT))
+    proc = _run([str(installed / "rt70"), "--version"], tmp_path)
+    version = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert proc.stdout == f"rt70 {version['project']['version']}\n"
