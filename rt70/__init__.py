@@ -22,7 +22,18 @@ from rt70.errors import (
     XacroError,
 )
 
-__version__ = "0.1.0"
+
+def __getattr__(name: str) -> str:
+    """``rt70.__version__``: the installed distribution's version (pyproject.toml's).
+
+    Read from the package metadata on first use, so that importing rt70 stays cheap.
+    """
+    if name == "__version__":
+        from importlib.metadata import version
+
+        return version("rt70")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "DtdError",

@@ -2,8 +2,10 @@
 
 The wheel is built from this tree, installed into a fresh virtual environment (no
 editable install, no source tree on the path) and ``rt70 validate`` is run from a
-temporary directory: the scenes must ship with the package. About a minute: the
-fresh environment installs rt70's dependencies from the package index.
+temporary directory: the scenes must ship with the package. The install has no extras,
+so the robots of example-robot-data are absent and asking for them names the extra.
+About a minute: the fresh environment installs rt70's dependencies from the package
+index.
 """
 
 from __future__ import annotations
@@ -87,3 +89,40 @@ def test_installed_package_ships_the_wind_tables(installed, tmp_path):
     )
     proc = _run([str(installed / "python"), "-c", code], tmp_path)
     assert proc.stdout.split()[:2] == ["1.42", "1.2"]
+
+
+def test_installed_package_is_typed_and_knows_its_version(installed, tmp_path):
+    """The PEP 561 marker ships in the wheel; --version reads the wheel's metadata."""
+    code = "from importlib.resources import files; print(files('rt70').joinpath('py.typed'))"
+    proc = _run([str(installed / "python"), "-c", code], tmp_path)
+    marker = Path(proc.stdout.strip())
+    assert marker.is_file() and marker.stat().st_size == 0
+    assert not str(marker).startswith(str(ROOT))
+    proc = _run([str(installed / "rt70"), "--version"], tmp_path)
+    version = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert proc.stdout == f"rt70 {version['project']['version']}\n"
+
+
+def test_core_install_without_robots_says_which_extra(installed, tmp_path):
+    """The wheel without extras has no example-robot-data: 'robots' names the extra."""
+    code = (
+        "import importlib.metadata as m\n"
+        "try:\n    m.version('example-robot-data')\n"
+        "except m.PackageNotFoundError:\n    print('absent')\n"
+    )
+    assert _run([str(installed / "python"), "-c", code], tmp_path).stdout == "absent\n"
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    proc = subprocess.run(
+        [str(installed / "rt70"), "validate", "robots"],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=HANG_GUARD_S,
+        check=False,
+    )
+    assert (proc.returncode, proc.stdout) == (2, "")
+    assert proc.stderr == (
+        "rt70: error: the robots of example-robot-data are not installed: "
+        "pip install 'rt70[robots]'\n"
+    )

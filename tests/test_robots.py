@@ -6,7 +6,14 @@ import pytest
 
 import rt70.crosscheck.robots
 from rt70.cli.main import main
-from rt70.crosscheck.robots import ROBOTS, UNEXPECTED, load_robot, robots_dir, survey
+from rt70.crosscheck.robots import (
+    NOT_INSTALLED,
+    ROBOTS,
+    UNEXPECTED,
+    load_robot,
+    robots_dir,
+    survey,
+)
 from rt70.crosscheck.validate import cross_check
 from rt70.errors import Rt70Error, SceneError
 from rt70.testing import assert_close
@@ -110,8 +117,31 @@ def test_unknown_robot_is_bad_input():
 
 def test_missing_package_is_a_clear_error(monkeypatch, tmp_path):
     monkeypatch.setattr(rt70.crosscheck.robots, "_candidates", lambda: [tmp_path])
-    with pytest.raises(Rt70Error, match="example-robot-data is not installed"):
+    with pytest.raises(Rt70Error) as exc:
         robots_dir()
+    assert str(exc.value) == NOT_INSTALLED
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["validate", "robots"], ["validate", "rt70", "robot:ur5"], ["bench", "--quick"]],
+    ids=["validate-robots", "validate-robot-name", "bench"],
+)
+def test_commands_without_the_robots_extra_exit_2(argv, monkeypatch, tmp_path, capsys):
+    """Without example-robot-data (a core install): one line naming the extra, exit 2.
+
+    The finder sees an environment without the package: no prefix holds the robots.
+    """
+    monkeypatch.setattr(rt70.crosscheck.robots, "_candidates", lambda: [tmp_path])
+    out = ["--out", str(tmp_path / "out")] if argv[0] == "bench" else []
+    assert main([*argv, *out]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == (
+        "rt70: error: the robots of example-robot-data are not installed: "
+        "pip install 'rt70[robots]'\n"
+    )
+    assert captured.out == ""
+    assert not (tmp_path / "out").exists()
 
 
 def test_unexpected_exception_is_recorded(monkeypatch):

@@ -370,6 +370,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Models of flexible structures, cross-checked against Pinocchio.",
         epilog="exit codes: " + "; ".join(f"{code} {what}" for code, what in EXIT_CODES.items()),
     )
+    parser.add_argument("--version", action=options.PrintVersion)
     sub = parser.add_subparsers(dest="command", required=True)
     val = sub.add_parser(
         "validate",
@@ -479,9 +480,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
-    parser = build_parser()
     argv = sys.argv[1:] if argv is None else argv
-    args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
+    args = build_parser().parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
     guards = options.warning_guards(args.command)  # module docstring
     with (
         options.stop_signals(EXIT_TERMINATED),

@@ -78,6 +78,41 @@ class Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
+def version_line() -> str:
+    """What ``rt70 --version`` prints: ``rt70 X.Y.Z``, the installed version (pyproject's)."""
+    import rt70
+
+    return f"rt70 {rt70.__version__}"
+
+
+class PrintVersion(argparse.Action):
+    """``--version``: print :func:`version_line` and exit 0.
+
+    The version is read from the package metadata only when the option is given, so
+    other commands do not pay for the lookup.
+    """
+
+    def __init__(
+        self,
+        option_strings: list[str],
+        dest: str = argparse.SUPPRESS,
+        default: str = argparse.SUPPRESS,
+        help: str = "print 'rt70 X.Y.Z' (the installed version) and exit",
+    ) -> None:
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: object,
+        option_string: str | None = None,
+    ) -> NoReturn:
+        """Print the version line on standard output and exit 0."""
+        print(version_line())
+        parser.exit()
+
+
 # --- argparse types: each raises ArgumentTypeError with the reason ---------------------
 def _number(text: str) -> float:
     try:

@@ -27,6 +27,9 @@ from rt70.textbook.massless import require_diagonal
 #: Distribution that ships the robots.
 DISTRIBUTION = "example-robot-data"
 
+#: The error when no installation prefix has the robots: they are rt70's ``robots`` extra.
+NOT_INSTALLED = "the robots of example-robot-data are not installed: pip install 'rt70[robots]'"
+
 #: Location of the robots inside an installation prefix (cmeel layout of the wheel).
 ROBOTS_SUBDIR = Path("cmeel.prefix", "share", "example-robot-data", "robots")
 
@@ -134,16 +137,14 @@ def robots_dir() -> Path:
     Raises
     ------
     Rt70Error
-        If example-robot-data (v6, the cmeel wheel) is not installed.
+        If example-robot-data (v6, the cmeel wheel; rt70's ``robots`` extra) is not
+        installed: :data:`NOT_INSTALLED`.
     """
     for prefix in _candidates():
         candidate = prefix / ROBOTS_SUBDIR
         if candidate.is_dir():
             return candidate
-    raise Rt70Error(
-        f"example-robot-data is not installed: no {ROBOTS_SUBDIR.as_posix()} directory "
-        f"in this environment (pip install 'example-robot-data>=6')"
-    )
+    raise Rt70Error(NOT_INSTALLED)
 
 
 def robot_path(name: str) -> Path:
