@@ -104,7 +104,7 @@ def test_kernels_on_siblings_through_unaligned_prismatic_and_continuous_joints()
 def test_a_mimic_model_keeps_the_python_path():
     """The simulation's backend uses the kernels only where the book's coordinates are
     Pinocchio's (q, v); the gear reducer's mimic joints map them."""
-    from rt70.simulation.simulate import BACKENDS
+    from rt70.simulation.backends import BACKENDS
 
     scene = load_scene("gear_reducer")
     assert not scene.reference.identity_map
@@ -136,15 +136,15 @@ def test_gimbal_lock_is_refused_like_the_python_path():
 def test_simulation_with_kernels_equals_the_python_path(monkeypatch):
     """The RT-70 from the listing's state: the fast path's trajectory is the Python path's
     to within the integration tolerance (same method, same rtol)."""
-    from rt70.simulation import simulate as sim
+    from rt70.simulation.backends import BACKENDS
 
     scene = load_scene("rt70")
     x0 = listing_initial_state(scene)
     t = np.linspace(0.0, 0.3, 31)
     runs = []
-    backend = sim.BACKENDS["pinocchio"]
+    backend = BACKENDS["pinocchio"]
     for kernels in (True, False):
-        monkeypatch.setitem(sim.BACKENDS, "pinocchio", functools.partial(backend, kernels=kernels))
+        monkeypatch.setitem(BACKENDS, "pinocchio", functools.partial(backend, kernels=kernels))
         runs.append(simulate(scene, (0.0, 0.3), x0, rtol=1e-8, t_eval=t))
     fast, slow = runs
     assert_close(fast.q, slow.q, rel=1e-6)

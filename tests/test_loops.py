@@ -24,7 +24,8 @@ from rt70.physics.baumgarte import Baumgarte
 from rt70.physics.kkt import solve_kkt
 from rt70.reference import loops as rl
 from rt70.reference import points as ref_points
-from rt70.simulation.closed_chains import CLOSURE_TOL, assemble
+from rt70.simulation.closed_chains import assemble
+from rt70.simulation.loop_constraints import CLOSURE_TOL
 from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import dynamics, forces

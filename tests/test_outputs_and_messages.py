@@ -491,7 +491,7 @@ def test_every_command_gives_the_same_loop_error(command, loop_files, capsys):
 
 def test_both_sides_find_the_same_closest_configuration(loop_files):
     from rt70.model.scene import load_scene
-    from rt70.simulation.closed_chains import closure_search
+    from rt70.simulation.closure import closure_search
     from rt70.testing import assert_close
 
     scene = load_scene(str(loop_files["too_far"]))

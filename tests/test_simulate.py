@@ -126,7 +126,7 @@ def test_bad_simulation_input():
 def test_rhs_jacobian_for_implicit_methods_is_checked():
     """The Pinocchio backend's Jacobian (computeABADerivatives + ΣJᵀCJ, ΣJᵀDJ) against
     central differences of the textbook right-hand side (scipy's alternative)."""
-    from rt70.simulation.simulate import BACKENDS
+    from rt70.simulation.backends import BACKENDS
 
     scene = load_scene("two_body_gravity")
     n = scene.textbook.nv

@@ -10,7 +10,8 @@ from scipy.integrate import solve_ivp
 import rt70.reference as reference
 from rt70.errors import Rt70Error, ShapeError
 from rt70.model.scene import load_scene
-from rt70.simulation.simulate import BACKENDS, IMPLICIT, simulate
+from rt70.simulation.backends import BACKENDS
+from rt70.simulation.simulate import IMPLICIT, simulate
 from rt70.simulation.states import EnergyAudit, StateComponent
 from rt70.testing import assert_close
 

@@ -37,6 +37,7 @@ from rt70.reports.threads import single_threaded
 with single_threaded():
     import pinocchio as pin
     from rt70.simulation import simulate as sim
+    from rt70.simulation.backends import BACKENDS
     from rt70.model.scene import load_scene
     from rt70.scenes.rt70_state import listing_initial_state
     method, rtol = sys.argv[1], float(sys.argv[2])
@@ -48,7 +49,7 @@ with single_threaded():
     if method != "BDF":
         r = sim.simulate(scene, (0.0, 10.0), (q, qd), method=method, rtol=rtol)
         out["method"] = [r.wall_time_s, r.n_steps, r.nfev, r.njev]
-    side = sim.BACKENDS["pinocchio"](scene)
+    side = BACKENDS["pinocchio"](scene)
     ref, rd = scene.reference, scene.reference_data
     tau = np.zeros(ref.pin_model.nv)
     calls = {

@@ -331,7 +331,7 @@ def check_outputs(args: argparse.Namespace) -> None:
     if args.command == "simulate" and args.out == "":
         raise OutputError("--out: empty path")
     if args.command == "simulate" and args.out:
-        from rt70.simulation.simulate import check_output_suffix
+        from rt70.simulation.result import check_output_suffix
 
         out = Path(args.out)
         files = [out] if args.no_plot else [out, out.with_suffix(".png")]

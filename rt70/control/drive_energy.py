@@ -87,7 +87,7 @@ def energy_balance(result, audited: Sequence[AuditedDrive]) -> tuple[np.ndarray,
 
     Parameters
     ----------
-    result : rt70.simulation.simulate.SimulationResult
+    result : rt70.simulation.result.SimulationResult
         A run with the audited drives among its components.
     audited : sequence of AuditedDrive
         The drives.

@@ -31,7 +31,7 @@ from rt70.model.outputs import Output, evaluate, optical_point_outputs, position
 from rt70.model.scene import Scene, require_coordinates
 from rt70.physics.aerodynamics import WindCondition
 from rt70.physics.loads import Wrench
-from rt70.simulation.closed_chains import require_closable
+from rt70.simulation.closure import require_closable
 from rt70.textbook import drives as tb_drives
 from rt70.textbook import dynamics, forces, points
 from rt70.urdf.description import DRIVE_PARAMETERS, Drive, DriveSector
@@ -494,7 +494,7 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
         If the scene has no degree of freedom, ``samples`` < 1, or the mass matrix is
         numerically singular at a sampled state.
     LoopClosureError
-        If the scene's loops cannot close (:func:`rt70.simulation.closed_chains.require_closable`),
+        If the scene's loops cannot close (:func:`rt70.simulation.closure.require_closable`),
         before anything is compared.
     """
     require_coordinates(scene)

@@ -8,7 +8,7 @@ the locks there (:func:`rt70.mechanics.locks.engage`) and returns the audit acro
 ``T⁺ + U_g + U_c + E_ψ + E_impact − W_u`` — positions do not jump, so neither do the
 potentials, the dissipated energy nor the input work; the two totals differ only by
 rounding (:attr:`rt70.physics.impact.Impact.balance`), while the simulation's own drift up to
-the engagement is reported as it is (:attr:`rt70.simulation.simulate.SimulationResult.balance`).
+the engagement is reported as it is (:attr:`rt70.simulation.result.SimulationResult.balance`).
 
 Continuing the motion with the lock held needs the constrained integration of the loop
 closures (the KKT equations (14)); it is not done here.
@@ -25,7 +25,8 @@ from rt70.errors import Rt70Error
 from rt70.mechanics.locks import Lock, check_locks, engage
 from rt70.model.scene import Scene
 from rt70.physics.impact import Impact
-from rt70.simulation.simulate import Inputs, SimulationResult, simulate
+from rt70.simulation.result import SimulationResult
+from rt70.simulation.simulate import Inputs, simulate
 
 
 @dataclass(frozen=True)

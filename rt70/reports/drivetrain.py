@@ -31,7 +31,8 @@ from rt70.control.friction import AxisFriction, switched_rigid_axis
 from rt70.control.geartrains import TwoTrainServo, train_gains
 from rt70.model.scene import Scene, scene_from_text
 from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, FRICTION, MOTOR, TRAINS, WIND_TORQUE
-from rt70.simulation.simulate import SimulationResult, simulate
+from rt70.simulation.result import SimulationResult
+from rt70.simulation.simulate import simulate
 
 #: Sidereal rate, rad/s (15.04″/s).
 SIDEREAL = 7.2921e-5

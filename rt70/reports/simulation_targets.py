@@ -15,7 +15,7 @@ Whole command
     (imports, URDF, Pinocchio) and what follows the integration (energies, printing).
 Right-hand side and Jacobian
     The reference backend's ``accelerations`` and ``jacobian``
-    (:class:`rt70.simulation.simulate._PinocchioBackend`) at the RT-70 listing's initial state,
+    (:class:`rt70.simulation.backends.PinocchioBackend`) at the RT-70 listing's initial state,
     timed interleaved with ``pin.aba`` and ``pin.computeABADerivatives`` on the same
     state and the same generalized forces, BLAS/OpenMP pinned to one thread
     (:func:`rt70.reports.threads.single_threaded`); the median per-round ratio must be
@@ -156,10 +156,10 @@ def kernel_ratios(rounds: int = 7, budget_s: float = 0.05) -> dict[str, tuple[fl
     from rt70.reports.bench import compare
     from rt70.reports.threads import single_threaded
     from rt70.scenes.rt70_state import listing_initial_state
-    from rt70.simulation.simulate import _PinocchioBackend
+    from rt70.simulation.backends import PinocchioBackend
 
     scene = load_scene("rt70")
-    backend = _PinocchioBackend(scene)
+    backend = PinocchioBackend(scene)
     q, qd = listing_initial_state(scene)
     model, data = scene.reference.pin_model, scene.reference_data.pin_data
     Qc, Qd = element_torques(scene.reference, scene.reference_data, q, qd)

@@ -119,6 +119,17 @@ def budgeted(rhs: Rhs, span: float, limit: int | None = None, t0: float = 0.0) -
     :data:`PACE_MARGIN` times ``limit`` evaluations is stopped then, in about a second,
     rather than after minutes at the memory limit (``rt70 simulate rt70 --t-end 1e12``).
 
+    Parameters
+    ----------
+    rhs : callable (t, x) -> ẋ
+        The right-hand side counted.
+    span : float
+        The run's length ``t1 − t0``, s (the budget in force grows with it).
+    limit : int, optional
+        The most samples memory holds for the run (none: only the budget in force).
+    t0 : float
+        The run's start time, s (for the pace check).
+
     Raises
     ------
     SimulationError

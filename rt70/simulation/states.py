@@ -20,7 +20,7 @@ Newton iteration treats them explicitly (it converges, more slowly if they are s
 
 The first component is the energy audit (:class:`EnergyAudit`, (1.73)), which every
 simulation carries; drives with motor states come next. The simulation's result holds
-every component's states by name (:attr:`rt70.simulation.simulate.SimulationResult.states`).
+every component's states by name (:attr:`rt70.simulation.result.SimulationResult.states`).
 """
 
 from __future__ import annotations
@@ -71,13 +71,34 @@ class StateComponent(ABC):
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """Time derivative ``ṡ`` of the component's states ``s``, shape (len(names),)."""
+        """Time derivative ``ṡ`` of the component's states ``s``, shape (len(names),).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates (rad or m) and velocities (rad/s or m/s).
+        s : numpy.ndarray, shape (len(names),)
+            The component's states.
+        forces : MechanicsForces
+            The dampers' and the inputs' generalised forces of this evaluation.
+        """
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray | None:
         """Generalised force on the mechanics from the states ``s`` (shape (nv,)), or None.
 
         Added to the input force ``Q_u`` before the accelerations are computed. The
         default is None: the component only watches.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates (rad or m) and velocities (rad/s or m/s).
+        s : numpy.ndarray, shape (len(names),)
+            The component's states.
         """
         return None
 
@@ -102,7 +123,19 @@ class EnergyAudit(StateComponent):
         self.atol = np.full(2, atol)
 
     def derivative(self, t, q, qd, s, forces):
-        """``[−q̇ᵀ Q_d, q̇ᵀ Q_u]``: the dampers' and the inputs' power."""
+        """``[−q̇ᵀ Q_d, q̇ᵀ Q_u]``: the dampers' and the inputs' power, W.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates and velocities (only q̇ is used).
+        s : numpy.ndarray, shape (2,)
+            ``[E_ψ, W_u]`` (unused).
+        forces : MechanicsForces
+            ``Q_d`` and ``Q_u`` of this evaluation.
+        """
         Q_d, Q_u = forces
         return np.array((-(qd @ Q_d), 0.0 if Q_u is None else qd @ Q_u))
 
@@ -159,7 +192,17 @@ class StateLayout:
         return [np.asarray(c.atol, dtype=float) for c in self.components]
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, x: np.ndarray) -> np.ndarray | None:
-        """Sum of the components' generalised forces at state ``x``, or None if none."""
+        """Sum of the components' generalised forces at state ``x``, or None if none.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates (rad or m) and velocities (rad/s or m/s).
+        x : numpy.ndarray, shape (2 nv + size,)
+            The whole state ``[q, q̇, s_1, s_2, …]``.
+        """
         n, total = self.nv, None
         for c, where in self.pushing:
             Q = c.force(t, q, qd, x[where])
@@ -177,7 +220,19 @@ class StateLayout:
     def derivatives(
         self, t: float, q: np.ndarray, qd: np.ndarray, x: np.ndarray, forces: MechanicsForces
     ) -> list[np.ndarray]:
-        """Time derivatives of the extra states at state ``x``, one array per component."""
+        """Time derivatives of the extra states at state ``x``, one array per component.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates (rad or m) and velocities (rad/s or m/s).
+        x : numpy.ndarray, shape (2 nv + size,)
+            The whole state ``[q, q̇, s_1, s_2, …]``.
+        forces : MechanicsForces
+            The dampers' and the inputs' generalised forces of this evaluation.
+        """
         out = []
         for c, where, k in self.placed:
             ds = c.derivative(t, q, qd, x[where], forces)

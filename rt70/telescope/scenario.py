@@ -23,7 +23,7 @@ from rt70.scenes.rt70_state import (
     POINTING_AXES,
     missing_axes,
 )
-from rt70.simulation.simulate import SimulationResult
+from rt70.simulation.result import SimulationResult
 from rt70.simulation.states import StateComponent
 from rt70.telescope.servo_tuning import holding_excess
 

@@ -31,7 +31,7 @@ from rt70.reports.stress.measures import (
 from rt70.reports.stress.runs import SIM_RTOL, RunOutcome, Settings, run_capped
 from rt70.reports.stress.tables import SIM_COLUMNS, Table, short_error, sim_fields, worst_value
 from rt70.scenes.rt70_state import listing_initial_state
-from rt70.simulation.simulate import BACKENDS
+from rt70.simulation.backends import BACKENDS
 from rt70.textbook import dynamics, forces
 from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, GIMBAL_LOCK_COS, euler_matrix
 

@@ -38,7 +38,8 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.model.scene import Scene
 from rt70.reports.stress.measures import CROSS_CHECK_SAMPLES
-from rt70.simulation.simulate import SimulationResult, simulate
+from rt70.simulation.result import SimulationResult
+from rt70.simulation.simulate import simulate
 
 #: Simulated time of each run, s (the quick report uses :data:`QUICK_SPAN_S`).
 SIM_SPAN_S = 0.5

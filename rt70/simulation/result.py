@@ -1,0 +1,144 @@
+"""What a simulation returns: the trajectory, its energy audit, and how it is written.
+
+:class:`SimulationResult` holds one run of :func:`rt70.simulation.simulate.simulate`
+(the samples, the energies of the audit and their balance, the extra states, the
+outputs, the solver's statistics and timing) and writes itself atomically as ``.npz``
+or ``.csv`` (:data:`OUTPUT_SUFFIXES`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rt70.errors import OutputError
+from rt70.model.outputs import column_labels
+from rt70.simulation.states import EnergyAudit
+
+#: Output formats of :meth:`SimulationResult.save`, by suffix.
+OUTPUT_SUFFIXES = (".csv", ".npz")
+
+
+@dataclass
+class SimulationResult:
+    """Trajectory, energies and solver statistics of one run.
+
+    Energies in J: ``kinetic`` T, ``gravity`` U_g, ``elastic`` U_c, ``dissipated`` E_ψ,
+    ``input_work`` W_u; ``balance = T + U_g + U_c + E_ψ − W_u − (its value at t0)`` and
+    ``balance_scale`` the energy exchanged in the run (what ``relative_drift`` is
+    relative to). ``drift_flagged`` is set when a passive run drifts by more than
+    ``DRIFT_FACTOR · rtol`` of it (:data:`rt70.simulation.simulate.DRIFT_FACTOR`).
+    ``states`` holds the trajectory of every extra state by name
+    (:mod:`rt70.simulation.states`; the energy audit's ``dissipated`` and ``input_work``
+    first). ``constraint_residual`` is ``max |Φ|`` per sample for a scene with closed
+    chains (:mod:`rt70.simulation.closed_chains`), empty otherwise. ``t_events`` holds
+    the times at which each of the ``events`` of :func:`rt70.simulation.simulate.simulate`
+    crossed zero. ``timing`` splits
+    ``wall_time_s``: "rhs" (s inside the right-hand side, including the calls of a
+    difference-quotient Jacobian), "jacobian" (s inside the analytic Jacobian) and
+    "integrator" (the rest: the solver's own work, its linear algebra included).
+    ``nlu`` is −1 where the solver does not report it (CVODE), ``n_steps`` −1 when
+    ``t_eval`` was given.
+    """
+
+    scene: str
+    backend: str
+    method: str
+    rtol: float
+    atol: float
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    kinetic: np.ndarray
+    gravity: np.ndarray
+    elastic: np.ndarray
+    dissipated: np.ndarray
+    input_work: np.ndarray
+    balance: np.ndarray
+    balance_scale: float
+    nfev: int
+    njev: int
+    nlu: int
+    n_steps: int
+    wall_time_s: float
+    success: bool
+    message: str
+    coordinates: list[str] = field(default_factory=list)
+    drift_flagged: bool = False
+    outputs: dict[str, np.ndarray] = field(default_factory=dict)
+    states: dict[str, np.ndarray] = field(default_factory=dict)
+    constraint_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    t_events: list[np.ndarray] = field(default_factory=list)
+    timing: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def relative_drift(self) -> float:
+        """Largest |balance| over the run, relative to ``balance_scale``."""
+        return float(np.max(np.abs(self.balance)) / self.balance_scale)
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated time per wall-clock second."""
+        return float((self.t[-1] - self.t[0]) / self.wall_time_s)
+
+    def save(self, path: str | Path) -> Path:
+        """Write the result atomically: ``.npz`` (all arrays) or ``.csv`` (a table)."""
+        from rt70.guards.atomic import atomic_write
+
+        return atomic_write(path, self.writer(path))
+
+    def writer(self, path: str | Path) -> Callable[[Path], None]:
+        """The function that writes the result to a (temporary) file, in ``path``'s format.
+
+        For :func:`rt70.guards.atomic.atomic_write_all`, to write it together with other files.
+
+        Raises
+        ------
+        OutputError
+            If ``path`` does not end in one of :data:`OUTPUT_SUFFIXES`.
+        """
+        suffix = check_output_suffix(path)
+        if suffix == ".npz":
+            arrays = {
+                k: getattr(self, k)
+                for k in ("t", "q", "qd", "kinetic", "gravity", "elastic", "dissipated")
+            }
+            arrays.update(input_work=self.input_work, balance=self.balance)
+            arrays.update({f"state:{k}": v for k, v in self._component_states().items()})
+            arrays["coordinates"] = np.array(self.coordinates)
+            if self.constraint_residual.size:  # closed chains: max |Φ| per sample
+                arrays["constraint_residual"] = self.constraint_residual
+            arrays.update({f"output:{k}": v for k, v in self.outputs.items()})
+            return lambda tmp: np.savez_compressed(tmp, **arrays)
+        extra = self._component_states()
+        names = ["t"] + [f"q:{c}" for c in self.coordinates] + [f"qd:{c}" for c in self.coordinates]
+        names += ["kinetic", "gravity", "elastic", "dissipated", "input_work", "balance"]
+        names += [f"state:{k}" for k in extra]
+        table = np.column_stack(
+            [self.t, self.q, self.qd, self.kinetic, self.gravity, self.elastic]
+            + [self.dissipated, self.input_work, self.balance, *extra.values()]
+        )
+        if self.constraint_residual.size:  # closed chains: max |Φ| per sample
+            names.append("constraint_residual")
+            table = np.column_stack([table, self.constraint_residual])
+        for name, values in self.outputs.items():  # rt70.model.outputs, one column per component
+            names += column_labels(name, values.shape[1])
+            table = np.column_stack([table, values])
+        lines = [",".join(names)] + [",".join(f"{x:.17g}" for x in row) for row in table]
+        text = "\n".join(lines) + "\n"
+        return lambda tmp: tmp.write_text(text, encoding="utf-8", newline="\n")
+
+    def _component_states(self) -> dict[str, np.ndarray]:
+        """The extra states other than the energy audit's (written as ``state:<name>``)."""
+        return {k: v for k, v in self.states.items() if k not in EnergyAudit.names}
+
+
+def check_output_suffix(path: str | Path) -> str:
+    """The suffix of an output path, one of :data:`OUTPUT_SUFFIXES`, or an OutputError."""
+    suffix = Path(path).suffix
+    if suffix not in OUTPUT_SUFFIXES:
+        raise OutputError(f"{path}: output must end in {' or '.join(OUTPUT_SUFFIXES)}")
+    return suffix
