@@ -9,7 +9,7 @@ rule it enforces:
   ``expected`` — or, where the quantity is a sum of larger terms that cancel (a bias
   near zero, a spring force at rest, the difference of two energies), the size of those
   terms, stated by the caller as ``scale=`` (a number, or an array broadcast against the
-  entries, as :func:`rt70.crosscheck.validate.natural_scales` derives them);
+  entries, as :func:`rt70.crosscheck.scales.natural_scales` derives them);
 - ``rel`` is never taken below :data:`MIN_REL`, a few units in the last place: two
   correct computations on two CPUs may differ by that much (fused multiply–adds, another
   summation order, another libm), so a tighter bound would test the machine, not the

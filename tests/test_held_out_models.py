@@ -25,7 +25,8 @@ import pytest
 from rt70.crosscheck import validate
 from rt70.crosscheck.impact_check import impact_scales, impact_values, state_locks
 from rt70.crosscheck.robots import load_robot, survey
-from rt70.crosscheck.validate import cross_check, random_state
+from rt70.crosscheck.samples import random_state
+from rt70.crosscheck.validate import cross_check
 from rt70.errors import InertiaError, ResourceError, SingularConfigurationError
 from rt70.guards import resources
 from rt70.mechanics.locks import Brake, constraint_rows, engage

@@ -11,7 +11,7 @@ import pytest
 
 from rt70.cli.main import main
 from rt70.crosscheck.impact_check import impact_scales, impact_values, state_locks
-from rt70.crosscheck.validate import random_state
+from rt70.crosscheck.samples import random_state
 from rt70.errors import Rt70Error, UnknownLinkError
 from rt70.mechanics.engagement import engage_after
 from rt70.mechanics.locks import Brake, StowPin, check_locks, engage, joint_impulses, parse_pin

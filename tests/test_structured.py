@@ -28,7 +28,7 @@ def test_structured_equals_dense(target):
     for k in range(4):
         A = dynamics.mass_matrix(m, d, Q[k])
         assert_close(A_batch[k], A, rel=1e-13, what="A")
-        # bias and gravity on the size of their terms (rt70.crosscheck.validate.natural_scales): the
+        # bias and gravity on the size of their terms (rt70.crosscheck.scales.natural_scales): the
         # velocity products ‖A‖ ‖q̇‖², the weights' moment G₀
         b = dynamics.bias_force(m, d, Q[k], Qd[k])
         b_scale = np.abs(A).max() * np.abs(Qd[k]).max() ** 2 + np.abs(b).max()

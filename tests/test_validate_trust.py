@@ -3,7 +3,7 @@
 - a NaN or an infinity on either side of any compared quantity fails that row;
 - a run that checks no target, or a model with no degree of freedom, exits 2;
 - rounding is not disagreement: every quantity has a floor from the state's natural
-  scale (:func:`rt70.crosscheck.validate.natural_scales`), and the floor hides no real error.
+  scale (:func:`rt70.crosscheck.scales.natural_scales`), and the floor hides no real error.
 """
 
 from __future__ import annotations
@@ -21,6 +21,8 @@ import pytest
 import rt70.crosscheck.validate as validate
 from rt70 import reference
 from rt70.cli.main import main
+from rt70.crosscheck.samples import random_state
+from rt70.crosscheck.scales import natural_scales
 from rt70.crosscheck.validate import QUANTITIES, cross_check
 from rt70.errors import Rt70Error, SceneError
 from rt70.model.scene import load_scene, scene_from_text
@@ -118,12 +120,12 @@ def test_rounding_is_not_disagreement(urdf, quantities, monkeypatch):
 
 
 def test_natural_scales_are_positive_and_finite(two_body):
-    q, qd = validate.random_state(two_body.textbook.nv, np.random.default_rng(1))
+    q, qd = random_state(two_body.textbook.nv, np.random.default_rng(1))
     values = {
         name: (np.asarray(a(), dtype=float), np.asarray(b(), dtype=float))
         for name, (a, b) in validate._pairs(two_body, q, qd).items()
     }
-    scales = validate.natural_scales(two_body, values, q, qd)
+    scales = natural_scales(two_body, values, q, qd)
     assert set(scales) == set(QUANTITIES)
     assert all(np.all(np.isfinite(v)) and np.all(np.asarray(v) > 0.0) for v in scales.values())
     # q̈: per coordinate, |A⁻¹| (f + |A||q̈|) ≥ |A⁻¹| |Q_g| ≥ |q̈ from gravity alone|

@@ -1,7 +1,7 @@
 """Impacts (issue 12, part 3): the cross-check against Pinocchio and the RT-70 engaging a lock.
 
 1. On the scenes double_pendulum, three_masses, rt70 and rt70_servo, at N random states
-   (``rt70.crosscheck.validate.random_state``, seed 0): the brake and the stow pin of
+   (``rt70.crosscheck.samples.random_state``, seed 0): the brake and the stow pin of
    ``rt70.crosscheck.impact_check.state_locks`` (random e), and the same locks plastic (e = 0);
    the textbook's KKT solve against ``pin.impulseDynamics``: the largest relative
    error (max-norm) of q̇⁺ and of Λ, q̇⁺'s error against its first-order rounding bound
@@ -30,7 +30,7 @@ from threadpoolctl import threadpool_limits
 
 from rt70 import reference
 from rt70.crosscheck.impact_check import impact_scales, state_locks
-from rt70.crosscheck.validate import random_state
+from rt70.crosscheck.samples import random_state
 from rt70.guards.atomic import atomic_write_text
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.mechanics.engagement import engage_after

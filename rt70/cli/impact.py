@@ -118,7 +118,7 @@ def _check_locks(scene, locks: list[tuple[str, object]]) -> list:
 
 
 def _state(scene, args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray]:
-    from rt70.crosscheck.validate import random_state
+    from rt70.crosscheck.samples import random_state
     from rt70.scenes.rt70_state import start_state
 
     n = scene.textbook.nv

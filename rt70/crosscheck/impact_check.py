@@ -30,7 +30,7 @@ def state_locks(scene: Scene, q: np.ndarray) -> list[tuple[list[Lock], float]]:
     """The impacts compared at the state q: ``[([Brake], e), ([StowPin], e)]``.
 
     Seeded from the bits of q (every other word, apart from the streams of
-    :func:`rt70.crosscheck.validate.state_wrench` and the others): the brake on a 1-DOF joint
+    :func:`rt70.crosscheck.samples.state_wrench` and the others): the brake on a 1-DOF joint
     drawn uniformly (none when the scene has none), the pin on a moving link at a point
     within ±1 m of its origin, each restitution uniform in [0, 1].
     """
@@ -50,7 +50,19 @@ def state_locks(scene: Scene, q: np.ndarray) -> list[tuple[list[Lock], float]]:
 
 
 def impact_values(scene: Scene, q: np.ndarray, qd: np.ndarray, side: str) -> dict:
-    """One side's ``{"impact": stacked q̇⁺, "impulse": stacked Λ}`` at the state."""
+    """One side's ``{"impact": stacked q̇⁺, "impulse": stacked Λ}`` at the state.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities before the impacts, rad/s or m/s.
+    side : {"textbook", "reference"}
+        Which side solves the impacts of :func:`state_locks`.
+    """
     results = [engage(scene, q, qd, locks, side, e) for locks, e in state_locks(scene, q)]
     return {
         "impact": np.concatenate([r.qd_after for r in results]),
@@ -63,6 +75,15 @@ def impact_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict:
 
     One solve per side gives both rows: each side's first evaluation is kept for the
     other row's first (value) call; every later (timed) call solves afresh.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities before the impacts, rad/s or m/s.
     """
     kept: dict[tuple[str, str], np.ndarray] = {}
 
@@ -98,8 +119,17 @@ def impact_scales(
       + |W⁺| |B_c| ((1 + e) |q̇⁻| + |Δq̇|)``, from ``δΛ = W⁺ (δr − δW Λ)`` with
       ``r = −(1 + e) B_c q̇⁻``.
 
-    ``reference_values``: the reference side's ``{"impact": …, "impulse": …}`` at this
-    state (:func:`impact_values`), if already computed.
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities before the impacts, rad/s or m/s.
+    reference_values : dict, optional
+        The reference side's ``{"impact": q̇⁺ (rad/s or m/s), "impulse": Λ (N·s or
+        N·m·s)}`` at this state (:func:`impact_values`), if already computed.
     """
     from rt70 import reference
 

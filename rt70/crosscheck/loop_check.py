@@ -47,7 +47,17 @@ def loop_quantities(scene: Scene) -> tuple[str, ...]:
 
 
 def loop_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
-    """(textbook, reference) evaluations of the loop rows at (q, q̇); empty without loops."""
+    """(textbook, reference) evaluations of the loop rows at (q, q̇); empty without loops.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities, rad/s or m/s.
+    """
     if not scene.description.loops:
         return {}
     from rt70.reference import loops as rl
@@ -88,8 +98,26 @@ def loop_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[C
     }
 
 
-def loop_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray, qdd_scale) -> dict:
-    """Natural scales of the loop rows (see the module docstring); empty without loops."""
+def loop_scales(
+    scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray, qdd_scale: np.ndarray
+) -> dict:
+    """Natural scales of the loop rows (see the module docstring); empty without loops.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    values : dict of str to (numpy.ndarray, numpy.ndarray)
+        Every row's ``(textbook value, reference value)`` at this state (the loop rows
+        among them when the scene has loops).
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities, rad/s or m/s.
+    qdd_scale : numpy.ndarray, shape (nv,)
+        The tree's q̈ scale per coordinate (:mod:`rt70.crosscheck.scales`), rad/s² or
+        m/s²: the scale of ``loop_dynamics``.
+    """
     if "loop_residual" not in values:
         return {}
     from rt70.reference import points as ref_points

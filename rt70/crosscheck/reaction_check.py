@@ -4,7 +4,7 @@ At each sampled state (q, q̇) of :func:`rt70.crosscheck.validate.cross_check` b
 wrench across every URDF joint (:mod:`rt70.textbook.reactions`,
 :mod:`rt70.reference.reactions`: ``[F; M]`` in the joint frame about its origin) under
 gravity, with accelerations q̈ drawn from the state (:func:`state_acceleration`) and the
-state's random load (:func:`rt70.crosscheck.validate.state_wrench`); the row stacks them in the
+state's random load (:func:`rt70.crosscheck.samples.state_wrench`); the row stacks them in the
 textbook's joint order. Kept here so that rt70/crosscheck/validate.py holds only the row's hunks.
 """
 
@@ -27,7 +27,7 @@ def state_acceleration(q: np.ndarray) -> np.ndarray:
     """The accelerations compared at the state q: uniform in ±1, seeded from the bits of q.
 
     Reproducible, new at every state, apart from the other streams drawn from q
-    (:func:`rt70.crosscheck.validate.state_wrench` and its siblings use other orders of the bits).
+    (:func:`rt70.crosscheck.samples.state_wrench` and its siblings use other orders of the bits).
     """
     bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
     rng = np.random.default_rng(np.roll(bits, 2)[::-1].copy())
@@ -57,7 +57,19 @@ def stacked(scene: Scene, reactions: dict[str, np.ndarray]) -> np.ndarray:
 def reaction_pair(
     scene: Scene, q: np.ndarray, qd: np.ndarray, wrench: Wrench
 ) -> tuple[Callable[[], np.ndarray], Callable[[], np.ndarray]]:
-    """(textbook, reference) evaluations of the row at (q, q̇) with the load ``wrench``."""
+    """(textbook, reference) evaluations of the row at (q, q̇) with the load ``wrench``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities, rad/s or m/s.
+    wrench : rt70.physics.loads.Wrench
+        The state's random load (:func:`rt70.crosscheck.samples.state_wrench`), N and N·m.
+    """
     from rt70.reference import reactions as ref_reactions
 
     tm, td = scene.textbook, scene.textbook_data
@@ -76,6 +88,17 @@ def reaction_scale(scene: Scene, q: np.ndarray, qd: np.ndarray, wrench: Wrench) 
     products alone, gravity alone and the load alone (reference side): the reactions
     are their sum, so rounding is ε times these, not times the (possibly cancelling)
     total.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    q : numpy.ndarray, shape (nv,)
+        The sampled coordinates in the file's order, rad or m.
+    qd : numpy.ndarray, shape (nv,)
+        The sampled velocities, rad/s or m/s.
+    wrench : rt70.physics.loads.Wrench
+        The state's random load, N and N·m.
     """
     from rt70.reference import reactions as ref_reactions
 

@@ -232,8 +232,17 @@ def survey(
     the textbook's forward dynamics (a singular mass matrix). Any other exception — a
     :class:`CoordinateMismatch` between the sides included — is a bug in rt70,
     recorded with a reason starting with :data:`UNEXPECTED`
-    (``"unexpected <Type>: message"``) for the caller to report. ``seed`` seeds the
-    random states; ``balance_inertia`` is passed to :func:`load_robot`.
+    (``"unexpected <Type>: message"``) for the caller to report.
+
+    Parameters
+    ----------
+    names : list of str, optional
+        Keys of :data:`ROBOTS` to try, in this order (default all).
+    seed : int
+        Seed of the random states each robot is evaluated at.
+    balance_inertia : bool
+        Repair inertias that are not physical instead of refusing them
+        (:func:`load_robot`).
 
     Raises
     ------

@@ -10,6 +10,9 @@ scene's drives (``<rt70:drive>``) and of a random gear sector, and, for a scene 
 :mod:`rt70.crosscheck.impact_check`); every row of the report gives the largest absolute
 error, the largest error relative to the reference's max-norm, and the mean wall time per
 evaluation of each side.
+
+The states and the probes compared at each: :mod:`rt70.crosscheck.samples`; the scale
+each row's error is measured against: :mod:`rt70.crosscheck.scales`.
 """
 
 from __future__ import annotations
@@ -21,20 +24,26 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from rt70.crosscheck.impact_check import impact_pairs, impact_scales
-from rt70.crosscheck.loop_check import loop_pairs, loop_quantities, loop_scales
-from rt70.crosscheck.reaction_check import reaction_pair, reaction_scale
+from rt70.crosscheck.impact_check import impact_pairs
+from rt70.crosscheck.loop_check import loop_pairs, loop_quantities
+from rt70.crosscheck.reaction_check import reaction_pair
+from rt70.crosscheck.samples import (
+    WIND,
+    compared_points,
+    random_state,
+    state_drive,
+    state_wind,
+    state_wrench,
+)
+from rt70.crosscheck.scales import natural_scales
 from rt70.errors import Rt70Error
 from rt70.mechanics.nonholonomic_scene import ROWS as NONHOLONOMIC
 from rt70.mechanics.nonholonomic_scene import validate_pairs as nonholonomic_pairs
-from rt70.model.outputs import Output, evaluate, optical_point_outputs, position_output
+from rt70.model.outputs import evaluate
 from rt70.model.scene import Scene, require_coordinates
-from rt70.physics.aerodynamics import WindCondition
-from rt70.physics.loads import Wrench
 from rt70.simulation.closure import require_closable
 from rt70.textbook import drives as tb_drives
 from rt70.textbook import dynamics, forces, points
-from rt70.urdf.description import DRIVE_PARAMETERS, Drive, DriveSector
 
 #: Default agreement tolerance, relative to the reference's max-norm.
 DEFAULT_TOLERANCE = 1e-10
@@ -57,14 +66,11 @@ QUANTITIES = (
     "impulse",
 )
 
-#: Compared after :data:`QUANTITIES` for a scene with ``<rt70:wind>`` elements only.
-WIND = "wind"
-
 
 def quantities(scene: Scene) -> tuple[str, ...]:
     """The rows of ``scene``'s report.
 
-    :data:`QUANTITIES`, :data:`WIND` if it has wind, the loop rows
+    :data:`QUANTITIES`, :data:`rt70.crosscheck.samples.WIND` if it has wind, the loop rows
     (:func:`rt70.crosscheck.loop_check.loop_quantities`) if it has ``<rt70:loop>`` closures, and
     :data:`rt70.mechanics.nonholonomic_scene.ROWS` if it has ``<rt70:no_slip>`` constraints.
     """
@@ -107,80 +113,6 @@ class Record:
         return out
 
 
-def random_state(nv: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """A random state: ``q`` uniform in ±0.5 (rad or m), ``q̇`` uniform in ±1."""
-    return rng.uniform(-0.5, 0.5, nv), rng.uniform(-1.0, 1.0, nv)
-
-
-def random_wrench(scene: Scene, rng: np.random.Generator) -> Wrench:
-    """A random load for the cross-check (:class:`rt70.physics.loads.Wrench`).
-
-    On a moving link drawn uniformly, at a point within ±1 m of its origin, with force
-    and torque uniform in ±1 N and ±1 N·m per ground axis.
-    """
-    links = [name for name, (body, _, _) in scene.textbook.link_frames.items() if body >= 0]
-    link = links[int(rng.integers(len(links)))]
-    xyz, force, torque = rng.uniform(-1.0, 1.0, (3, 3))
-    return Wrench(link, xyz, force, torque)
-
-
-def state_wrench(scene: Scene, q: np.ndarray) -> Wrench:
-    """The random load compared at the state q (row ``load_force``).
-
-    :func:`random_wrench` drawn from a generator seeded with the bits of q: reproducible,
-    new at every sampled state, and apart from the stream the states are drawn from.
-    """
-    bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
-    return random_wrench(scene, np.random.default_rng(bits))
-
-
-def state_drive(scene: Scene, q: np.ndarray) -> Drive:
-    """A random gear-sector drive compared at the state q (row ``drives``).
-
-    Seeded from q as :func:`state_wrench`: the sector on a moving link drawn uniformly,
-    its stator another link with a frame (the ground too), mesh point within ±1 m,
-    random unit tangent and an axis normal to it, radius in [0.5, 2] m. Only its
-    geometry is used (the motor's parameters are ones), so every scene has a drive to
-    compare.
-    """
-    bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
-    rng = np.random.default_rng(bits[::-1].copy())
-    frames = scene.textbook.link_frames
-    moving = [name for name, (body, _, _) in frames.items() if body >= 0]
-    link = moving[int(rng.integers(len(moving)))]
-    others = [name for name, (body, _, _) in frames.items() if body != frames[link][0]]
-    stator = others[int(rng.integers(len(others)))] if others else scene.description.root
-    xyz, direction, axis = rng.uniform(-1.0, 1.0, (3, 3))
-    direction /= np.linalg.norm(direction)
-    axis -= (axis @ direction) * direction
-    axis /= np.linalg.norm(axis)
-    sector = DriveSector(link, xyz, direction, axis, float(rng.uniform(0.5, 2.0)), stator)
-    return Drive("probe", "", *np.ones(len(DRIVE_PARAMETERS)), sector=sector)
-
-
-def state_wind(q: np.ndarray) -> WindCondition:
-    """The steady wind compared at the state q (row ``wind``).
-
-    Seeded from q as :func:`state_wrench` (the bits in another order): speed uniform in
-    [1, 40] m/s, direction uniform in [0°, 360°), the scene's air density.
-    """
-    bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
-    rng = np.random.default_rng(np.roll(bits, 1))
-    return WindCondition(float(rng.uniform(1.0, 40.0)), float(rng.uniform(0.0, 360.0)))
-
-
-def compared_points(scene: Scene) -> list[Output]:
-    """The positions compared in row ``points``.
-
-    The scene's optical points (its outputs, :func:`rt70.model.outputs.optical_point_outputs`)
-    and the origin of every link with a frame on both sides (``link:<name>``), so that
-    every scene has points to compare.
-    """
-    links = scene.textbook.link_frames
-    origins = [position_output(f"link:{link}", link, np.zeros(3)) for link in links]
-    return optical_point_outputs(scene) + origins
-
-
 def _stacked(values: dict[str, np.ndarray]) -> np.ndarray:
     return np.concatenate(list(values.values())) if values else np.zeros(0)
 
@@ -217,7 +149,7 @@ def _timed(fn: Callable[[], object], repeat: int) -> tuple[object, float]:
 def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
     """Per quantity: (textbook evaluation, reference evaluation), in the user's coordinate order.
 
-    The load of ``load_force`` is :func:`state_wrench`.
+    The load of ``load_force`` is :func:`rt70.crosscheck.samples.state_wrench`.
     """
     from rt70 import reference
     from rt70.reference import drives as ref_drives
@@ -307,160 +239,6 @@ def _stacked_drives(drive_force: Callable, model, data, q: np.ndarray, drives) -
 #: terms (Higham, *Accuracy and Stability of Numerical Algorithms*, §3.1).
 FLOOR = 1e-4
 
-#: Mass matrices whose condition number passes this leave q̈ undetermined in doubles.
-MAX_CONDITION = 1e14
-
-
-def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) -> dict:
-    """The size of the terms each compared quantity is computed from, at this state.
-
-    A quantity that nearly cancels (the velocity-product force of joints that barely
-    couple, the gravity torque of a wheel whose centre of mass is on its axis, the
-    accelerations of a balanced robot) carries the rounding error of its terms, about
-    ε times their size, so its error relative to its own tiny value means nothing. Each
-    quantity is therefore measured against ``max(own max-norm, FLOOR · scale)``; with a
-    tolerance of 10⁻¹⁰ any error above 10⁻¹⁴ of the scale (about 45 ε, see
-    :data:`FLOOR`) — anything beyond rounding — still fails. Each scale is the size of
-    that quantity's own terms (max-norms, Pinocchio's values), so a huge spring force
-    does not excuse an error of gravity:
-
-    - mass matrix: ``‖A‖`` (positive definite, nothing cancels);
-    - bias ``B q̇``: ``‖A‖ ‖q̇‖² + ‖B q̇‖``, the size of the velocity products;
-    - gravity: ``G₀ + ‖Q_g‖`` with ``G₀ = Σ_b m_b |g| |c_b|``, the moment of the
-      weights about the ground origin (``c_b`` the bodies' centres of mass): gravity
-      torques are differences of such moments;
-    - springs, dampers: ``‖Σ_e |J_e|ᵀ |C_e δ_e|‖`` and ``‖Σ_e |J_e|ᵀ |D_e δ̇_e|‖``, the
-      elements' forces before they cancel (:func:`rt70.reference.spring_damper_magnitudes`);
-    - q̈, per coordinate: ``|A⁻¹| (f + |A| |q̈|)`` with ``f_i`` the sum of the force
-      scales above for coordinate i (``‖A_i‖₁ ‖q̇‖² + |B q̇|_i + G₀ + |Q_g|_i`` and the
-      springs' and dampers' terms): the first-order bound of how far a rounding of the
-      forces and of A moves q̈ = A⁻¹ Q (Higham §7.1), coordinate by coordinate, so a
-      badly scaled A (a mimic factor of 10³⁰, mixed units) excuses no other coordinate;
-    - kinetic energy: ``‖A‖ ‖q̇‖²``; potential energy: ``G₀ + U_c`` (the terms
-      ``m_b g·c_b`` and the spring energy);
-    - points (:func:`compared_points`): the largest distance of a compared point from
-      the ground origin (a position is a sum of the bodies' offsets);
-    - load force (the wrench ``f = [F; M]`` of :func:`state_wrench`):
-      ``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖``, the terms of ``Jᵀ f`` before they cancel;
-    - drives (``[θ_d, Q]`` of the scene's drives and :func:`state_drive`), per entry: the
-      positions θ_d is computed from over the mesh radius, and the mesh forces' terms
-      ``|J_v|ᵀ|F|`` (:func:`_drive_scale`);
-    - impact, impulse (q̇⁺ and Λ of a random brake and stow pin): their first-order
-      rounding bounds, entry by entry (:func:`rt70.crosscheck.impact_check.impact_scales`);
-    - the loop rows of a scene with ``<rt70:loop>``: :func:`rt70.crosscheck.loop_check.loop_scales`.
-
-    Raises
-    ------
-    Rt70Error
-        If Pinocchio's mass matrix at this state is numerically singular: its
-        Jacobi-scaled form ``D^-½ A D^-½`` (D = diag A, which removes mere differences
-        of scale, van der Sluis) has a condition number above :data:`MAX_CONDITION`
-        or a non-positive eigenvalue — q̈ is then not determined in double precision.
-    """
-
-    def norm(name: str) -> float:
-        x = values[name][1]
-        return float(np.max(np.abs(x))) if x.size else 0.0
-
-    A = values["mass_matrix"][1]
-    d = np.sqrt(np.abs(np.diag(A)))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        eig = np.linalg.eigvalsh(A / np.outer(d, d)) if A.size else np.ones(1)
-    if not (np.all(d > 0.0) and eig[0] > 0.0 and eig[-1] <= MAX_CONDITION * eig[0]):
-        raise Rt70Error(
-            f"{scene.path}: the mass matrix is singular at a sampled state (scaled "
-            f"eigenvalues {eig[0]:.3g} … {eig[-1]:.3g}): the forward dynamics is not "
-            "determined"
-        )
-    from rt70 import reference
-
-    ref, rd = scene.reference, scene.reference_data
-    speed2 = float(np.max(np.abs(qd), initial=0.0)) ** 2
-    g0 = reference.weight_moment(ref, rd, q)
-    Sc, Sd = reference.spring_damper_magnitudes(ref, rd, q, qd)
-    Q_b, Q_g = np.abs(values["bias"][1]), np.abs(values["gravity"][1])
-    f = np.abs(A).sum(axis=1) * speed2 + Q_b + g0 + Q_g + Sc + Sd
-    qdd = np.abs(values["forward_dynamics"][1])
-    qdd_scale = np.abs(np.linalg.inv(A)) @ (f + np.abs(A) @ qdd)
-    return {
-        "mass_matrix": norm("mass_matrix"),
-        "bias": norm("mass_matrix") * speed2 + norm("bias"),
-        "gravity": g0 + norm("gravity"),
-        "spring_force": float(np.max(Sc, initial=0.0)),
-        "damper_force": float(np.max(Sd, initial=0.0)),
-        "forward_dynamics": qdd_scale,
-        "kinetic_energy": norm("mass_matrix") * speed2,
-        "potential_energy": g0 + reference.spring_potential(ref, rd, q),
-        "points": float(np.max(np.linalg.norm(values["points"][1].reshape(-1, 3), axis=1))),
-        "load_force": _load_scale(scene, q),
-        "drives": _drive_scale(scene, q),
-        "reactions": reaction_scale(scene, q, qd, state_wrench(scene, q)),
-        **impact_scales(scene, q, qd, {k: values[k][1] for k in ("impact", "impulse")}),
-        **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
-        **loop_scales(scene, values, q, qd, qdd_scale),
-        **{row: norm(row) for row in NONHOLONOMIC if row in values},
-    }
-
-
-def _load_scale(scene: Scene, q: np.ndarray) -> float:
-    """``‖|J_v|ᵀ|F| + |J_ω|ᵀ|M|‖`` of the state's load, Pinocchio's Jacobian."""
-    from rt70.reference import points as ref_points
-
-    w = state_wrench(scene, q)
-    Jv, Jw = ref_points.point_jacobian(scene.reference, scene.reference_data, q, w.link, w.xyz)
-    terms = np.abs(Jv).T @ np.abs(w.force) + np.abs(Jw).T @ np.abs(w.torque)
-    return float(np.max(terms, initial=0.0))
-
-
-def _drive_scale(scene: Scene, q: np.ndarray) -> np.ndarray:
-    """Per entry of the ``drives`` row (``[θ_d, Q]`` per drive): the size of its terms.
-
-    A gear sector's ``θ_d = atan2(v·d, u·d)`` with ``d = P − centre`` and P the mesh
-    point in the stator's axes, ``R_sᵀ (p_l + R_l xyz − p_s)``: a rounding of those
-    positions moves θ_d by ε times ``(|p_l| + |xyz| + |p_s| + |centre|) / |d|``. Its
-    ``Q = Σ J_vᵀ F`` of the mesh force on the link and its reaction on the stator:
-    ``Σ |J_v|ᵀ |F|``, the terms before they cancel — which they do exactly when the
-    link and the stator move as one (a mimic joint with multiplier 0 between them, say:
-    then θ_d and Q are zero and both sides compute rounding). A torque drive's θ_d and
-    Q (the coordinate and a unit vector) are exact on both sides: 0, their own size.
-    Pinocchio's poses and Jacobians.
-    """
-    from rt70.reference import drives as ref_drives
-    from rt70.reference import points as ref_points
-
-    ref, rd = scene.reference, scene.reference_data
-    scales = []
-    for drive in [*scene.description.drives, state_drive(scene, q)]:
-        if drive.sector is None:
-            scales.append(np.zeros(1 + ref.nv))
-            continue
-        s = drive.sector
-        mesh = ref_drives.sector_mesh(ref, rd, drive)
-        link = ref_drives.link_pose(ref, rd, q, s.link)
-        stator = ref_drives.link_pose(ref, rd, q, s.stator)
-        _, _, P = mesh.angle(s.xyz, link, stator)
-        lengths = np.linalg.norm([link[1], s.xyz, stator[1], mesh.centre], axis=1).sum()
-        angle = lengths / float(np.linalg.norm(P - mesh.centre))
-        terms = np.zeros(ref.nv)
-        for w in mesh.wrenches(s.link, s.stator, s.xyz, 1.0, link, stator):
-            Jv, _ = ref_points.point_jacobian(ref, rd, q, w.link, w.xyz)
-            terms += np.abs(Jv).T @ np.abs(np.asarray(w.force))
-        scales.append(np.concatenate([[angle], terms]))
-    return np.concatenate(scales)
-
-
-def _wind_scale(scene: Scene, q: np.ndarray) -> float:
-    """``‖Σ_i |J_v,i|ᵀ|F_i| + |J_ω,i|ᵀ|M_i|‖`` of the state's wind, Pinocchio's Jacobians."""
-    from rt70.reference import points as ref_points
-    from rt70.reference import wind as ref_wind
-
-    ref, rd = scene.reference, scene.reference_data
-    terms = np.zeros(ref.nv)
-    for w in ref_wind.wind_wrenches(ref, rd, q, state_wind(q)).values():
-        Jv, Jw = ref_points.point_jacobian(ref, rd, q, w.link, w.xyz)
-        terms += np.abs(Jv).T @ np.abs(w.force) + np.abs(Jw).T @ np.abs(w.torque)
-    return float(np.max(terms, initial=0.0))
-
 
 def _relative_error(x_tb: np.ndarray, x_ref: np.ndarray, floor) -> float:
     """``max_i |x_tb − x_ref|_i / max(‖x_ref‖, floor_i)`` (floor scalar or per entry)."""
@@ -482,11 +260,21 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
 
     The relative error is the max-norm of the difference over the larger of the
     max-norm of Pinocchio's value and ``FLOOR`` times the quantity's natural scale at
-    the state (:func:`natural_scales`). A NaN or infinite value on either side makes
-    the row's errors infinite and names the side in :attr:`Record.nonfinite`: such a
-    row never passes. Each evaluation is timed as the mean of ``repeat`` calls after a
-    warm-up call (fewer when they would take longer than :data:`REPEAT_BUDGET_S`:
-    :func:`_timed`).
+    the state (:func:`rt70.crosscheck.scales.natural_scales`). A NaN or infinite value
+    on either side makes the row's errors infinite and names the side in
+    :attr:`Record.nonfinite`: such a row never passes.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared, both sides built from its one file.
+    samples : int
+        Random states (:func:`rt70.crosscheck.samples.random_state`), at least 1.
+    seed : int
+        Seed of the states' generator.
+    repeat : int
+        Timed calls of each evaluation after a warm-up call, averaged (fewer when they
+        would take longer than :data:`REPEAT_BUDGET_S`: :func:`_timed`; 0: not timed).
 
     Raises
     ------
@@ -502,50 +290,75 @@ def cross_check(scene: Scene, samples: int = 10, seed: int = 0, repeat: int = 3)
         raise Rt70Error(f"samples must be at least 1, got {samples}")
     require_closable(scene)  # loops that cannot close: a model error, not a disagreement
     rng = np.random.default_rng(seed)
-    nv = scene.textbook.nv
-    rows = quantities(scene)
-    abs_err = dict.fromkeys(rows, 0.0)
-    rel_err = dict.fromkeys(rows, 0.0)
-    t_tb = dict.fromkeys(rows, 0.0)
-    t_ref = dict.fromkeys(rows, 0.0)
-    bad: dict[str, set[str]] = {name: set() for name in rows}
+    tally = _Tally(quantities(scene))
     for _ in range(samples):
-        q, qd = random_state(nv, rng)
+        q, qd = random_state(scene.textbook.nv, rng)
+        values = tally.evaluate(_pairs(scene, q, qd), repeat, samples)
+        if tally.any_nonfinite():  # no scale from non-finite values
+            scales = dict.fromkeys(tally.rows, 0.0)
+        else:
+            scales = natural_scales(scene, values, q, qd)
+        tally.compare(values, scales)
+    return tally.records(scene.name, scene.textbook.nv)
+
+
+class _Tally:
+    """Per row of the report: the largest errors so far, the mean times, the bad sides."""
+
+    def __init__(self, rows: tuple[str, ...]) -> None:
+        self.rows = rows
+        self.abs_err = dict.fromkeys(rows, 0.0)
+        self.rel_err = dict.fromkeys(rows, 0.0)
+        self.t_tb = dict.fromkeys(rows, 0.0)
+        self.t_ref = dict.fromkeys(rows, 0.0)
+        self.bad: dict[str, set[str]] = {name: set() for name in rows}
+
+    def evaluate(
+        self, pairs: dict[str, tuple[Callable, Callable]], repeat: int, samples: int
+    ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Both sides' values of every row at one state, timed (:func:`_timed`)."""
         values = {}
-        for name, (tb_fn, ref_fn) in _pairs(scene, q, qd).items():
+        for name, (tb_fn, ref_fn) in pairs.items():
             x_tb, dt_tb = _timed(tb_fn, repeat)
             x_ref, dt_ref = _timed(ref_fn, repeat)
             values[name] = np.asarray(x_tb, dtype=float), np.asarray(x_ref, dtype=float)
-            t_tb[name] += dt_tb / samples
-            t_ref[name] += dt_ref / samples
+            self.t_tb[name] += dt_tb / samples
+            self.t_ref[name] += dt_ref / samples
             for side, x in zip(("textbook", "pinocchio"), values[name], strict=True):
                 if _nonfinite(x):
-                    bad[name].add(side)
-        if any(bad[name] for name in rows):  # no scale from non-finite values
-            scales = dict.fromkeys(rows, 0.0)
-        else:
-            scales = natural_scales(scene, values, q, qd)
+                    self.bad[name].add(side)
+        return values
+
+    def any_nonfinite(self) -> bool:
+        """Whether some row was NaN or infinite on some side, at any state so far."""
+        return any(self.bad[name] for name in self.rows)
+
+    def compare(self, values: dict[str, tuple[np.ndarray, np.ndarray]], scales: dict) -> None:
+        """Fold one state's errors in: absolute, and relative to ``FLOOR ·`` the scales."""
         for name, (x_tb, x_ref) in values.items():
-            if bad[name]:
-                abs_err[name] = rel_err[name] = math.inf
+            if self.bad[name]:
+                self.abs_err[name] = self.rel_err[name] = math.inf
                 continue
             err = float(np.max(np.abs(x_tb - x_ref))) if x_ref.size else 0.0
-            abs_err[name] = max(abs_err[name], err)
+            self.abs_err[name] = max(self.abs_err[name], err)
             rel = _relative_error(x_tb, x_ref, FLOOR * np.asarray(scales[name]))
-            rel_err[name] = max(rel_err[name], rel)
-    return [
-        Record(
-            scene.name,
-            nv,
-            name,
-            abs_err[name],
-            rel_err[name],
-            t_tb[name],
-            t_ref[name],
-            " and ".join(sorted(bad[name])),
-        )
-        for name in rows
-    ]
+            self.rel_err[name] = max(self.rel_err[name], rel)
+
+    def records(self, target: str, nv: int) -> list[Record]:
+        """One :class:`Record` per row, in report order."""
+        return [
+            Record(
+                target,
+                nv,
+                name,
+                self.abs_err[name],
+                self.rel_err[name],
+                self.t_tb[name],
+                self.t_ref[name],
+                " and ".join(sorted(self.bad[name])),
+            )
+            for name in self.rows
+        ]
 
 
 def format_table(records: Iterable[Record], tolerance: float = DEFAULT_TOLERANCE) -> str:

@@ -185,7 +185,7 @@ def choose_independent(A: np.ndarray) -> np.ndarray:
     return np.sort(piv[np.atleast_2d(A).shape[0] :])
 
 
-# --- rt70 validate's rows (rt70.crosscheck.validate: quantities(), _pairs(), natural_scales())
+# --- rt70 validate's rows (rt70.crosscheck: validate.quantities(), scales.natural_scales())
 #: Rows compared for a scene with ``<rt70:no_slip>`` elements.
 ROWS = ("no_slip", "reduced_dynamics")
 

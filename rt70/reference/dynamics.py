@@ -91,7 +91,7 @@ def weight_moment(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> 
     ``c_b`` is body b's centre of mass in the ground frame (Pinocchio's joint placements
     ``oMi`` and inertia levers). It is the size of the terms that gravity torques and
     the gravity potential are sums and differences of (the natural scale of
-    :func:`rt70.crosscheck.validate.natural_scales`), in N·m = J.
+    :func:`rt70.crosscheck.scales.natural_scales`), in N·m = J.
     """
     qp, _, _, _ = to_pinocchio(model, q)
     pm, pd = model.pin_model, data.pin_data

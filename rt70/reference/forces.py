@@ -229,7 +229,7 @@ def spring_damper_magnitudes(
     The same sums as :func:`spring_damper_force` with every term taken by its absolute
     value (joint springs ``|k q|``, bushings ``|∂δ/∂q|ᵀ |C δ|`` and
     ``|∂δ/∂q|ᵀ |D δ̇|``): forces of elements that oppose each other cancel in the sum
-    but not here. The natural scale of :func:`rt70.crosscheck.validate.natural_scales`.
+    but not here. The natural scale of :func:`rt70.crosscheck.scales.natural_scales`.
     """
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     nv = model.pin_model.nv

@@ -17,7 +17,8 @@ import numpy as np
 import scipy
 import scipy.linalg
 
-from rt70.crosscheck.validate import cross_check, random_state
+from rt70.crosscheck.samples import random_state
+from rt70.crosscheck.validate import cross_check
 from rt70.model.scene import Scene
 from rt70.textbook import dynamics, forces, structured
 from rt70.textbook.kinematics import update_structure

@@ -14,7 +14,7 @@ import numpy as np
 import scipy
 import scipy.linalg
 
-from rt70.crosscheck.validate import random_state
+from rt70.crosscheck.samples import random_state
 from rt70.model.scene import Scene, load_scene, scene_from_text
 from rt70.reports.stress.edits import convert_units, free_floating_text, rt70_text
 from rt70.reports.stress.measures import (
