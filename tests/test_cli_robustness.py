@@ -395,7 +395,7 @@ _SIGTERM_BETWEEN_RENAMES = r"""
 import os, signal, sys
 from pathlib import Path
 from rt70.guards.atomic import atomic_write_all
-from rt70.cli.options import stop_signals
+from rt70.cli.session import stop_signals
 
 real_replace = os.replace
 def replace_then_sigterm(src, dst):  # SIGTERM right after the first rename

@@ -34,7 +34,7 @@ import numpy as np
 import pytest
 
 from rt70.cli.main import main
-from rt70.cli.options import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
+from rt70.cli.session import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 NO_DOF = """<robot name="still">
   <link name="world"/>

@@ -220,7 +220,7 @@ def test_stop_signals_record_and_raise_and_clear(monkeypatch):
     """The command line's SIGINT and SIGTERM handlers raise, record, and forget on exit."""
     import signal
 
-    from rt70.cli.options import stop_signals
+    from rt70.cli.session import stop_signals
     from rt70.guards import stop
 
     with stop_signals(143):

@@ -1,7 +1,8 @@
 """``rt70 cart``: the two-wheeled cart of companion source 002 steered by program constraints.
 
 Its own module, as ``rt70 pointing``'s (rt70/cli/pointing.py). The servo:
-:mod:`rt70.mechanics.chaplygin_cart`; docs/nonholonomic.md.
+:mod:`rt70.mechanics.chaplygin_cart`
+(docs: 'Nonholonomic systems and program constraints', docs/nonholonomic.md).
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "(companion source 002, physically consistent formulation): print the initial "
         "wheel torques and lateral reaction, the state at every --step, the smallest "
         "obstacle function g along the path and the largest constraint residual "
-        "(docs/nonholonomic.md).",
+        "(docs: 'Nonholonomic systems and program constraints', docs/nonholonomic.md).",
     )
     car.add_argument(
         "scene", nargs="?", default="two_wheeled_cart", help="scene (two_wheeled_cart)"

@@ -2,7 +2,8 @@
 
 Its own module, as ``rt70 pointing``'s (rt70/cli/pointing.py). The impact:
 :mod:`rt70.physics.impact`, the locks: :mod:`rt70.mechanics.locks`, the engagement after a
-simulation and its energy audit: :mod:`rt70.mechanics.engagement`; docs/impacts.md.
+simulation and its energy audit: :mod:`rt70.mechanics.engagement` (docs: 'Impacts',
+docs/impacts.md).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "on both sides: the textbook's KKT solve against Pinocchio's impulseDynamics. "
         "Prints the post-impact velocities, the impulses and the energy lost (Carnot); "
         "with --after T the scene is first simulated T seconds and the energy audit is "
-        "carried across the event (docs/impacts.md).",
+        "carried across the event (docs: 'Impacts', docs/impacts.md).",
     )
     imp.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
     imp.add_argument(
@@ -141,7 +142,7 @@ def _state(scene, args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray]:
 
 def run(args: argparse.Namespace) -> int:
     """Check the options, the scene and the locks; solve on both sides; print."""
-    from rt70.mechanics.locks import engage, joint_impulses, labels
+    from rt70.mechanics.locks import engage, joint_impulses
     from rt70.model.scene import load_scene
 
     asked = _locks(args)  # options first
@@ -157,19 +158,35 @@ def run(args: argparse.Namespace) -> int:
     else:
         impact = engage(scene, q, qd, locks, "textbook", args.restitution)
     ref = engage(scene, q, qd, locks, "reference", args.restitution)
-    names = list(scene.textbook.coordinate_names)
-    err_v = _relative(impact.qd_after, ref.qd_after)
-    err_l = _relative(impact.impulses, ref.impulses)
     shock = joint_impulses(scene, q, impact, locks, "textbook")  # (16), bearing shock loads
     shock_ref = joint_impulses(scene, q, ref, locks, "reference")
+    out = _report(scene, q, locks, (impact, shock), (ref, shock_ref))
+    if audit is not None:
+        out["audit"] = audit.to_dict()
+    options.check_finite(out, f"{scene.name}: impact")
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    _print_text(args, out, (impact, ref), shock, audit)
+    return 0
+
+
+def _report(scene, q: np.ndarray, locks: list, textbook: tuple, pinocchio: tuple) -> dict:
+    """The JSON-ready result: the textbook's impact, Pinocchio's and their differences.
+
+    ``textbook`` and ``pinocchio`` are each side's ``(Impact, joint impulses)``.
+    """
+    from rt70.mechanics.locks import labels
+
+    (impact, shock), (ref, shock_ref) = textbook, pinocchio
     err_j = _relative(
         np.concatenate(list(shock.values())), np.concatenate(list(shock_ref.values()))
     )
-    out = {
+    return {
         "scene": scene.name,
         "locks": labels(locks),  # one label per impulse (a lock given twice: twice)
         "restitution": impact.restitution,
-        "coordinates": names,
+        "coordinates": list(scene.textbook.coordinate_names),
         "q": q.tolist(),
         "qd_before": impact.qd_before.tolist(),
         "qd_after": impact.qd_after.tolist(),
@@ -183,25 +200,29 @@ def run(args: argparse.Namespace) -> int:
         "pinocchio": {
             "qd_after": ref.qd_after.tolist(),
             "impulses": ref.impulses.tolist(),
-            "max_rel_err_qd_after": err_v,
-            "max_rel_err_impulses": err_l,
+            "max_rel_err_qd_after": _relative(impact.qd_after, ref.qd_after),
+            "max_rel_err_impulses": _relative(impact.impulses, ref.impulses),
             "max_rel_err_joint_impulses": err_j,
         },
         "joint_impulses": {k: v.tolist() for k, v in shock.items()},  # [F; M], joint axes
     }
-    if audit is not None:
-        out["audit"] = audit.to_dict()
-    options.check_finite(out, f"{scene.name}: impact")
-    if args.json:
-        print(json.dumps(out, indent=2))
-        return 0
+
+
+def _print_text(args: argparse.Namespace, out: dict, impacts: tuple, shock: dict, audit) -> None:
+    """The text output: impulses, the largest velocity changes, energies, joint impulses.
+
+    ``impacts`` is ``(textbook Impact, Pinocchio's Impact)``; ``shock`` the textbook's
+    joint impulses; ``audit`` the energy audit across the engagement (``--after``) or None.
+    """
+    impact, ref = impacts
+    names, locks = out["coordinates"], out["locks"]
     print(
-        f"{scene.name}: {', '.join(labels(locks))} engage (e = {impact.restitution:g}, "
+        f"{out['scene']}: {', '.join(locks)} engage (e = {impact.restitution:g}, "
         f"{impact.rank} independent row(s))"
         + (f" after {args.after:g} s" if args.after is not None else "")
     )
     print("  impulses (N·s, N·m·s; pins in ground axes):")
-    for name, a, b in zip(labels(locks), impact.impulses, ref.impulses, strict=True):
+    for name, a, b in zip(locks, impact.impulses, ref.impulses, strict=True):
         print(f"    {name:<28} {a:>16.9g}   (pinocchio {b:.9g})")
     change = np.abs(impact.qd_after - impact.qd_before)
     shown = sorted(np.argsort(-change, kind="stable")[:SHOWN])
@@ -219,23 +240,29 @@ def run(args: argparse.Namespace) -> int:
     for k in sorted(size, key=size.get, reverse=True)[:SHOWN_JOINTS]:
         F, M = shock[k][:3], shock[k][3:]
         print(f"    {k:<28} |F| {np.linalg.norm(F):>12.6g}   |M| {np.linalg.norm(M):>12.6g}")
+    err = out["pinocchio"]
     print(
-        f"  against Pinocchio (impulseDynamics; rnea for the joints): q̇⁺ {err_v:.2e}, "
-        f"Λ {err_l:.2e}, joint impulses {err_j:.2e} relative"
+        "  against Pinocchio (impulseDynamics; rnea for the joints): "
+        f"q̇⁺ {err['max_rel_err_qd_after']:.2e}, Λ {err['max_rel_err_impulses']:.2e}, "
+        f"joint impulses {err['max_rel_err_joint_impulses']:.2e} relative"
     )
     if audit is not None:
-        print(
-            f"  energy audit at t = {audit.t:g} s: T {audit.kinetic_before:.9g} → "
-            f"{audit.kinetic_after:.9g}, U_g {audit.gravity:.9g}, U_c {audit.elastic:.9g}, "
-            f"E_ψ {audit.dissipated:.9g}, W_u {audit.input_work:.9g}, impact "
-            f"{audit.impact_lost:.9g} J"
-        )
-        print(
-            f"    total {audit.total_before:.12g} J before, {audit.total_after:.12g} J after "
-            f"(jump {audit.jump:.3g} J); simulation drift since t = 0: "
-            f"{audit.drift_before:.3g} J"
-        )
-    return 0
+        _print_audit(audit)
+
+
+def _print_audit(audit) -> None:
+    """The energy audit across the engagement (``--after``): each term, the jump, the drift."""
+    print(
+        f"  energy audit at t = {audit.t:g} s: T {audit.kinetic_before:.9g} → "
+        f"{audit.kinetic_after:.9g}, U_g {audit.gravity:.9g}, U_c {audit.elastic:.9g}, "
+        f"E_ψ {audit.dissipated:.9g}, W_u {audit.input_work:.9g}, impact "
+        f"{audit.impact_lost:.9g} J"
+    )
+    print(
+        f"    total {audit.total_before:.12g} J before, {audit.total_after:.12g} J after "
+        f"(jump {audit.jump:.3g} J); simulation drift since t = 0: "
+        f"{audit.drift_before:.3g} J"
+    )
 
 
 def _relative(x: np.ndarray, ref: np.ndarray) -> float:

@@ -1,10 +1,12 @@
-"""Command-line options checked before any work: argparse types, output paths, signals.
+"""Command-line options checked before any work: argparse types, the RT-70's pointing, outputs.
 
 Every bad option ends the run at once with exit code 2 and one line on stderr,
 ``rt70: error: argument --rtol: ...`` — no usage block, no traceback — before a scene
 is read or a simulation started. Output paths are probed (a temporary file is created
 and removed in the directory that will receive them), so a read-only directory, a
-directory where a file should go or a wrong suffix is refused up front.
+directory where a file should go or a wrong suffix is refused up front. What surrounds
+the run itself (exit codes, standard output, warnings, signals) is
+:mod:`rt70.cli.session`.
 """
 
 from __future__ import annotations
@@ -12,36 +14,16 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import signal
 import sys
 import tempfile
-import threading
-import warnings
 from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager
 from pathlib import Path
 from typing import NoReturn
 
-from rt70.errors import OutputError, Rt70Error, Rt70Warning
-from rt70.guards import stop
+from rt70.cli.session import numerical_message
+from rt70.errors import OutputError, Rt70Error
 from rt70.scenes.rt70_state import ELEVATION_RANGE
-
-#: Exit status on SIGTERM, Ctrl-C and a closed standard output (128 + signal number).
-EXIT_TERMINATED = 128 + signal.SIGTERM
-EXIT_INTERRUPTED = 128 + signal.SIGINT
-EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
-
-#: What each exit code of the command line means (the epilog of ``rt70 --help``).
-EXIT_CODES = {
-    0: "success",
-    1: "a check disagreed (validate), a robot failed unexpectedly (a bug in rt70), or "
-    "simulate's integration stopped before the end time",
-    2: "bad input: one line 'rt70: error: ...' naming the option or the file",
-    int(EXIT_INTERRUPTED): "interrupted (Ctrl-C)",
-    int(EXIT_BROKEN_PIPE): "standard output closed early ('rt70 ... | head')",
-    int(EXIT_TERMINATED): "stopped by SIGTERM (temporary files removed)",
-}
-
 
 #: Largest magnitude of an azimuth or a wind direction on the command line, degrees: one
 #: turn either way holds every direction; beyond it a float's spacing grows until the
@@ -158,7 +140,7 @@ def physical_float(text: str) -> float:
     if abs(value) > MAX_MAGNITUDE:
         raise argparse.ArgumentTypeError(
             f"magnitude above {MAX_MAGNITUDE:g}, the largest number rt70 reads "
-            f"(docs/urdf-reader.md), got {text}"
+            f"(docs: 'What rt70 reads from a URDF file', docs/urdf-reader.md), got {text}"
         )
     return value
 
@@ -241,6 +223,63 @@ def angle_deg(text: str) -> float:
     return value
 
 
+# --- the RT-70's pointing ----------------------------------------------------------------
+def add_pointing_arguments(parser: argparse.ArgumentParser, default: str = "zenith") -> None:
+    """``--elevation`` and ``--azimuth`` of the RT-70 (read back by :func:`asked_pointing`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    default : str
+        The default elevation as the help text names it ("zenith", "45").
+    """
+    parser.add_argument(
+        "--elevation",
+        type=elevation,
+        help=f"RT-70 elevation, degrees, 0 (horizon) to 90 (zenith); default {default}",
+    )
+    parser.add_argument("--azimuth", type=angle_deg, help="RT-70 azimuth, degrees (default 0)")
+
+
+def asked_pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, float, float, dict]:
+    """The RT-70 pointing asked for: (has axes, elevation, azimuth, held coordinates).
+
+    Elevation 90° and azimuth 0° unless given, held on the scene's pointing axes
+    (:func:`rt70.scenes.rt70_state.rt70_pointing`); a scene without them holds nothing.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options, with ``elevation`` and ``azimuth`` (degrees or None).
+    scene : rt70.model.scene.Scene
+        The scene the command runs on.
+    what : str
+        What the command computes, for the message of a scene that has no coordinate.
+
+    Raises
+    ------
+    Rt70Error
+        If the scene has no degree of freedom, or a pointing is given for a scene
+        without the RT-70's pointing axes.
+    """
+    from rt70.scenes import rt70_state
+
+    names = scene.textbook.coordinate_names
+    if not names:
+        raise Rt70Error(f"{scene.name}: the model has no degree of freedom: no {what}")
+    axes = (rt70_state.AZIMUTH_COORDINATE, rt70_state.ELEVATION_COORDINATE)
+    has_axes = all(axis in names for axis in axes)
+    if (args.elevation is not None or args.azimuth is not None) and not has_axes:
+        raise Rt70Error(
+            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes ({', '.join(axes)})"
+        )
+    elevation = 90.0 if args.elevation is None else args.elevation
+    azimuth = 0.0 if args.azimuth is None else args.azimuth
+    held = rt70_state.rt70_pointing(elevation, azimuth) if has_axes else {}
+    return has_axes, elevation, azimuth, held
+
+
 # --- values checked where they are used ------------------------------------------------
 @contextmanager
 def option_at_fault(option: str) -> Iterator[None]:
@@ -267,7 +306,7 @@ def option_at_fault(option: str) -> Iterator[None]:
     except Rt70Error as exc:
         raise type(exc)(f"{option}: {exc}") from None
     except RuntimeWarning as exc:
-        raise Rt70Error(f"{option}: {_numerical(exc)}") from None
+        raise Rt70Error(f"{option}: {numerical_message(exc)}") from None
 
 
 # --- results ---------------------------------------------------------------------------
@@ -375,150 +414,3 @@ def check_writable_directory(directory: Path) -> None:
         ) from None
     os.close(fd)
     os.unlink(name)
-
-
-class _CheckedOutput:
-    """Standard output whose write errors are one :class:`OutputError` (a closed pipe aside).
-
-    ``rt70 ... > file`` on a full disk fails inside ``print``; the error names standard
-    output, and what is still buffered goes to ``os.devnull`` so that the interpreter's
-    last flush at exit does not fail a second time.
-    """
-
-    def __init__(self, stream) -> None:
-        self._stream = stream
-
-    def write(self, text: str) -> int:
-        with self._errors():
-            return self._stream.write(text)
-
-    def flush(self) -> None:
-        with self._errors():
-            self._stream.flush()
-
-    def __getattr__(self, name: str):
-        return getattr(self._stream, name)
-
-    @contextmanager
-    def _errors(self) -> Iterator[None]:
-        try:
-            yield
-        except BrokenPipeError:  # the reader went away: the command line's exit 141
-            raise
-        except OSError as exc:
-            with suppress(OSError, ValueError):  # no file descriptor (a StringIO): nothing to do
-                _point_at_devnull(self._stream.fileno())
-            raise OutputError(f"standard output: cannot write ({exc.strerror or exc})") from None
-
-
-def _point_at_devnull(fd: int) -> None:
-    """Make file descriptor ``fd`` write to ``os.devnull``."""
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, fd)
-    finally:
-        os.close(devnull)
-
-
-@contextmanager
-def checked_stdout() -> Iterator[None]:
-    """Inside the block, a failed write to standard output raises :class:`OutputError`."""
-    stream = sys.stdout
-    sys.stdout = _CheckedOutput(stream)
-    try:
-        yield
-    finally:
-        sys.stdout = stream
-
-
-# --- numerical trouble -------------------------------------------------------------------
-#: Commands run without an :class:`~rt70.simulation.integrators.EvaluationBudget`: ``bench``
-#: measures methods at any cost by design, ``sweep`` keeps its own limits.
-UNBUDGETED = ("bench", "sweep")
-
-
-@contextmanager
-def warning_guards(command: str) -> Iterator[None]:
-    """Warnings as the command line treats them, and the integrations' budget.
-
-    Enter it inside ``warnings.catch_warnings()`` (rt70/cli/main.py's docstring): an
-    :class:`~rt70.errors.Rt70Warning` is printed each time as one ``rt70: warning:``
-    line; numpy's floating-point warnings and scipy's ``LinAlgWarning`` (every
-    ``RuntimeWarning``) become exceptions that the command line prints as its one error
-    line (:func:`numerical_failure`); every integration of ``command`` but those of
-    :data:`UNBUDGETED` runs under :func:`rt70.simulation.integrators.evaluation_budget`.
-    """
-    from contextlib import nullcontext
-
-    from rt70.simulation.integrators import evaluation_budget
-
-    warnings.simplefilter("error", RuntimeWarning)
-    warnings.simplefilter("always", Rt70Warning)
-    warnings.showwarning = _show_warning
-    with nullcontext() if command in UNBUDGETED else evaluation_budget():
-        yield
-
-
-_default_showwarning = warnings.showwarning
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Print an :class:`~rt70.errors.Rt70Warning` as one ``rt70: warning:`` line on stderr."""
-    if issubclass(category, Rt70Warning):
-        print(f"rt70: warning: {message}", file=sys.stderr)
-    else:
-        _default_showwarning(message, category, filename, lineno, file, line)
-
-
-def numerical_failure(argv: list[str], exc: RuntimeWarning) -> str:
-    """The error line of a RuntimeWarning that reached the command line.
-
-    No check named the value at fault, so the line names what the user gave: the
-    command as typed (its scene file and options, ``argv``) and the failure.
-    """
-    import shlex
-
-    return f"rt70 {shlex.join(argv)}: {_numerical(exc)}"
-
-
-def _numerical(exc: RuntimeWarning) -> str:
-    """``numerical failure (<warning>): ...``: what a floating-point failure says."""
-    what = " ".join(str(exc).split())
-    return (
-        f"numerical failure ({type(exc).__name__}: {what}): an input is beyond what the "
-        "computation can represent; check the magnitudes of these options and of the model"
-    )
-
-
-# --- signals -----------------------------------------------------------------------------
-@contextmanager
-def stop_signals(code: int) -> Iterator[None]:
-    """Inside the block SIGTERM raises ``SystemExit(code)`` and SIGINT ``KeyboardInterrupt``.
-
-    ``finally`` blocks run, so temporary output files are removed
-    (:mod:`rt70.guards.atomic`). Each stop is recorded as well
-    (:func:`rt70.guards.stop.request`), so one raised where it gets lost is raised again
-    at the integrators' next right-hand side (:func:`rt70.guards.stop.check`). The previous
-    handlers are restored afterwards and the record cleared; outside the main thread
-    nothing changes.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def terminate(signum: int, _frame: object) -> NoReturn:
-        stop.request(lambda: SystemExit(code))
-
-    def interrupt(signum: int, _frame: object) -> NoReturn:
-        stop.request(KeyboardInterrupt)
-
-    previous = {
-        signal.SIGTERM: signal.signal(signal.SIGTERM, terminate),
-        signal.SIGINT: signal.signal(signal.SIGINT, interrupt),
-    }
-    try:
-        yield
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
-        stop.clear()

@@ -2,7 +2,7 @@
 
 Its own module, as ``rt70 sweep``'s (rt70/cli/sweep.py), so that rt70/cli/main.py stays one
 screenful of commands. The budget: :mod:`rt70.telescope.pointing`; the gust record check:
-:mod:`rt70.telescope.gust_run`; docs/pointing.md.
+:mod:`rt70.telescope.gust_run` (docs: 'The wind pointing budget', docs/pointing.md).
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
         "against the source, the counterreflector against the main mirror (arc seconds) "
         "and the focus offset (mm); the steady value and the gust rms (Lyapunov), and the "
         "three closed-loop modes that contribute most. --duration also runs that many "
-        "seconds of gusts through the nonlinear model and compares (docs/pointing.md).",
+        "seconds of gusts through the nonlinear model and compares (docs: 'The wind "
+        "pointing budget', docs/pointing.md).",
     )
     poi.add_argument("scene", metavar="SCENE", help="scene name or URDF path (rt70_servo)")
     add_pointing_arguments(poi, default="45")
@@ -86,7 +87,8 @@ def run(args: argparse.Namespace) -> int:
     if scene.name == LISTING and not scene.description.drives:
         print(
             f"rt70: note: {LISTING} is the listing as printed, which its drives cannot hold "
-            f"(docs/rt70-errata.md, item 12); the budget is that of {SERVO_SCENE}, the "
+            f"(docs: 'RT-70 errata and data choices', docs/rt70-errata.md, item 12); the "
+            f"budget is that of {SERVO_SCENE}, the "
             "control object (counterweight below the elevation axis, drives, wind elements)",
             file=sys.stderr,
         )

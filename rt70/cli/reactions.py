@@ -2,7 +2,7 @@
 
 Its own module, as ``rt70 pointing``'s (rt70/cli/pointing.py). The loads:
 :mod:`rt70.telescope.bearing_loads`; the reactions: :mod:`rt70.textbook.reactions` and
-:mod:`rt70.reference.reactions`; docs/reactions.md.
+:mod:`rt70.reference.reactions` (docs: 'Joint reactions', docs/reactions.md).
 """
 
 from __future__ import annotations
@@ -39,7 +39,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
         description="The wrenches across the azimuth joint (platform_rz) and the elevation "
         "joint (base_rx) and the drives' reducer torques at the static equilibrium the "
         "drives hold, under gravity and optionally a steady wind (front and back by "
-        "default): source 004's joint reactions on both sides (docs/reactions.md).",
+        "default): source 004's joint reactions on both sides (docs: 'Joint reactions', "
+        "docs/reactions.md).",
     )
     rea.add_argument("scene", metavar="SCENE", help="scene name or URDF path (rt70_servo)")
     rea.add_argument(

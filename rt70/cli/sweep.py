@@ -27,7 +27,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "Axis values: A:B:N (N values, ends included), A,B,... or A. Writes FILE (.npz: "
         "the axes and one array per quantity field) and FILE's .json sidecar (metadata, "
         "failed points); finished chunks are kept in FILE.partial/ so the same command "
-        "resumes an interrupted sweep (docs/sweeps.md).",
+        "resumes an interrupted sweep (docs: 'Sweeps', docs/sweeps.md).",
     )
     swp.add_argument("scene", metavar="SCENE", help="scene name or URDF path (RT-70 axes)")
     for name, unit, default in (

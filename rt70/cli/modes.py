@@ -1,0 +1,183 @@
+"""``rt70 modes``: eigenfrequencies and mode shapes of a scene at its static equilibrium.
+
+The linearisation: :mod:`rt70.linear.linearize`; the modes: :mod:`rt70.linear.modal` and
+their table :mod:`rt70.linear.mode_table`; a scene with ``<rt70:loop>`` closures on its
+manifold Φ(q) = 0 (:mod:`rt70.linear.constrained_scene`; docs: 'Modes of a constrained
+scene', docs/constrained-modes.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from rt70.cli import options
+from rt70.errors import SingularConfigurationError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add ``rt70 modes`` to the command line's subparsers ``sub``; return its parser."""
+    mod = sub.add_parser(
+        "modes",
+        help="eigenfrequencies and mode shapes at static equilibrium",
+        description="Linearise a scene at its static equilibrium under gravity (the "
+        "RT-70 at a given pointing, held there) and print the eigenfrequencies of "
+        "K v = ω² M v. A scene with <rt70:drive> elements (rt70_servo) gives its "
+        "locked-rotor spectrum: the motors held, the reducers' stiffness holding the axes. "
+        "Without drives (rt70, the listing) the axes are free unless --lock-axes.",
+    )
+    mod.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
+    options.add_pointing_arguments(mod)
+    mod.add_argument(
+        "--lock-axes",
+        action="store_true",
+        help="remove the azimuth and elevation coordinates (drives infinitely stiff)",
+    )
+    mod.add_argument("--json", action="store_true", help="print JSON")
+    mod.set_defaults(func=run)
+    return mod
+
+
+def run(args: argparse.Namespace) -> int:
+    """Linearise the scene at its static equilibrium and print its modes (text or JSON)."""
+    from rt70.linear import mode_table
+    from rt70.model.scene import load_scene
+
+    scene = load_scene(args.scene)
+    has_axes, elevation, azimuth, held = options.asked_pointing(args, scene, "modes")
+    result, shapes, model, damped, constraints = _spectrum(args, scene, held)
+    drives = bool(scene.description.drives) and not args.lock_axes
+    rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates)
+    damped_summary = mode_table.damped_summary(result, damped)
+    options.check_finite({"modes": rows, "damped": damped_summary}, f"{scene.name}: modes")
+    if args.json:
+        out = {
+            "scene": scene.name,
+            "held": held,
+            "locked_rotor": drives,
+            **({"constraints": constraints} if constraints is not None else {}),
+            "modes": rows,
+            "damped": damped_summary,
+        }
+        print(json.dumps(out, indent=2))
+        return 0
+    where = f", elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
+    what = f"{len(rows)} modes at static equilibrium{where}{_manifold(constraints)}"
+    print(f"{scene.name}: {what}{_axes(args, scene, held, drives)}")
+    _print_table(rows, result, damped)
+    _print_unheld(rows, held, args.lock_axes)
+    return 0
+
+
+def _spectrum(args: argparse.Namespace, scene, held: dict) -> tuple:
+    """``(modes, shapes, model, damped modes, constraints)`` at the static equilibrium.
+
+    The tree held at the pointing (the axes locked with ``--lock-axes``; with drives and
+    free axes, the locked-rotor model), or a closed-chain scene on its manifold
+    (:func:`_loop_modes`; ``constraints`` is None for a tree).
+    """
+    import numpy as np
+
+    from rt70.linear import linearize as lin
+    from rt70.linear import modal
+    from rt70.textbook.massless import require_diagonal
+
+    constraints = None
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
+            if scene.description.loops:  # on the manifold Φ(q) = 0 (docs/constrained-modes.md)
+                result, shapes, model, damped, constraints = _loop_modes(args, scene, held)
+            else:
+                q0 = lin.equilibrium(scene, held)
+                model = lin.linearize(scene, q0, locked=tuple(held) if args.lock_axes else ())
+                if scene.description.drives and not args.lock_axes:  # motors held: locked rotor
+                    model = lin.locked_rotor(scene, model)
+    except SingularConfigurationError as exc:  # a state on the way: name the scene
+        raise SingularConfigurationError(f"{scene.name}: {exc}") from None
+    if constraints is None:
+        require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
+        result = modal.modes(model.M, model.K, model.D)
+        shapes = result.shapes
+        damped = modal.damped_modes(model.M, model.K, model.D)
+    return result, shapes, model, damped, constraints
+
+
+def _loop_modes(args: argparse.Namespace, scene, held: dict) -> tuple:
+    """Modes of a closed-chain scene on its manifold (textbook side; docs/constrained-modes.md).
+
+    From the mechanism's closed start, or a closed state at rest
+    (:func:`rt70.simulation.closed_chains.closed_rest`); the stable equilibrium (Newton
+    descending where the stiffness is negative). Returns modes, shapes, model, damped modes,
+    constraints.
+    """
+    from rt70.linear import constrained_scene as cs
+    from rt70.scenes.loop_scenes import start_state
+    from rt70.simulation.closed_chains import closed_rest
+    from rt70.textbook import loops
+
+    start = start_state(scene)
+    q = start[0] if start is not None else closed_rest(scene)[0]
+    for name, value in held.items():
+        q[scene.textbook.coordinate_names.index(name)] = value
+    model = cs.constrained_linearize(
+        scene,
+        loops.loop_residual,
+        loops.loop_jacobian,
+        held,
+        args.lock_axes,
+        q_start=q,
+        descend=True,
+    )
+    modes, shapes, damped, constraints = cs.spectrum(model)
+    return modes, shapes, model, damped, constraints
+
+
+def _manifold(constraints: dict | None) -> str:
+    """The title's note of the loop-closure rows the modes are constrained by, if any."""
+    if constraints is None:
+        return ""
+    return (
+        f", on the manifold of {constraints['loop_rows']} loop-closure row(s) "
+        f"(rank {constraints['rank']})"
+    )
+
+
+def _axes(args: argparse.Namespace, scene, held: dict, drives: bool) -> str:
+    """The title's note of what holds the axes: locked, or the drives' locked rotors."""
+    if drives:
+        names = ", ".join(d.name for d in scene.description.drives)
+        return f" (locked rotor: the motors of {names} held, their reducers hold the axes)"
+    return " (axes locked)" if args.lock_axes and held else ""
+
+
+def _print_table(rows: list[dict], result, damped) -> None:
+    """The modes' table and the line on the damping and the damped system's eigenvalues."""
+    print(f"{'mode':>4} {'f, Hz':>10} {'ξ':>8}  {'kind':<8} dominant coordinate (energy)")
+    for r in rows:
+        zeta = "" if r["zeta"] is None else f"{r['zeta']:.4f}"
+        freq = f"{r['freq_hz']:.4f}" if r["freq_hz"] is not None else "—"
+        print(f"{r['mode']:>4} {freq:>10} {zeta:>8}  {r['kind']:<8} {r['dominant']}")
+    print(
+        "ξ = (VᵀDV)ᵢᵢ/2ωᵢ of the undamped modes"
+        + ("" if result.proportional else " (approximate: the damping is not proportional)")
+        + f"; the damped system has {len(damped.oscillatory)} oscillatory pairs and "
+        f"{len(damped.real)} real eigenvalues (creeping motions: overdamped, rigid, unstable)"
+    )
+
+
+def _print_unheld(rows: list[dict], held: dict, lock_axes: bool) -> None:
+    """One line per unstable or rigid mode: what it is and what would hold it."""
+    hint = "; --lock-axes lets the drives hold it" if held and not lock_axes else ""
+    for r in rows:
+        if r["kind"] == "unstable":
+            print(
+                f"mode {r['mode']} is unstable (negative stiffness, divergence rate "
+                f"{r['divergence_rate']:.4g} 1/s): gravity's moment about {r['dominant']} "
+                "grows faster than any spring resists it — the part it swings is not balanced "
+                f"about that free axis{hint}"
+            )
+        elif r["kind"] == "rigid":
+            print(
+                f"mode {r['mode']} is a rigid-body motion along {r['dominant']}: nothing holds "
+                f"it (no spring, no drive, no gravity moment){hint}"
+            )

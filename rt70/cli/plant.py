@@ -1,0 +1,195 @@
+"""``rt70 plant``: the linear plant of a scene, with named inputs and outputs, and its reductions.
+
+The plant: :mod:`rt70.linear.plant` (for the RT-70 the axis torques in; the axis angles,
+the optical points, the focal offset and the pointing corrections out); its reductions
+by modal or balanced truncation and their H∞ error: :mod:`rt70.linear.reduce` (docs:
+'Reduced plants of the RT-70', docs/plant-reduction.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from rt70.cli import options
+from rt70.errors import Rt70Error, SingularConfigurationError
+
+#: Above this elevation (degrees) the pointing corrections are not given (zenith keyhole).
+ZENITH_KEYHOLE_DEG = 89.0
+
+#: The units of the plant's signals, as ``--json`` reports them.
+UNITS = (
+    "inputs N or N·m; angles rad, points m, focal_offset mm, "
+    "pointing_correction arcsec (Δα, Δβ); states m, rad and their rates"
+)
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add ``rt70 plant`` to the command line's subparsers ``sub``; return its parser."""
+    pla = sub.add_parser(
+        "plant",
+        help="the linear plant (state space) with named inputs and outputs",
+        description="Linearise a scene at its static equilibrium (the RT-70 at a pointing, "
+        "its axes held) and print the state space's named inputs and outputs: for the "
+        "RT-70 the axis torques in, the axis angles and the optical points out; for other "
+        "scenes a force on and the value of every coordinate. --out writes A, B, C, D and "
+        "the names (.npz); in Python, rt70.linear.plant.to_control gives python-control's "
+        "StateSpace.",
+    )
+    pla.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
+    options.add_pointing_arguments(pla)
+    pla.add_argument("--json", action="store_true", help="print JSON")
+    pla.add_argument("--out", help="write A, B, C, D and the names to FILE.npz")
+    pla.add_argument(
+        "--reduce",
+        type=options.positive_int,
+        metavar="N",
+        help="reduce to N states and print the H∞ error (--out writes the reduced plant)",
+    )
+    pla.add_argument(
+        "--method",
+        choices=("modal", "balanced"),
+        help="with --reduce: modal truncation with static correction, or balanced "
+        "truncation by Hankel singular values (default)",
+    )
+    pla.set_defaults(func=run)
+    return pla
+
+
+def run(args: argparse.Namespace) -> int:
+    """Build the plant at the static equilibrium, reduce it if asked, write and print it."""
+    import numpy as np
+
+    from rt70.linear import linearize as lin
+    from rt70.linear import modal
+    from rt70.linear import plant as pl
+    from rt70.model.scene import load_scene
+
+    method = _check_reduction(args)
+    scene = load_scene(args.scene)
+    has_axes, elevation, azimuth, held = options.asked_pointing(args, scene, "plant")
+    inputs, outputs = _signals(scene, has_axes, elevation, azimuth, held)
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            q0 = lin.equilibrium(scene, held)
+            ss = pl.plant(scene, q0, inputs, outputs)
+    except SingularConfigurationError as exc:
+        raise SingularConfigurationError(f"{scene.name}: {exc}") from None
+    # from K v = ω² M v, not from eig(A): a rigid mode's double pole at 0 splits by
+    # rounding into ±√ε-sized poles that would look unstable
+    so = ss.second_order
+    spectrum = modal.modes(so.M, so.K)
+    info = {
+        "scene": scene.name,
+        "pointing": {"elevation_deg": elevation, "azimuth_deg": azimuth} if has_axes else None,
+        "states": list(ss.state_names),
+        "inputs": list(ss.input_names),
+        "outputs": list(ss.output_names),
+        "unstable_modes": int(spectrum.negative.sum()),
+        "rigid_modes": int(spectrum.rigid.sum()),
+        "units": UNITS,
+    }
+    if args.reduce is not None:  # modal or balanced truncation, and what it costs
+        ss = _reduce(args, scene, method, ss, info)
+    _write(args, scene, ss, info)
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    where = f" at elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
+    _print_text(args, f"{scene.name}: linear plant{where}", ss, info)
+    return 0
+
+
+def _check_reduction(args: argparse.Namespace) -> str:
+    """The reduction method (``--method``, default balanced), checked against ``--reduce``."""
+    method = args.method or "balanced"
+    if args.method is not None and args.reduce is None:
+        raise Rt70Error("--method needs --reduce N")
+    if method == "modal" and args.reduce is not None and args.reduce % 2:
+        raise Rt70Error(
+            f"--reduce {args.reduce}: modal truncation keeps whole modes, 2 states each"
+        )
+    return method
+
+
+def _signals(scene, has_axes: bool, elevation: float, azimuth: float, held: dict) -> tuple:
+    """``(inputs, outputs)`` of the plant.
+
+    With the RT-70's axes: the drives' torques in; the axis angles, the optical points
+    and (below :data:`ZENITH_KEYHOLE_DEG`) the focal offset and the pointing corrections
+    out. Otherwise a generalised force on, and the value of, every coordinate.
+    """
+    from rt70.linear import plant as pl
+    from rt70.model.outputs import optical_point_outputs
+
+    if not has_axes:
+        names = scene.textbook.coordinate_names
+        inputs = [pl.CoordinateInput(f"force:{n}", n) for n in names]
+        return inputs, [pl.CoordinateOutput(n, n) for n in names]
+    inputs = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
+    outputs = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
+    outputs += optical_point_outputs(scene)
+    if elevation < ZENITH_KEYHOLE_DEG:  # at the zenith Δα, Δβ are undefined (4.160)
+        from rt70.scenes.rt70_optics import rt70_mirror_outputs
+
+        mirror = rt70_mirror_outputs(scene, elevation, azimuth)
+        outputs += [o for o in mirror if o.name in ("focal_offset", "pointing_correction")]
+    return inputs, outputs
+
+
+def _reduce(args: argparse.Namespace, scene, method: str, full, info: dict):
+    """The plant reduced to ``--reduce`` states; its order and H∞ error go into ``info``."""
+    from rt70.linear import reduce as rd
+
+    with options.option_at_fault(f"{scene.name}: --reduce {args.reduce}"):
+        red = (
+            rd.modal_truncation(full, args.reduce // 2)
+            if method == "modal"
+            else rd.balanced_truncation(full, args.reduce)
+        )
+    ss, err = red.ss, rd.hinf_error(full, red.ss)
+    info["states"] = list(ss.state_names)
+    info["reduced"] = {
+        "method": method,
+        "order": red.order,
+        "full_order": full.n_states,
+        "hinf_error": err.peak,
+        "hinf_error_relative": err.relative,
+        "peak_hz": err.freq_hz,
+        "bound_2sum_hsv": red.bound,
+    }
+    return ss
+
+
+def _write(args: argparse.Namespace, scene, ss, info: dict) -> None:
+    """Check the plant is finite; with ``--out``, write A, B, C, D and the names (.npz)."""
+    import numpy as np
+
+    arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
+    options.check_finite({**info, **arrays}, f"{scene.name}: plant")
+    if args.out:
+        from rt70.guards.atomic import atomic_write
+
+        labels = {k: np.array(info[k]) for k in ("states", "inputs", "outputs")}
+        atomic_write(args.out, lambda tmp: np.savez_compressed(tmp, **arrays, **labels))
+
+
+def _print_text(args: argparse.Namespace, title: str, ss, info: dict) -> None:
+    """The plant's summary: its size, unstable and rigid modes, signals, reduction."""
+    print(
+        f"{title}: {ss.n_states} states, {ss.n_inputs} inputs, "
+        f"{ss.n_outputs} outputs; {info['unstable_modes']} unstable and "
+        f"{info['rigid_modes']} rigid mode(s) (the loops the drives must close)"
+    )
+    print("  inputs:  " + ", ".join(ss.input_names))
+    print("  outputs: " + ", ".join(ss.output_names))
+    if args.reduce is not None:
+        r = info["reduced"]
+        bound = "" if r["bound_2sum_hsv"] is None else f" (bound 2Σσ {r['bound_2sum_hsv']:.3g})"
+        print(
+            f"  reduced by {r['method']} truncation to {r['order']} states: H∞ error "
+            f"{r['hinf_error']:.3g}{bound}, {r['hinf_error_relative']:.2e} of ‖G‖∞, "
+            f"peak at {r['peak_hz']:.3g} Hz (in the outputs' units per input unit)"
+        )
+    if args.out:
+        print(f"wrote {args.out}")
