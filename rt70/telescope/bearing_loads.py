@@ -322,8 +322,19 @@ def load_table(
 ) -> list[BearingLoads]:
     """The loads at every elevation: calm, and with the wind from each of ``directions``.
 
-    ``directions`` are azimuths the wind blows from (None: front), used when
-    ``wind_speed`` > 0.
+    Parameters
+    ----------
+    scene : Scene
+        A scene with the RT-70's drives (and ``<rt70:wind>`` elements for a wind).
+    elevations : sequence of float
+        The elevations, degrees (:data:`ELEVATIONS`).
+    azimuth_deg : float
+        The azimuth of every case, degrees.
+    wind_speed : float
+        Mean wind speed, m/s; 0: calm cases only.
+    directions : tuple of float or None
+        Azimuths the wind blows from, degrees (None: front, into the dish), used when
+        ``wind_speed`` > 0.
     """
     cases = []
     for e in elevations:

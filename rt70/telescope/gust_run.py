@@ -22,13 +22,14 @@ budget (the ensemble rms, which a finite record estimates with a statistical err
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import control
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.model.outputs import evaluate
+from rt70.model.outputs import Output, evaluate
 from rt70.model.scene import Scene
 from rt70.telescope.pointing import (
     BUDGET_OUTPUTS,
@@ -104,8 +105,21 @@ def _rms(y: np.ndarray) -> float:
 STATES_PER_DRIVE = 8
 
 
-def check_duration(scene: Scene, duration: float, dt: float = DT, outputs=()) -> None:
+def check_duration(
+    scene: Scene, duration: float, dt: float = DT, outputs: Sequence[Output] = ()
+) -> None:
     """Refuse a record whose samples (every ``dt`` over ``duration``) this machine cannot hold.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene run (its coordinates and drives set the states per sample).
+    duration : float
+        The record's length, s.
+    dt : float
+        The gust sampling interval, s.
+    outputs : sequence of rt70.model.outputs.Output
+        The outputs recorded with every sample.
 
     Raises
     ------
@@ -137,20 +151,32 @@ def gust_run(
 ) -> GustRun:
     """Run one gust record through both models (module docstring).
 
-    ``model``: the case's :class:`rt70.telescope.pointing.BudgetModel` if the budget was computed
-    already (``rt70 pointing --duration``): its equilibria, loop and covariance are used
-    as they are.
+    Parameters
+    ----------
+    scene : Scene
+        A scene with the RT-70's drives and wind elements (``rt70_servo``).
+    case : PointingCase
+        The pointing and the mean wind.
+    duration : float
+        The record's length, s (at least two samples).
+    seed : int
+        Seed of the gust record (:func:`rt70.wind.gusts.realise`).
+    dt : float
+        Gust sampling interval, s (:data:`DT`).
+    rtol : float
+        Relative tolerance of the nonlinear run (:data:`RTOL`).
+    progress : bool
+        Show the nonlinear run's progress bar on stderr.
+    model : rt70.telescope.pointing.BudgetModel, optional
+        The case's budget model if the budget was computed already (``rt70 pointing
+        --duration``): its equilibria, loop and covariance are used as they are.
 
     Raises
     ------
     Rt70Error
         A bad case, a record shorter than two samples, or the integration failing.
     """
-    from rt70.linear.covariance import sample_variance_error
-    from rt70.simulation.simulate import simulate
-    from rt70.telescope.scene_servo import SceneServoFactory
     from rt70.wind.gusts import GustFilter, realise
-    from rt70.wind.load import WindLoad
 
     check_case(case)
     if not (np.isfinite(duration) and duration >= 2 * dt):
@@ -162,8 +188,63 @@ def gust_run(
     outputs = model.outputs
     check_duration(scene, duration, dt, outputs)
     series = realise(GustFilter(case.speed), duration, dt, seed)
-    t = series.t
-    # the nonlinear model, at rest in the windy equilibrium held by its drives
+    t, v = series.t, np.asarray(series.v)
+    nonlinear, seconds, steps = _nonlinear_run(scene, model, series, rtol, progress)
+    linear = _linear_response(model, t, v)
+    # the same linear loop fed the load's exact speed law: (v̄+v′)² − v̄² = 2v̄(v′ + v′²/2v̄)
+    exact_load = _linear_response(model, t, v + v * v / (2.0 * case.speed))
+    lyap = model.gust_rms()
+    return GustRun(
+        case=case,
+        duration=float(t[-1]),
+        seed=seed,
+        t=t,
+        gust=v,
+        nonlinear=nonlinear,
+        linear=linear,
+        linear_exact_load=exact_load,
+        rms_nonlinear={k: _rms(y) for k, y in nonlinear.items()},
+        rms_linear={k: _rms(y) for k, y in linear.items()},
+        rms_linear_exact_load={k: _rms(y) for k, y in exact_load.items()},
+        rms_lyapunov=lyap,
+        rms_error=_rms_error(model, lyap, float(t[-1]), dt),
+        seconds=seconds,
+        steps=steps,
+    )
+
+
+def _rms_error(
+    model: BudgetModel, lyap: dict[str, float], duration: float, dt: float
+) -> dict[str, float]:
+    """The standard deviation of a record's rms about the ensemble rms ``lyap``, per output.
+
+    ``std(ŝ²) / (2 s)`` for a small relative error, ``std(ŝ²)`` of a record of
+    ``duration`` seconds sampled every ``dt`` from the linear model
+    (:func:`rt70.linear.covariance.sample_variance_error`).
+    """
+    from rt70.linear.covariance import sample_variance_error
+
+    return {
+        o.name: sample_variance_error(model.augmented, model.rows(o), duration, dt=dt)
+        / (2.0 * lyap[o.name])
+        for o in model.outputs
+    }
+
+
+def _nonlinear_run(
+    scene: Scene, model: BudgetModel, series, rtol: float, progress: bool
+) -> tuple[dict[str, np.ndarray], float, int]:
+    """The nonlinear model's record: ``(outputs' changes, wall seconds, evaluations)``.
+
+    The scene's structure with both drives' servo cascades
+    (:class:`rt70.telescope.scene_servo.SceneServoFactory`) and the wind load exact in
+    the speed (:class:`rt70.wind.load.WindLoad`), at rest in the windy equilibrium held
+    by its drives; each output as its change from that equilibrium.
+    """
+    from rt70.simulation.simulate import simulate
+    from rt70.telescope.scene_servo import SceneServoFactory
+    from rt70.wind.load import WindLoad
+
     factory = SceneServoFactory()
     couplings = factory.couplings(scene)
     names = scene.coordinate_names
@@ -180,56 +261,33 @@ def gust_run(
     start = time.perf_counter()
     result = simulate(
         scene,
-        (0.0, float(t[-1])),
+        (0.0, float(series.t[-1])),
         (q0, np.zeros(scene.textbook.nv)),
         method=METHOD,
         rtol=rtol,
-        t_eval=t,
-        outputs=outputs,
+        t_eval=series.t,
+        outputs=model.outputs,
         components=components,
         progress=progress,
     )
     seconds = time.perf_counter() - start
     if not result.success:
         raise Rt70Error(f"{scene.name}: gust run: {result.message}")
-    steady = evaluate(scene, q0, outputs, "reference")
-    nonlinear = {o.name: result.outputs[o.name] - steady[o.name] for o in outputs}
-    # the linear closed loop on the same samples
+    steady = evaluate(scene, q0, model.outputs, "reference")
+    nonlinear = {o.name: result.outputs[o.name] - steady[o.name] for o in model.outputs}
+    return nonlinear, seconds, int(getattr(result, "nfev", -1))
+
+
+def _linear_response(model: BudgetModel, t: np.ndarray, u: np.ndarray) -> dict[str, np.ndarray]:
+    """The budget's linear closed loop driven by the gust samples ``u`` (m/s) at times ``t``.
+
+    python-control's ``forced_response``; each output's (n, 3) record by name.
+    """
+    outputs = model.outputs
     labels = [r for o in outputs for r in model.rows(o)]
-
-    def linear_response(u: np.ndarray) -> dict[str, np.ndarray]:
-        response = control.forced_response(model.loop[labels, "gust"], T=t, U=u)
-        y = np.atleast_2d(response.outputs).T
-        return {o.name: y[:, 3 * k : 3 * k + 3] for k, o in enumerate(outputs)}
-
-    v = np.asarray(series.v)
-    linear = linear_response(v)
-    # the same linear loop fed the load's exact speed law: (v̄+v′)² − v̄² = 2v̄(v′ + v′²/2v̄)
-    exact_load = linear_response(v + v * v / (2.0 * case.speed))
-    lyap = model.gust_rms()
-    # std of a record's rms: std(ŝ²) / (2 s) for a small relative error
-    error = {
-        o.name: sample_variance_error(model.augmented, model.rows(o), float(t[-1]), dt=dt)
-        / (2.0 * lyap[o.name])
-        for o in outputs
-    }
-    return GustRun(
-        case,
-        float(t[-1]),
-        seed,
-        t,
-        v,
-        nonlinear,
-        linear,
-        exact_load,
-        {k: _rms(y) for k, y in nonlinear.items()},
-        {k: _rms(y) for k, y in linear.items()},
-        {k: _rms(y) for k, y in exact_load.items()},
-        lyap,
-        error,
-        seconds,
-        int(getattr(result, "nfev", -1)),
-    )
+    response = control.forced_response(model.loop[labels, "gust"], T=t, U=u)
+    y = np.atleast_2d(response.outputs).T
+    return {o.name: y[:, 3 * k : 3 * k + 3] for k, o in enumerate(outputs)}
 
 
 __all__ = ["BUDGET_OUTPUTS", "GustRun", "gust_run"]

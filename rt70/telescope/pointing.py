@@ -40,6 +40,7 @@ from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.model.outputs import Output, column_labels, evaluate
 from rt70.model.scene import Scene
+from rt70.telescope.gust_modes import ModeShare, mode_shares
 
 #: The budget's outputs (names of :func:`rt70.model.optics.mirror_outputs`), their units.
 BUDGET_OUTPUTS = {
@@ -47,8 +48,6 @@ BUDGET_OUTPUTS = {
     "counterreflector_error": "arcsec",
     "focal_offset": "mm",
 }
-#: How many modes the budget names.
-TOP_MODES = 3
 
 
 @dataclass(frozen=True)
@@ -78,24 +77,15 @@ class PointingCase:
         return self.azimuth_deg if self.direction_deg is None else self.direction_deg
 
 
-@dataclass(frozen=True)
-class ModeShare:
-    """One closed-loop mode's share of an output's gust variance."""
-
-    frequency_hz: float
-    damping: float
-    share: float
-    label: str
-
-
 @dataclass
 class PointingBudget:
     """Steady and gust errors of one case (module docstring).
 
     ``steady[name]`` and ``gust_rms[name]`` are magnitudes in the output's unit;
     ``steady_vector`` the steady change of each output's components; ``modes`` the
-    :data:`TOP_MODES` modes with the largest share of the main mirror's gust variance;
-    ``wind_torque`` the change of each drive's holding torque, N·m on its angle.
+    :data:`rt70.telescope.gust_modes.TOP_MODES` modes with the largest share of the main
+    mirror's gust variance; ``wind_torque`` the change of each drive's holding torque,
+    N·m on its angle.
     """
 
     case: PointingCase
@@ -204,6 +194,17 @@ def wind_inputs(scene: Scene, q0: np.ndarray, speed: float, direction_deg: float
     ``∂Q_w,e/∂v = 2 Q_w,e / v̄``; ``wind`` the same on every body at once (coherent
     gusts, the budget's input). For :func:`rt70.linear.plant.plant`: its
     disturbance-to-pointing transfer functions.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:wind>`` elements.
+    q0 : numpy.ndarray, shape (nv,)
+        The state linearised about, rad or m.
+    speed : float
+        Mean wind speed, m/s (> 0).
+    direction_deg : float
+        Azimuth the wind blows from, degrees.
     """
     from rt70.linear.plant import ForceInput
     from rt70.reference import wind as ref_wind
@@ -230,7 +231,17 @@ class WindState:
 
 
 def wind_equilibria(scene: Scene, case: PointingCase, windy: WindyScene) -> WindState:
-    """The drive-held equilibria without and with the case's steady wind."""
+    """The drive-held equilibria without and with the case's steady wind.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with the RT-70's drives and wind elements.
+    case : PointingCase
+        The pointing held (:func:`rt70.telescope.scene_servo.scene_equilibrium`).
+    windy : WindyScene
+        The case's wind, whose force is the static load of the windy equilibrium.
+    """
     from rt70.telescope.scene_servo import SceneServoFactory, scene_equilibrium
 
     couplings = SceneServoFactory(side="reference").couplings(scene)
@@ -247,7 +258,19 @@ def _magnitude(v: np.ndarray) -> float:
 def steady_errors(
     scene: Scene, outputs: list[Output], state: WindState
 ) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    """The outputs' change from the calm to the windy equilibrium (reference side)."""
+    """The outputs' change from the calm to the windy equilibrium (reference side).
+
+    Returns the magnitude of each change and the change itself, by output name.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    outputs : list of Output
+        The budget's outputs (:func:`budget_outputs`).
+    state : WindState
+        The calm and windy drive-held equilibria (:func:`wind_equilibria`).
+    """
     calm = evaluate(scene, state.q_calm, outputs, "reference")
     windy = evaluate(scene, state.q_wind, outputs, "reference")
     vectors = {o.name: np.asarray(windy[o.name] - calm[o.name]) for o in outputs}
@@ -264,7 +287,17 @@ class WindyLinearization:
 
 
 def windy_linearization(scene: Scene, windy: WindyScene, state: WindState) -> WindyLinearization:
-    """Linearise about the windy equilibrium, with the wind's stiffness and gust input."""
+    """Linearise about the windy equilibrium, with the wind's stiffness and gust input.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    windy : WindyScene
+        The case's wind (its stiffness and gust column at the windy equilibrium).
+    state : WindState
+        The calm and windy drive-held equilibria (:func:`wind_equilibria`).
+    """
     q = state.q_wind
     return WindyLinearization(lin.linearize(scene, q), windy.stiffness(q), windy.gust_column(q))
 
@@ -289,6 +322,15 @@ def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
 
     Returns the augmented python-control ``StateSpace`` (input ``w``) and the closed
     loop alone (inputs ``<drive>_reference`` and ``gust``, m/s).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene with its drives (their servos close the loop).
+    case : PointingCase
+        The case: its outputs and the mean wind speed of the gust filter.
+    w : WindyLinearization
+        The linear model about the windy equilibrium (:func:`windy_linearization`).
     """
     from rt70.control.scene_loop import closed_loop
     from rt70.linear.covariance import cascade_with_filter
@@ -361,9 +403,18 @@ def budget_model(scene: Scene, case: PointingCase) -> BudgetModel:
 def pointing_budget(
     scene: Scene, case: PointingCase, model: BudgetModel | None = None
 ) -> PointingBudget:
-    """The budget of one case (module docstring); ``model`` of this case if already built.
+    """The budget of one case (module docstring).
 
     Its ``seconds`` count the model's building too, wherever it was built.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with the RT-70's drives and wind elements (``rt70_servo``).
+    case : PointingCase
+        The pointing and the mean wind.
+    model : BudgetModel, optional
+        This case's model if already built (:func:`budget_model`).
     """
     if model is None:
         model = budget_model(scene, case)
@@ -374,7 +425,7 @@ def pointing_budget(
     steady, vectors = steady_errors(scene, model.outputs, state)
     state_rms = np.sqrt(np.clip(np.diag(model.P), 0.0, None))
     main = next(o for o in model.outputs if o.name == "main_mirror_error")
-    modes, quasi_static = _mode_shares(
+    modes, quasi_static = mode_shares(
         augmented, model.rows(main), state_rms, linear.lm, state.drives
     )
     torque = {
@@ -390,74 +441,6 @@ def pointing_budget(
             "first_frequency_hz": windy_first_frequency(scene, linear),
         },
     )  # fmt: skip
-
-
-def _mode_shares(
-    augmented, outputs: list[str], rms: np.ndarray, lm: lin.Linearization, drives: list[str]
-) -> tuple[list[ModeShare], float]:
-    """The loop's :data:`TOP_MODES` largest shares of ``E|y|²``, and the gust filter's share.
-
-    The augmented system is the gust filter in series with the loop, so its A is block
-    triangular and its eigenvalues are the filter's and the loop's: a mode whose
-    eigenvalue is one of the filter's is the quasi-static response to the wind (the
-    structure following the slow gusts). The shares are those of
-    :func:`rt70.linear.covariance.mode_contributions` over the outputs' components; each
-    loop mode is named by :func:`mode_label`.
-    """
-    from rt70.linear.covariance import mode_contributions
-
-    labels = list(augmented.state_labels)
-    filt = [i for i, n in enumerate(labels) if n.startswith("filter.")]
-    poles = np.linalg.eigvals(augmented.A[np.ix_(filt, filt)])
-    quasi_static, loop = 0.0, []
-    for m in mode_contributions(augmented, outputs):
-        if np.min(np.abs(poles - m.eigenvalue)) <= 1e-9 * abs(m.eigenvalue):
-            quasi_static += m.share
-        else:
-            loop.append(m)
-    loop.sort(key=lambda m: -m.share)
-    top = [
-        ModeShare(
-            m.frequency_hz,
-            m.damping,
-            m.share,
-            mode_label(augmented, m, rms, lm.M, lm.coordinates, drives),
-        )
-        for m in loop[:TOP_MODES]
-    ]
-    return top, float(quasi_static)
-
-
-def mode_label(
-    augmented,
-    mode,
-    rms: np.ndarray,
-    M: np.ndarray,
-    coordinates: list[str],
-    drives: list[str],
-) -> str:
-    """Name a loop mode: a servo's, or the coordinate that carries its kinetic energy.
-
-    Which block the mode belongs to is decided on the eigenvector's entries divided by
-    each state's stationary rms under the gust (so states of any unit compare; the gust
-    filter's states left out): a state of one of the ``drives`` (its motor or its
-    cascade, named ``<drive>_…`` by :func:`rt70.control.scene_loop.closed_loop`) makes it
-    ``<drive> servo``; a structural one names it by the coordinate with the largest
-    share of the mode's kinetic energy ``Re(v̇ᵢ* (M v̇)ᵢ)`` (the heavy body that moves,
-    not the light one that moves most).
-    """
-    labels = [n.removeprefix("plant.") for n in augmented.state_labels]
-    loop = np.array([not n.startswith("filter.") for n in labels])
-    vector = np.asarray(mode.eigenvector)
-    v = np.abs(vector) / np.where(rms > 0.0, rms, np.inf)
-    v[~loop] = 0.0
-    name = labels[int(np.argmax(v))]
-    for drive in drives:
-        if name.startswith(f"{drive}_"):
-            return f"{drive} servo"
-    rate = np.array([vector[labels.index(f"structure_{c}_dot")] for c in coordinates])
-    energy = np.real(np.conj(rate) * (M @ rate))
-    return coordinates[int(np.argmax(energy))]
 
 
 #: What the budget's outputs are called in a table.

@@ -94,6 +94,17 @@ def scenario(
     ``track`` follows a source moving at 15″/s in azimuth, from rest (the loops acquire
     it); the steps are commanded at t = 0 (the reference holds its new value from the
     start).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`SCENARIOS`.
+    elevation_deg : float
+        Start elevation, degrees, 0 to 90.
+    azimuth_deg : float
+        Start azimuth, degrees.
+    t_end : float, optional
+        Length, s (default :data:`DEFAULT_T_END` of the scenario).
     """
     if name not in SCENARIOS:
         raise Rt70Error(f"unknown scenario '{name}' (choose from {', '.join(SCENARIOS)})")
@@ -135,6 +146,17 @@ def choose(
     :data:`DEFAULT_ELEVATION`); one they cannot hold (the listing as printed, errata 12)
     runs the structural benchmark with a hint, or is refused if a scenario or a pointing
     was asked for; a scene without the axes runs the structural benchmark.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene ``rt70 simulate`` runs.
+    name : str or None
+        The scenario asked for (``--scenario``), or None.
+    elevation_deg, azimuth_deg : float or None
+        The pointing asked for, degrees, or None.
+    t_end : float or None
+        The length asked for, s, or None (the scenario's default).
 
     Raises
     ------

@@ -85,7 +85,11 @@ from rt70.telescope.servo_tuning import (  # noqa: F401  (re-exported: the scena
     tuning_text,
 )
 
-#: Integration method of the scenarios (see :func:`run_scenario`).
+#: Integration method of the scenarios. scipy's BDF and Radau stop at random on a hold
+#: ("Required step size is less than spacing between numbers": measured at 30° and 90°,
+#: 60 s): at rest every Newton correction is rounding noise, their ratio reaches 1 and
+#: the iteration is declared diverging at any step size; LSODA's own test does not (60 s
+#: hold at 30°: 3.9e-7″, 17 s wall).
 METHOD = "LSODA"
 
 
@@ -114,54 +118,26 @@ def run_scenario(
         itself (``(q0, {coordinate: torque})``, e.g. the equilibrium with a gear
         sector's force, :mod:`rt70.telescope.scene_servo`); otherwise the start is the
         equilibrium with the axes held by torques on their coordinates.
-    rtol, backend, progress
-        As :func:`rt70.simulation.simulate.simulate`.
-    method : str, optional
-        The integration method; default :data:`METHOD` (LSODA). scipy's BDF and Radau
-        stop at random on a hold ("Required step size is less than spacing between
-        numbers": measured at 30° and 90°, 60 s): at rest every Newton correction is
-        rounding noise, their ratio reaches 1 and the iteration is declared diverging at
-        any step size; LSODA's own test does not (60 s hold at 30°: 3.9e-7″, 17 s wall).
+    rtol : float
+        Relative tolerance of the integration (:func:`rt70.simulation.simulate.simulate`).
     samples_per_s : float
         Output samples per second of simulated time.
+    backend : {"pinocchio", "textbook"}
+        Which side evaluates the mechanics.
+    method : str, optional
+        The integration method; default :data:`METHOD` (LSODA, and why).
+    progress : bool
+        Show a progress bar on stderr.
     """
-    names = scene.coordinate_names
-    missing = missing_axes(names)
+    missing = missing_axes(scene.coordinate_names)
     if missing:
         raise Rt70Error(f"{scene.name}: no RT-70 pointing axis '{missing[0]}': no servo scenario")
     drives = servo_drives() if drives is None else drives
-    ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
-    held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)
-    start = getattr(drives, "start", None)
-    if start is None:
-        q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
-        Q0 = static_force(scene, q0)
-        torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
-    else:  # a factory whose drives do not push on the coordinates alone
-        q0, torques = start(scene, held)
-    # references in coordinate radians: platform_rz = A, base_rx = π/2 − E
-    a0, e0 = q0[ia], q0[ie]
-    refs = {
-        AZIMUTH_COORDINATE: lambda t: a0 + np.radians(sc.azimuth(t)),
-        ELEVATION_COORDINATE: lambda t: e0 - np.radians(sc.elevation(t)),
-    }
+    start = _start(scene, sc, drives)
+    q0, torques, _ = start
+    refs = _axis_references(scene, sc, q0)
     components = drives(scene, q0, torques, refs)
-    if sc.t_end * samples_per_s < 1.0:
-        raise Rt70Error(
-            f"{scene.name}: --t-end {sc.t_end:g}: a scenario is measured on samples every "
-            f"{1 / samples_per_s:g} s; it must last at least that long"
-        )
-    n_t = np.ceil(sc.t_end * samples_per_s) + 1
-    check_time_series(
-        n_t,
-        sample_channels(
-            len(names), 2 + sum(len(c.names) for c in components), [mirror_axis_output(scene)]
-        ),
-        f"scenario '{sc.name}' sampled {samples_per_s:g} times a second",
-        f"{scene.name}: --t-end {sc.t_end:g}",
-    )
-    n_t = int(n_t)
-    t_eval = np.linspace(0.0, sc.t_end, n_t)
+    t_eval = _sample_times(scene, sc, samples_per_s, components)
     result = simulate(
         scene,
         (0.0, sc.t_end),
@@ -176,6 +152,82 @@ def run_scenario(
     )
     if not result.success:
         raise Rt70Error(f"{scene.name}: scenario '{sc.name}': {result.message}")
+    run = _measured(scene, sc, result, refs, start, components)
+    run.metrics = measure(run)
+    return run
+
+
+def _start(scene: Scene, sc: Scenario, drives: DriveFactory) -> tuple:
+    """``(q0, holding torques, rest)``: the start at the scenario's pointing.
+
+    The drive factory's own start if it has one (``rest(held)`` then gives its
+    equilibrium at another pointing), else the static equilibrium with the axes held by
+    torques on their coordinates (``rest`` None).
+    """
+    names = scene.coordinate_names
+    held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)
+    start = getattr(drives, "start", None)
+    if start is None:
+        q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
+        Q0 = static_force(scene, q0)
+        torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
+        return q0, torques, None
+    # a factory whose drives do not push on the coordinates alone
+    q0, torques = start(scene, held)
+    return q0, torques, (lambda held: start(scene, held)[0])
+
+
+def _axis_references(scene: Scene, sc: Scenario, q0: np.ndarray) -> dict[str, Reference]:
+    """The axes' references in coordinate radians: platform_rz = A, base_rx = π/2 − E."""
+    names = scene.coordinate_names
+    a0 = q0[names.index(AZIMUTH_COORDINATE)]
+    e0 = q0[names.index(ELEVATION_COORDINATE)]
+    return {
+        AZIMUTH_COORDINATE: lambda t: a0 + np.radians(sc.azimuth(t)),
+        ELEVATION_COORDINATE: lambda t: e0 - np.radians(sc.elevation(t)),
+    }
+
+
+def _sample_times(
+    scene: Scene, sc: Scenario, samples_per_s: float, components: Sequence[StateComponent]
+) -> np.ndarray:
+    """The output times, ``samples_per_s`` a second, after checking memory holds them."""
+    if sc.t_end * samples_per_s < 1.0:
+        raise Rt70Error(
+            f"{scene.name}: --t-end {sc.t_end:g}: a scenario is measured on samples every "
+            f"{1 / samples_per_s:g} s; it must last at least that long"
+        )
+    n_t = np.ceil(sc.t_end * samples_per_s) + 1
+    check_time_series(
+        n_t,
+        sample_channels(
+            len(scene.coordinate_names),
+            2 + sum(len(c.names) for c in components),
+            [mirror_axis_output(scene)],
+        ),
+        f"scenario '{sc.name}' sampled {samples_per_s:g} times a second",
+        f"{scene.name}: --t-end {sc.t_end:g}",
+    )
+    return np.linspace(0.0, sc.t_end, int(n_t))
+
+
+def _measured(
+    scene: Scene,
+    sc: Scenario,
+    result,
+    refs: dict[str, Reference],
+    start: tuple,
+    components: Sequence[StateComponent],
+) -> ScenarioRun:
+    """What the run measured: the axes' errors, the pointing error, the drives' torques.
+
+    The pointing error is the main mirror's axis against the target axis: its axis in
+    equilibrium at the reference pointing (:func:`_target_axes`); ``start`` is
+    :func:`_start`'s.
+    """
+    names = scene.coordinate_names
+    ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
+    q0, torques, rest = start
     t = result.t
     reference = {
         "azimuth": np.array([refs[AZIMUTH_COORDINATE](x) for x in t]),
@@ -188,7 +240,6 @@ def run_scenario(
     }
     e_ref = sc.elevation_deg + np.array([sc.elevation(x) for x in t])
     a_ref = sc.azimuth_deg + np.array([sc.azimuth(x) for x in t])
-    rest = None if start is None else (lambda held: start(scene, held)[0])
     target = _target_axes(scene, q0, t, e_ref, a_ref, rest)
     n = result.outputs[MIRROR_AXIS]
     pointing = sky_error(n, target)
@@ -196,7 +247,7 @@ def run_scenario(
     total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / ARCSEC
     torque, current, limits = _drive_torques(components, result, names)
     static = _static_misalignment(scene, q0, sc)
-    run = ScenarioRun(
+    return ScenarioRun(
         sc,
         result,
         reference,
@@ -210,8 +261,6 @@ def run_scenario(
         torques,
         list(components),
     )
-    run.metrics = measure(run)
-    return run
 
 
 def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:

@@ -77,6 +77,18 @@ def scene_axis_gains(
     axis-referred torque limit is ``n T_peak i_r`` (9.81·10⁷ N·m for the RT-70) and the
     top voltage the rated one per motor, for parallel (the scene's) or series
     (:func:`rt70.telescope.scenarios.drive_parameters`) lumping alike.
+
+    Parameters
+    ----------
+    p : DriveParameters
+        The scene drive's lumped parameters (:func:`rt70.control.drives.drive_parameters`).
+    axis : AxisDrive
+        The RT-70 table's axis it drives (:data:`AXES`): the limits and reference inertia.
+    position_hz : float
+        Bandwidth of the position loop, Hz.
+    ratio : float
+        Ratio of the position loop's proportional to integral corner
+        (:func:`rt70.control.servo.cascade_gains`).
     """
     m, n = axis.motor, axis.motors_per_axis
     return cascade_gains(
@@ -105,8 +117,21 @@ def scene_equilibrium(
     matrix (:func:`rt70.linear.linearize.stiffness_matrix`) and the columns ∂θ_d/∂q for
     the K_d, leaving out the term ``K_d ∂²θ_d/∂q²`` (the sector's geometric stiffness,
     some 10⁻⁴ of the structure's: it slows the convergence, not the answer). ``Q_l`` is
-    an external static load (``load(q)``, a steady wind's generalised force, default
-    none); its stiffness is left out of Newton's matrix likewise.
+    an external static load; its stiffness is left out of Newton's matrix likewise.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:drive>`` elements.
+    couplings : list of SceneCoupling
+        The drives' couplings to the structure (:meth:`SceneServoFactory.couplings`).
+    held : dict of str to float
+        The encoders' readings: each driven joint's coordinate, rad.
+    tol : float
+        Convergence: ``max |R|`` relative to the force scale (below).
+    load : callable q -> Q_l, optional
+        An external static generalised force, shape (nv,), N·m or N (a steady wind's);
+        default none.
 
     Returns
     -------
@@ -134,19 +159,47 @@ def scene_equilibrium(
     q = equilibrium(scene, held, tol=tol)  # the coordinate equilibrium: a close start
     Q = static_force(scene, q)
     K = np.array([-float(Q[c.index]) for c in couplings])
-    # the force scale of equilibrium(): the static force of the undeformed structure
-    # (the weights); the held torques alone have none at the zenith
-    undeformed = np.zeros_like(q)
-    for name, value in held.items():
-        undeformed[names.index(name)] = value
-    scale = max(float(np.max(np.abs(static_force(scene, undeformed)))), 1.0)
+    scale = _force_scale(scene, held)
     free = np.array([i for i in range(len(names)) if names[i] not in held])
     S = stiffness_matrix(scene, q)
-    size = np.inf
 
     def force(q: np.ndarray) -> np.ndarray:
         return static_force(scene, q) if load is None else static_force(scene, q) + load(q)
 
+    return _drives_newton(scene, couplings, force, (q, K), (S, free), scale, tol)
+
+
+def _force_scale(scene: Scene, held: dict[str, float]) -> float:
+    """The force scale of :func:`rt70.linear.linearize.equilibrium`, at least 1.
+
+    The static force of the undeformed structure (the weights) at the held pointing;
+    the held torques alone have none at the zenith.
+    """
+    names = scene.coordinate_names
+    undeformed = np.zeros(len(names))
+    for name, value in held.items():
+        undeformed[names.index(name)] = value
+    return max(float(np.max(np.abs(static_force(scene, undeformed)))), 1.0)
+
+
+def _drives_newton(
+    scene: Scene,
+    couplings: list[SceneCoupling],
+    force: Callable[[np.ndarray], np.ndarray],
+    start: tuple[np.ndarray, np.ndarray],
+    jacobian: tuple[np.ndarray, np.ndarray],
+    scale: float,
+    tol: float,
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Newton's iteration of :func:`scene_equilibrium`: ``(q, K, residual)``.
+
+    From ``start = (q, K)``; ``jacobian = (S, free)``, the stiffness matrix at the start
+    (kept throughout) and the coordinates that move. Stops when ``max |R| / scale ≤ tol``
+    or when a step moves no coordinate by more than ``STEP_TOL``.
+    """
+    q, K = start
+    S, free = jacobian
+    size = np.inf
     for k in range(MAX_ITER):
         with np.errstate(over="ignore", invalid="ignore"):  # checked just below
             G = np.column_stack([c.angle_gradient(q)[1] for c in couplings])
@@ -317,8 +370,18 @@ def choose_drives(
 ) -> tuple[object, str]:
     """The drive factory of a scenario and a phrase describing it.
 
-    ``model`` None: the scene's drives where it declares one per axis (its own model of
-    the drives), the coordinate drives otherwise.
+    Parameters
+    ----------
+    scene : Scene
+        The scene the scenario runs on.
+    model : {"scene", "coordinate"} or None
+        The drives' model (:data:`DRIVE_MODELS`): the scene's ``<rt70:drive>`` elements,
+        or torques on the axis coordinates; None: the scene's drives where it declares
+        one per axis (its own model of the drives), the coordinate drives otherwise.
+    friction : bool
+        Add the book's dry friction on both axes.
+    side : {"pinocchio", "textbook"}
+        Which side computes the scene drives' couplings.
 
     Raises
     ------

@@ -24,6 +24,15 @@ def settling_time(t: np.ndarray, error: np.ndarray, band: float = BAND_ARCSEC) -
     """First time after which ``|error| ≤ band`` to the end of the run; NaN if never.
 
     The run must end inside the band and stay there (NaN if the last sample is outside).
+
+    Parameters
+    ----------
+    t : numpy.ndarray, shape (n,)
+        Sample times, s.
+    error : numpy.ndarray, shape (n,)
+        The error at each sample, arc seconds.
+    band : float
+        The settling band, arc seconds.
     """
     outside = np.flatnonzero(np.abs(error) > band)
     if outside.size == 0:
@@ -45,6 +54,15 @@ def predicted_settling(step_arcsec: float, gains: CascadeGains, band: float = BA
     0.28 ω_p at ratio 5, sets the tail. The time is the slew plus the first time after
     which the linear response stays inside ``band`` (evaluated exactly on a 5 ms grid).
     It neglects the rate loop's lag and the structure.
+
+    Parameters
+    ----------
+    step_arcsec : float
+        The step, arc seconds (its sign does not matter).
+    gains : CascadeGains
+        The axis's cascade (position-loop gains and rate limit).
+    band : float
+        The settling band, arc seconds.
     """
     import scipy.linalg
 

@@ -66,6 +66,15 @@ def axis_gains(axis: AxisDrive, position_hz: float, ratio: float) -> CascadeGain
 
     Current reference clamped to the peak torque (2 I_n per motor), axis rate to the
     table's rate limit, armature voltage to the motors' rated voltage (n U_n lumped).
+
+    Parameters
+    ----------
+    axis : AxisDrive
+        The RT-70 table's axis.
+    position_hz : float
+        Bandwidth of the position loop, Hz.
+    ratio : float
+        Ratio of the position loop's proportional to integral corner.
     """
     p = drive_parameters(axis)
     return cascade_gains(
@@ -85,6 +94,17 @@ def preset_servo_state(p: DriveParameters, gains: CascadeGains, angle: float, to
     ``[I, α_m, ω_m]`` of :meth:`DcDrive.holding`, the position integral 0 (no rate
     asked), the rate integral giving the holding current ``I = K_i,v ∫e_v`` and the
     current integral the voltage ``R_a I = K_i,i ∫e_i``.
+
+    Parameters
+    ----------
+    p : DriveParameters
+        The drive's parameters.
+    gains : CascadeGains
+        Its cascade's gains.
+    angle : float
+        The axis angle held, rad.
+    torque : float
+        The torque the drive supplies on the axis, N·m.
     """
     hold = ServoDrive.holding(p, angle, torque)
     return np.concatenate([hold, [0.0, hold[0] / gains.ki_v, p.R_a * hold[0] / gains.ki_i]])
@@ -151,6 +171,15 @@ def holding_excess(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0)
     The static torque the drives must supply on each axis at the equilibrium of the
     pointing, against the table's nominal (continuous) drive torque. The RT-70 listing
     as printed needs 2.66× it on elevation at the horizon (docs/rt70-errata.md item 12).
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with the RT-70's pointing axes.
+    elevation_deg : float
+        The elevation, degrees.
+    azimuth_deg : float
+        The azimuth, degrees.
     """
     held = rt70_pointing(elevation_deg, azimuth_deg)
     q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
