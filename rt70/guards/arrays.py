@@ -18,6 +18,15 @@ from rt70.errors import NonFiniteError, ShapeError
 def check_vector(name: str, x: np.ndarray, size: int) -> np.ndarray:
     """Return ``x`` as a float vector of ``size`` entries, or raise naming ``name``.
 
+    Parameters
+    ----------
+    name : str
+        What ``x`` is, for the message (``"initial state q0"``).
+    x : array_like
+        The value given, in the caller's units.
+    size : int
+        The number of entries it must have.
+
     Raises
     ------
     ShapeError

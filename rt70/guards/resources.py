@@ -125,8 +125,19 @@ def massless_peak_bytes(nb: int, n_full: int) -> int:
 def check_memory(needed: int, what: str, source: str, available: int | None = None) -> None:
     """Raise :class:`ResourceError` if ``needed`` bytes exceed the share this run may use.
 
-    ``available`` defaults to :func:`available_memory`; where that is unknown nothing is
-    checked.
+    The share is :data:`MEMORY_FRACTION` of the available memory.
+
+    Parameters
+    ----------
+    needed : int
+        The estimated peak memory, bytes.
+    what : str
+        What needs it, for the message.
+    source : str
+        The file, option or call that asked for it, for the message.
+    available : int, optional
+        The available memory, bytes; default :func:`available_memory` (where that is
+        unknown nothing is checked).
     """
     available = available_memory() if available is None else available
     if available is None:
@@ -161,8 +172,18 @@ def check_time_series(
 ) -> None:
     """Refuse a run whose ``samples × channels`` time series this machine cannot hold.
 
-    ``source`` names the option or the call that asked for it (``--t-end 1e+12``);
-    ``available`` as :func:`check_memory`.
+    Parameters
+    ----------
+    samples : float
+        The number of samples (a float: a duration over a step, before rounding).
+    channels : int
+        Values kept per sample.
+    what : str
+        What the samples are, for the message.
+    source : str
+        The option or the call that asked for them (``--t-end 1e+12``).
+    available : int, optional
+        The available memory, bytes, as :func:`check_memory`.
 
     Raises
     ------
@@ -178,7 +199,17 @@ def check_time_series(
 
 
 def check_textbook(nb: int, n_full: int, source: str) -> None:
-    """Refuse a textbook model whose dense matrices this machine cannot hold."""
+    """Refuse a textbook model whose dense matrices this machine cannot hold.
+
+    Parameters
+    ----------
+    nb : int
+        Number of bodies.
+    n_full : int
+        Number of coordinates before the constraints are eliminated.
+    source : str
+        The file the model is read from, for the message.
+    """
     check_memory(
         textbook_peak_bytes(nb, n_full),
         f"the textbook side's dense matrices for {nb} bodies ({6 * nb} × {6 * nb})",
@@ -187,7 +218,17 @@ def check_textbook(nb: int, n_full: int, source: str) -> None:
 
 
 def check_massless(nb: int, n_full: int, source: str) -> None:
-    """Refuse a textbook model whose mass check (:func:`massless_peak_bytes`) cannot fit."""
+    """Refuse a textbook model whose mass check (:func:`massless_peak_bytes`) cannot fit.
+
+    Parameters
+    ----------
+    nb : int
+        Number of bodies.
+    n_full : int
+        Number of coordinates before the constraints are eliminated.
+    source : str
+        The file the model is read from, for the message.
+    """
     check_memory(
         massless_peak_bytes(nb, n_full),
         f"the textbook side's check that every coordinate moves mass ({n_full} × {n_full} "

@@ -72,7 +72,17 @@ def column_labels(name: str, size: int) -> list[str]:
 
 
 def position_output(name: str, link: str, xyz: Sequence[float]) -> Output:
-    """The ground-axis position (3 components, m) of the point ``xyz`` of ``link``."""
+    """The ground-axis position (3 components, m) of the point ``xyz`` of ``link``.
+
+    Parameters
+    ----------
+    name : str
+        The output's name (its key in the results).
+    link : str
+        The link the point is fixed to.
+    xyz : sequence of float, shape (3,)
+        The point in the link's frame, m.
+    """
     point = (link, tuple(float(x) for x in np.asarray(xyz, dtype=float).reshape(3)))
     return Output(name, "m", 3, (point,))
 
@@ -124,6 +134,17 @@ def evaluate(
 
     One kinematics pass for all the outputs' points.
 
+    Parameters
+    ----------
+    scene : Scene
+        The scene, its two sides built from one file.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates in the file's order, rad or m.
+    outputs : sequence of Output
+        The outputs, their names distinct.
+    side : {"textbook", "reference"}
+        Whose kinematics place the points.
+
     Raises
     ------
     UnknownLinkError
@@ -141,7 +162,19 @@ def evaluate(
 def evaluate_trajectory(
     scene: Scene, q: np.ndarray, outputs: Sequence[Output], side: str = "textbook"
 ) -> dict[str, np.ndarray]:
-    """Every output along a trajectory ``q`` (n_t × nv), by name: arrays (n_t, size)."""
+    """Every output along a trajectory ``q`` (n_t × nv), by name: arrays (n_t, size).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene, its two sides built from one file.
+    q : numpy.ndarray, shape (n_t, nv)
+        The trajectory's coordinates, one row per sample, rad or m.
+    outputs : sequence of Output
+        The outputs, their names distinct.
+    side : {"textbook", "reference"}
+        Whose kinematics place the points.
+    """
     _check(outputs, side)
     if not outputs:
         return {}
@@ -201,6 +234,17 @@ def output_matrix(
     columns are the scene's coordinates (for a
     :class:`rt70.linear.linearize.Linearization` take the columns
     ``coordinate_indices(scene, lm.coordinates)``).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene, its two sides built from one file.
+    q0 : numpy.ndarray, shape (nv,)
+        The configuration linearised about, rad or m.
+    outputs : sequence of Output
+        The outputs, their names distinct.
+    side : {"textbook", "reference"}
+        Whose kinematics and point Jacobians are used.
 
     Raises
     ------

@@ -146,8 +146,17 @@ def scene_from_text(
 ) -> Scene:
     """Build a scene from URDF text (generated models, tests, a sweep's workers).
 
-    ``source`` (the file the text was read from) labels messages about its content;
-    without it, ``name`` does.
+    Parameters
+    ----------
+    text : str
+        The URDF text.
+    name : str
+        The scene's name; labels messages when there is no ``source``.
+    balance_inertia : bool
+        Repair impossible rotational inertias of moving links instead of refusing them
+        (as :func:`load_scene`).
+    source : str, optional
+        The file the text was read from: labels messages about its content.
     """
     return _scene(name, Path(source or name), text, source or name, balance_inertia)
 

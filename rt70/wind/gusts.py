@@ -314,9 +314,20 @@ def discretise(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.
     ``e_k ~ N(0, Q_d)`` independent, with ``Q_d = Q(dt)`` and ``Φ = e^{A dt}``
     (``scipy.linalg.expm`` at dt).
 
+    Parameters
+    ----------
+    A : ndarray, shape (n, n)
+        The continuous system's matrix, 1/s.
+    B : ndarray, shape (n, m)
+        Its input matrix for m unit white noises.
+    dt : float
+        The sampling interval, s.
+
     Returns
     -------
     Phi, Qd : ndarray
+        The transition matrix ``e^{A dt}`` and the covariance of the sampled noise, both
+        (n, n).
     """
     n = A.shape[0]
     norm = np.linalg.norm(A, 1) * dt

@@ -107,9 +107,33 @@ class WindLoad(StateComponent):
         return WindCondition(abs(v), direction, c.density)
 
     def derivative(self, t, q, qd, s, forces) -> np.ndarray:
-        """No states: an empty derivative."""
+        """No states: an empty derivative.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates and velocities (unused).
+        s : numpy.ndarray, shape (0,)
+            The component's (no) states.
+        forces : rt70.simulation.states.MechanicsForces
+            The mechanics' forces of this evaluation (unused).
+        """
         return np.zeros(0)
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The wind's generalised force at time t and configuration q (nv,)."""
+        """The wind's generalised force at time t and configuration q (nv,), N·m or N.
+
+        Parameters
+        ----------
+        t : float
+            Time, s: the gust's speed is the one at t.
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates in the file's order, rad or m.
+        qd : numpy.ndarray, shape (nv,)
+            Their velocities (unused: the load depends on the wind, not on the motion).
+        s : numpy.ndarray, shape (0,)
+            The component's (no) states.
+        """
         return self._force(q, self.condition_at(t))
