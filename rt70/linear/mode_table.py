@@ -1,6 +1,6 @@
 """The rows ``rt70 modes`` prints: one per mode, with its kind, damping and dominant coordinate.
 
-One builder for the unconstrained spectrum (:func:`rt70.cli.main._modes`) and the spectrum on a
+One builder for the unconstrained spectrum (:func:`rt70.cli.modes.run`) and the spectrum on a
 constraint manifold (:mod:`rt70.linear.constrained_scene`), whose shapes live in the full
 coordinates while the eigenproblem was solved in reduced ones.
 """
