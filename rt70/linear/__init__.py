@@ -1,6 +1,7 @@
 """Linear models: topology (chapter 2), holonomic elimination (chapter 3), modal analysis.
 
 - :mod:`rt70.linear.topology` — the topology matrix Γ and ``m q̈ + ΓᵀDΓq̇ + ΓᵀCΓq = Q``;
+  :mod:`rt70.linear.torsion_scene` reads such a model back from a torsional URDF scene;
 - :mod:`rt70.linear.holonomic` — rigid links eliminated through a spanning tree
   (Γ*, ``L = Γ*⁻ᵀ``, mobility f, ``S = fᵀL``, reduced A*, C*, D*);
 - :mod:`rt70.linear.modal` — eigenfrequencies, mode shapes, damping, principal coordinates;
