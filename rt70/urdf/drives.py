@@ -3,7 +3,7 @@
 One job: turn the XML of a drive — a DC motor with a compliant reducer on one axis
 (formalism §4.5, (4.137)–(4.150)) — into a :class:`~rt70.urdf.description.Drive`, or
 refuse it with an :class:`~rt70.errors.ExtensionError` naming the file and the element.
-Called by :mod:`rt70.urdf.reader` once the joints and links are known.
+Called by :mod:`rt70.urdf.extensions` once the joints and links are known.
 """
 
 from __future__ import annotations

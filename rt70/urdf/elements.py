@@ -1,9 +1,9 @@
 """What every element reader of a URDF file needs: numbers, names, links, joints, errors.
 
 :class:`ElementReader` is the part of the reader (:mod:`rt70.urdf.reader`) that the readers
-of single extension elements (:mod:`rt70.urdf.drives`, :mod:`rt70.urdf.no_slip`,
-:mod:`rt70.urdf.wind`) use: each error it raises names the file, the element and the
-attribute (docs/urdf-reader.md).
+of the extension elements (:mod:`rt70.urdf.extensions`, :mod:`rt70.urdf.drives`,
+:mod:`rt70.urdf.no_slip`, :mod:`rt70.urdf.wind`) use: each error it raises names the
+file, the element and the attribute (docs/urdf-reader.md).
 """
 
 from __future__ import annotations

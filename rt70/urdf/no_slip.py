@@ -6,7 +6,7 @@ point of a wheel of given radius) has no velocity along a direction fixed in a l
 or refuse it with an :class:`~rt70.errors.ExtensionError` naming the file and the
 element. Each side builds the constraint row ``A(q)`` from its own kinematics
 (:mod:`rt70.textbook.no_slip`, :mod:`rt70.reference.no_slip`). Called by
-:mod:`rt70.urdf.reader`.
+:mod:`rt70.urdf.extensions`.
 """
 
 from __future__ import annotations

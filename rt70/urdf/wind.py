@@ -6,7 +6,7 @@ reference area and length, and coefficient table — into a
 :class:`~rt70.errors.ExtensionError` naming the file and the element. The coefficient
 table is read and checked here (:class:`rt70.physics.aerodynamics.CoefficientTable`): a built-in
 ``shape`` or a ``coefficients`` CSV file, relative to the URDF file's directory.
-Called by :mod:`rt70.urdf.reader`.
+Called by :mod:`rt70.urdf.extensions`.
 """
 
 from __future__ import annotations
