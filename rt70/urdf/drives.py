@@ -29,6 +29,18 @@ def read_drive(
 ) -> Drive:
     """The :class:`Drive` of one ``<rt70:drive>`` element.
 
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages, the attribute readers).
+    elem : xml.etree.ElementTree.Element
+        The ``<rt70:drive>`` element.
+    desc : RobotDescription
+        The description read so far: its links, and the drives already read (a name
+        may not repeat).
+    joints : dict of str to Joint
+        The file's joints by name.
+
     Raises
     ------
     ExtensionError

@@ -34,6 +34,17 @@ def read_no_slip(
     ``radius`` below ``xyz`` along ``−normal``), ``normal`` (ground axes, default
     ``0 0 1``, normalised).
 
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages, the attribute readers).
+    elem : xml.etree.ElementTree.Element
+        The ``<rt70:no_slip>`` element.
+    desc : RobotDescription
+        The description read so far (its links).
+    seen : list of NoSlip
+        The no-slip constraints already read from the file (a name may not repeat).
+
     Raises
     ------
     ExtensionError

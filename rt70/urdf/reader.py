@@ -78,6 +78,22 @@ def read_urdf_string(
     :func:`rt70.urdf.schema.check_scene` refuses (an unknown or missing attribute of an
     rt70 element, a namespace that looks like rt70's but is not it); unknown attributes
     of standard elements are warned about.
+
+    Parameters
+    ----------
+    text : str
+        The URDF document.
+    source : str
+        The name every message gives the text (a file's path, or ``<string>``); a
+        relative ``coefficients`` file of ``<rt70:wind>`` is found beside it.
+    balance_inertia : bool
+        Repair an impossible rotational inertia of a moving link instead of refusing it
+        (:func:`read_urdf`).
+
+    Raises
+    ------
+    UrdfError
+        (or a subclass) as :func:`read_urdf`.
     """
     text = prepare_text(text, source)
     refuse_entities(text, source)

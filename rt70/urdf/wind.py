@@ -27,6 +27,18 @@ def read_wind(
 ) -> Wind:
     """The :class:`Wind` of one ``<rt70:wind>`` element.
 
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages and the directory a relative
+        ``coefficients`` file is found in; the attribute readers).
+    elem : xml.etree.ElementTree.Element
+        The ``<rt70:wind>`` element.
+    desc : RobotDescription
+        The description read so far (its links).
+    seen : list of Wind
+        The winds already read from the file (a name may not repeat).
+
     Raises
     ------
     ExtensionError
