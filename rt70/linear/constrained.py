@@ -224,6 +224,22 @@ def solve_dependent(
 
     Newton on the partition's rows, ``w ← w − (∂Φ/∂w)⁻¹ Φ``, until the step is below
     :data:`~rt70.linear.manifold.STEP_TOL` of the coordinate scale.
+
+    Parameters
+    ----------
+    constraints : Constraints
+        Φ and B_c.
+    part : Partition
+        The independent rows and the dependent and independent coordinates.
+    q_guess : array_like, shape (n,)
+        The independent coordinates' values and the dependent ones' start, m or rad.
+    max_iter : int
+        Newton steps allowed.
+
+    Raises
+    ------
+    Rt70Error
+        If Newton does not converge.
     """
     q = np.array(q_guess, dtype=float)
     scale = max(float(np.max(np.abs(q), initial=0.0)), 1.0)
@@ -254,6 +270,27 @@ def partition_linearize(
     :func:`solve_dependent`), symmetrised; ``M_r = Jᵀ M J``, ``D_r = Jᵀ D J`` at q0.
     The multipliers' stiffness is not formed: it is the term ``−(∂J/∂z)ᵀ Q`` of the
     difference. λ is returned for reference (least-norm, from Q at q0).
+
+    Parameters
+    ----------
+    force : callable
+        Static generalised force ``q ↦ Q(q)``, shape (n,), N or N·m per coordinate.
+    constraints : Constraints
+        Φ and B_c.
+    q0 : array_like, shape (n,)
+        The equilibrium on the manifold, m or rad per coordinate.
+    M, D : ndarray, shape (n, n)
+        Mass and damping matrices at q0 in the full coordinates (D default zero).
+    partition : Partition, optional
+        The coordinate partition (default :func:`choose_partition` of ``B_c(q0)``).
+    h : float
+        The difference step of ``K_r`` per independent coordinate, m or rad.
+
+    Raises
+    ------
+    Rt70Error
+        If the constraints leave no motion at q0, or a dependent coordinate cannot be
+        solved for.
     """
     q0 = np.asarray(q0, dtype=float)
     n = q0.size

@@ -67,6 +67,17 @@ def scene_constraints(
 
     With ``loop_bias`` (``(model, data, q, q̇) → C``, ``B_c q̈ + C = 0``) the geometric
     stiffness is formed exactly from it; without, by differences of the Jacobian.
+
+    Parameters
+    ----------
+    scene : Scene
+        The tree the loops close.
+    loop_residual, loop_jacobian : callable
+        ``(model, data, q) → Φ``, shape (m,), and ``→ B_c``, shape (m, n), of ``side``.
+    side : {"textbook", "reference"}
+        Whose model and data the loop functions are called with.
+    loop_bias : callable, optional
+        ``(model, data, q, q̇) → C``, shape (m,), of ``side``.
     """
     model, data = _side(scene, side)
     bias = None if loop_bias is None else (lambda q, qd: loop_bias(model, data, q, qd))

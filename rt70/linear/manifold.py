@@ -95,6 +95,15 @@ def fixed(n: int, indices: Sequence[int], values: Sequence[float]) -> Constraint
 
     The multiplier of a row is the force that holds its coordinate; ∇²Φ = 0, so the rows
     add no geometric stiffness.
+
+    Parameters
+    ----------
+    n : int
+        Number of coordinates.
+    indices : sequence of int
+        The held coordinates' indices in q.
+    values : sequence of float
+        Their values, m or rad.
     """
     idx = np.asarray(indices, dtype=int)
     val = np.asarray(values, dtype=float)
@@ -151,6 +160,15 @@ def force_stiffness(force: Vector, q: np.ndarray, h: float = FD_STEP) -> np.ndar
     """``K = −∂force/∂q`` by central differences with step h per coordinate, symmetrised.
 
     The stiffness of a conservative force (its Jacobian is a Hessian of the potential).
+
+    Parameters
+    ----------
+    force : callable
+        ``q ↦ Q(q)``, shape (n,): N or N·m per coordinate.
+    q : numpy.ndarray, shape (n,)
+        The point, m or rad per coordinate.
+    h : float
+        The difference step per coordinate, m or rad.
     """
     cols = []
     for i in range(q.size):
@@ -173,6 +191,17 @@ def geometric_stiffness(
     ``G_jj = −λᵀ C(e_j)``, ``G_jk = −½ λᵀ (C(e_j + e_k) − C(e_j) − C(e_k))``
     (n(n+1)/2 calls). Without it, central differences of ``B_cᵀ λ`` with step h per
     coordinate (2n calls), symmetrised (the ∇²Φ_i are symmetric).
+
+    Parameters
+    ----------
+    constraints : Constraints
+        Φ, B_c and, if known, the bias C.
+    q : array_like, shape (n,)
+        The point (on the manifold), m or rad per coordinate.
+    lam : array_like, shape (m,)
+        The multipliers λ, one per constraint row (N or N·m for a row of m or rad).
+    h : float
+        The difference step per coordinate, m or rad (without the bias).
     """
     q = np.asarray(q, dtype=float)
     lam = np.asarray(lam, dtype=float)
