@@ -97,6 +97,17 @@ def creep_speed(friction: DryFriction, torque: float, width: float, kind: str = 
 
     The ideal axis sticks (speed 0); this is the regularisation's error. Solved from
     ``τ + τ_f(ω) = 0`` by bisection (the law is monotonic in ω).
+
+    Parameters
+    ----------
+    friction : DryFriction
+        F_s (``static_torque``, N·m), k (``slope``, N·m·s/rad).
+    torque : float
+        The steady torque on the axis, N·m, ``|torque| < F_s``.
+    width : float
+        ω_ε, rad/s.
+    kind : {"tanh", "linear"}
+        The regularisation (module docstring).
     """
     check_width(width, kind)
     F_s = friction.static_torque
@@ -171,7 +182,19 @@ class AxisFriction(StateComponent):
         return friction_torque(self.friction, qd[self.index], self.width, self.kind)
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """τ_f as a generalised force on the axis's coordinate."""
+        """τ_f as a generalised force on the axis's coordinate.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates, m or rad (unused).
+        qd : numpy.ndarray, shape (nv,)
+            Generalised velocities, m/s or rad/s; the axis's is ``qd[index]``.
+        s : numpy.ndarray, shape (1,)
+            The heat dissipated so far, J (unused).
+        """
         Q = np.zeros(self.n)
         Q[self.index] = self.torque(qd)
         return Q
@@ -179,7 +202,21 @@ class AxisFriction(StateComponent):
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The heat rate ``−τ_f ω`` (≥ 0)."""
+        """The heat rate ``−τ_f ω`` (≥ 0).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates, m or rad (unused).
+        qd : numpy.ndarray, shape (nv,)
+            Generalised velocities, m/s or rad/s; the axis's is ``qd[index]``.
+        s : numpy.ndarray, shape (1,)
+            The heat dissipated so far, J (unused).
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         return np.array([-self.torque(qd) * qd[self.index]])
 
 
