@@ -443,7 +443,8 @@ def force_input(
     Returns
     -------
     numpy.ndarray, shape (n,)
-        ``Q_u`` per unit load: m or rad of work per N (or N·m) along each coordinate.
+        ``Q_u`` of the unit load on each coordinate of ``lm.coordinates`` (N or N·m per
+        N, or per N·m for a torque).
     """
     a = np.asarray(direction, dtype=float)
     unit = a / np.linalg.norm(a)
