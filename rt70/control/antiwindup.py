@@ -64,7 +64,7 @@ class BackCalculationServo(ServoDrive):
         Parameters
         ----------
         t : float
-            Time, s (the position reference's).
+            Time, s (the position reference is taken at t).
         q : numpy.ndarray, shape (nv,)
             Generalised coordinates, m or rad, book order.
         s : numpy.ndarray, shape (6,)
@@ -81,7 +81,7 @@ class BackCalculationServo(ServoDrive):
         Parameters
         ----------
         t : float
-            Time, s (the position reference's).
+            Time, s (the position reference is taken at t).
         q, qd : numpy.ndarray, shape (nv,)
             Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
         s : numpy.ndarray, shape (6,)

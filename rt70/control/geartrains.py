@@ -358,7 +358,7 @@ class TwoTrainServo(TwoTrainDrive):
         Parameters
         ----------
         t : float
-            Time, s (the position reference's).
+            Time, s (the position reference is taken at t).
         q, qd : numpy.ndarray, shape (nv,)
             Generalised coordinates (m or rad) and velocities (m/s or rad/s); the axis's
             are ``q[index]``, ``qd[index]``.

@@ -179,7 +179,7 @@ class LqgDrive(DcDrive):
         Parameters
         ----------
         t : float
-            Time, s (the reference's).
+            Time, s (the reference is taken at t).
         q, qd : numpy.ndarray, shape (nv,)
             Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
         s : numpy.ndarray
@@ -201,7 +201,7 @@ class LqgDrive(DcDrive):
         Parameters
         ----------
         t : float
-            Time, s (the reference's).
+            Time, s (the reference is taken at t).
         q, qd : numpy.ndarray, shape (nv,)
             Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
         s : numpy.ndarray
@@ -217,7 +217,7 @@ class LqgDrive(DcDrive):
         Parameters
         ----------
         t : float
-            Time, s (the reference's).
+            Time, s (the reference is taken at t).
         q, qd : numpy.ndarray, shape (nv,)
             Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
         s : numpy.ndarray

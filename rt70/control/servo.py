@@ -188,7 +188,7 @@ class ServoDrive(DcDrive):
         Parameters
         ----------
         t : float
-            Time, s (the position reference's).
+            Time, s (the position reference is taken at t).
         q, qd : numpy.ndarray, shape (nv,)
             Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
         s : numpy.ndarray, shape (6,)
