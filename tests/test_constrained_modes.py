@@ -1,4 +1,5 @@
-"""Equilibrium, linearisation and modes on a constraint manifold (rt70.linear.constrained).
+"""Equilibrium, linearisation and modes on a constraint manifold (rt70.linear.manifold,
+rt70.linear.constrained_equilibrium, rt70.linear.constrained).
 
 Mechanisms with answers known without the module: a particle hanging by the constraint
 x² + y² = l² (ω² = g/l, all of it from the multipliers' geometric stiffness: K = 0 in
@@ -16,6 +17,8 @@ import scipy.optimize
 
 from rt70.errors import Rt70Error
 from rt70.linear import constrained as cm
+from rt70.linear import constrained_equilibrium as ce
+from rt70.linear import manifold as mf
 from rt70.testing import assert_close
 
 G = 9.81
@@ -26,7 +29,7 @@ G = 9.81
 
 def particle(m: float = 2.0, length: float = 1.5, scale: float = 1.0):
     """A particle of mass m in (x, y) on ``scale · (x² + y² − l²) = 0``, gravity −y."""
-    con = cm.Constraints(
+    con = mf.Constraints(
         residual=lambda q: np.array([scale * (q @ q - length**2)]),
         jacobian=lambda q: scale * 2.0 * q.reshape(1, 2),
         bias=lambda q, qd: np.array([scale * 2.0 * qd @ qd]),
@@ -37,7 +40,7 @@ def particle(m: float = 2.0, length: float = 1.5, scale: float = 1.0):
 
 def _particle_lin(geometric=True, start=(0.4, -1.0), scale=1.0, D=None):
     con, force, M = particle(scale=scale)
-    eq = cm.equilibrium(force, con, np.array(start))
+    eq = ce.equilibrium(force, con, np.array(start))
     lin = cm.linearize(con, eq.q, eq.lam, M, np.zeros((2, 2)), D, geometric=geometric)
     return eq, lin, con, force, M
 
@@ -81,10 +84,10 @@ def test_scaled_and_redundant_constraints_give_the_same_frequency():
     _, lin5, *_ = _particle_lin(scale=5.0)
     assert_close(cm.modes(lin5).modes.omega2, [G / 1.5], rel=1e-9)
     con, force, M = particle()
-    twice = cm.combine(
-        con, cm.Constraints(lambda q: 2 * con.residual(q), lambda q: 2 * con.jacobian(q))
+    twice = mf.combine(
+        con, mf.Constraints(lambda q: 2 * con.residual(q), lambda q: 2 * con.jacobian(q))
     )
-    eq = cm.equilibrium(force, twice, np.array([0.4, -1.0]))
+    eq = ce.equilibrium(force, twice, np.array([0.4, -1.0]))
     lin = cm.linearize(twice, eq.q, eq.lam, M, np.zeros((2, 2)))
     assert lin.rank == 1 and eq.lam.size == 2
     assert_close(eq.lam, -2.0 * G / 3.0 * np.array([1, 2]) / 5, rel=1e-12)
@@ -116,13 +119,13 @@ ROD_M, ROD_L = 3.0, 0.8
 def rod():
     """A rod (m, l) in (x, y, θ) of its centre, its end pinned at the origin."""
     h = ROD_L / 2
-    con = cm.Constraints(
+    con = mf.Constraints(
         residual=lambda q: np.array([q[0] - h * np.sin(q[2]), q[1] + h * np.cos(q[2])]),
         jacobian=lambda q: np.array([[1.0, 0.0, -h * np.cos(q[2])], [0.0, 1.0, -h * np.sin(q[2])]]),
     )
     force = lambda q: np.array([0.0, -ROD_M * G, 0.0])  # noqa: E731
     M = np.diag([ROD_M, ROD_M, ROD_M * ROD_L**2 / 12])
-    eq = cm.equilibrium(force, con, np.array([0.1, -0.3, 0.2]))
+    eq = ce.equilibrium(force, con, np.array([0.1, -0.3, 0.2]))
     return con, force, M, eq
 
 
@@ -210,7 +213,7 @@ def fourbar_full():
             for L, p, wi in zip(LENGTHS, psi, w, strict=True)
         )
 
-    return cm.Constraints(residual, jacobian, bias), force, mass
+    return mf.Constraints(residual, jacobian, bias), force, mass
 
 
 def _closed_form(phi):
@@ -267,7 +270,7 @@ def fourbar():
     con, force, mass = fourbar_full()
     phi, omega2, shape = minimal_fourbar()
     start = _closed_form(phi + 0.05)[0] + np.array([0.0, 0.01, -0.02])  # off the manifold
-    eq = cm.equilibrium(force, con, start, tol=1e-12)
+    eq = ce.equilibrium(force, con, start, tol=1e-12)
     return con, force, mass, eq, phi, omega2, shape
 
 
@@ -282,7 +285,7 @@ def test_fourbar_equilibrium_is_the_minimum_of_the_minimal_model(fourbar):
 def test_fourbar_modes_both_ways_against_the_minimal_model(fourbar):
     con, force, mass, eq, phi, omega2, shape = fourbar
     M = mass(eq.q)
-    K = cm.force_stiffness(force, eq.q)
+    K = mf.force_stiffness(force, eq.q)
     null = cm.modes(cm.linearize(con, eq.q, eq.lam, M, K))
     part = cm.modes(cm.partition_linearize(force, con, eq.q, M))
     assert null.modes.n == part.modes.n == 1
@@ -300,18 +303,18 @@ def test_fourbar_modes_both_ways_against_the_minimal_model(fourbar):
 def test_geometric_stiffness_exact_from_the_bias_and_by_differences(fourbar):
     """G by polarisation of C = Ḃ_c q̇ (exact) and by differences of B_cᵀλ agree."""
     con, force, mass, eq, phi, omega2, shape = fourbar
-    differenced = cm.Constraints(con.residual, con.jacobian)
-    G_exact = cm.geometric_stiffness(con, eq.q, eq.lam)
-    G_diff = cm.geometric_stiffness(differenced, eq.q, eq.lam)
+    differenced = mf.Constraints(con.residual, con.jacobian)
+    G_exact = mf.geometric_stiffness(con, eq.q, eq.lam)
+    G_diff = mf.geometric_stiffness(differenced, eq.q, eq.lam)
     assert np.abs(G_exact).max() > 1.0  # the loop's reactions are tens of newtons
     assert_close(G_diff, G_exact, rel=1e-8)
-    M, K = mass(eq.q), cm.force_stiffness(force, eq.q)
+    M, K = mass(eq.q), mf.force_stiffness(force, eq.q)
     exact = cm.modes(cm.linearize(con, eq.q, eq.lam, M, K))
     assert_close(exact.modes.omega2, [omega2], rel=1e-8)
     # the bias's check of its shape
-    bad = cm.Constraints(con.residual, con.jacobian, lambda q, qd: np.zeros(3))
+    bad = mf.Constraints(con.residual, con.jacobian, lambda q, qd: np.zeros(3))
     with pytest.raises(Rt70Error, match="bias has shape"):
-        cm.geometric_stiffness(bad, eq.q, eq.lam)
+        mf.geometric_stiffness(bad, eq.q, eq.lam)
 
 
 # ------------------------------------------------------------------------------ refusals
@@ -319,8 +322,8 @@ def test_geometric_stiffness_exact_from_the_bias_and_by_differences(fourbar):
 
 def test_a_rigid_mechanism_has_no_modes():
     con, force, M = particle()
-    both = cm.combine(con, cm.fixed(2, [0], [0.0]))
-    eq = cm.equilibrium(force, both, np.array([0.2, -1.0]))
+    both = mf.combine(con, mf.fixed(2, [0], [0.0]))
+    eq = ce.equilibrium(force, both, np.array([0.2, -1.0]))
     with pytest.raises(Rt70Error, match="leave no motion"):
         cm.linearize(both, eq.q, eq.lam, M, np.zeros((2, 2)))
 
@@ -329,23 +332,23 @@ def test_a_free_direction_is_neutral_without_a_force_and_refused_with_one():
     """No gravity: every point of the circle is an equilibrium (the start is closed onto
     it, a rigid mode). A force along a direction nothing holds: no equilibrium."""
     con, _, M = particle()
-    eq = cm.equilibrium(lambda q: np.zeros(2), con, np.array([0.4, -1.0]))
+    eq = ce.equilibrium(lambda q: np.zeros(2), con, np.array([0.4, -1.0]))
     # closed to the equilibrium's default tol: |Φ| = |q·q − l²| ≤ 1e-10 max|q|
     assert_close(np.hypot(*eq.q), 1.5, rel=1e-10)
     lin = cm.linearize(con, eq.q, eq.lam, M, np.zeros((2, 2)))
     assert cm.modes(lin).modes.rigid.all()
-    on_a_line = cm.Constraints(lambda q: q[1:], lambda q: np.array([[0.0, 1.0]]))
+    on_a_line = mf.Constraints(lambda q: q[1:], lambda q: np.array([[0.0, 1.0]]))
     with pytest.raises(Rt70Error, match="singular.*a force acts along it"):
-        cm.equilibrium(lambda q: np.array([1.0, 0.0]), on_a_line, np.array([0.4, -1.0]))
+        ce.equilibrium(lambda q: np.array([1.0, 0.0]), on_a_line, np.array([0.4, -1.0]))
 
 
 def test_wrong_shapes_are_refused():
-    con = cm.Constraints(lambda q: np.zeros(1), lambda q: np.zeros((1, 3)))
+    con = mf.Constraints(lambda q: np.zeros(1), lambda q: np.zeros((1, 3)))
     with pytest.raises(Rt70Error, match="3 columns, q has 2"):
-        cm.equilibrium(lambda q: np.zeros(2), con, np.zeros(2))
+        ce.equilibrium(lambda q: np.zeros(2), con, np.zeros(2))
     con, _, M = particle()
     with pytest.raises(Rt70Error, match="force has shape"):
-        cm.equilibrium(lambda q: np.zeros(3), con, np.array([0.4, -1.0]))
+        ce.equilibrium(lambda q: np.zeros(3), con, np.array([0.4, -1.0]))
     with pytest.raises(Rt70Error, match="M must be 2 × 2"):
         cm.linearize(con, np.array([0.0, -1.5]), np.ones(1), np.eye(3), np.zeros((2, 2)))
 
@@ -375,10 +378,10 @@ def report() -> list[tuple[str, float, float, float, float]]:
     )
     con, force, mass = fourbar_full()
     phi, omega2, _ = minimal_fourbar()
-    eq = cm.equilibrium(
+    eq = ce.equilibrium(
         force, con, _closed_form(phi + 0.05)[0] + np.array([0, 0.01, -0.02]), tol=1e-12
     )
-    M, K = mass(eq.q), cm.force_stiffness(force, eq.q)
+    M, K = mass(eq.q), mf.force_stiffness(force, eq.q)
     rows.append(
         (
             "four-bar vs minimal model",

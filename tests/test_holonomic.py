@@ -28,10 +28,10 @@ from rt70.linear.topology import (
     book_delta,
     edges_from_topology,
     from_graph,
-    from_scene,
     proportional_damping,
     topology_matrix,
 )
+from rt70.linear.torsion_scene import from_scene
 from rt70.model.scene import load_scene
 from rt70.scenes import rt70_data
 from rt70.scenes.rt70_chapter2 import azimuth_model, elevation_model

@@ -1,4 +1,5 @@
-"""Servo loops around the linear RT-70 plant (rt70.control.loops, lqg, servo_compare).
+"""Servo loops around the linear RT-70 plant (rt70.control.axis_plant, loops, loop_measures,
+lqg, servo_compare).
 
 The linear drive + structure is checked against two independent forms: the drive's
 Lagrange equations on a rigid rotor (rt70.bondgraph.lagrange) and, on the RT-70, an
@@ -16,7 +17,7 @@ import pytest
 from test_drives import J_L, PARAMS  # a rotor and a well-conditioned drive
 
 from rt70.bondgraph.lagrange import drive_lagrange
-from rt70.control import loops, lqg
+from rt70.control import axis_plant, loop_measures, loops, lqg
 from rt70.control.drives import DcDrive
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
@@ -48,7 +49,7 @@ def test_connected_drive_on_a_rotor_is_its_lagrange_form():
         inputs=["reducer_torque", "load_torque"],
         outputs=["axis_angle", "axis_rate"],
     )
-    sys = loops.connect_drive(rotor, PARAMS)
+    sys = axis_plant.connect_drive(rotor, PARAMS)
     lagrange = drive_lagrange(PARAMS, "voltage")  # q = [ρ, α_m, α_l], u = [U, τ_l]
     for f in FREQS:
         s = 2j * np.pi * f
@@ -67,7 +68,7 @@ def test_connected_drive_on_a_rotor_is_its_lagrange_form():
             assert_close(abs(got - ref), 0.0, rel=1e-10, scale=abs(ref), what=f"{o}/{i} {f} Hz")
 
 
-def _direct_assembly(scene, ap: loops.AxisPlant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _direct_assembly(scene, ap: axis_plant.AxisPlant) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A, b_voltage, c_angle of [q; q̇; I, α_m, ω_m] from M, K, D and DcDrive's equations.
 
     The drive's rates and reducer torque are linear in (q, q̇, s, u): their Jacobians by
@@ -121,7 +122,7 @@ def test_cascade_margins_at_the_design_bandwidth(azimuth45):
     r = loops.analyse_cascade(azimuth45, rs.CASCADE_POSITION_HZ)
     assert r.stable and r.adequate
     for m in r.margins.values():
-        assert np.isfinite(m.pm_deg) and m.pm_deg >= loops.MIN_PM_DEG
+        assert np.isfinite(m.pm_deg) and m.pm_deg >= loop_measures.MIN_PM_DEG
     # measured values (docstring): GM to ±0.2 dB, PM to ±1°, bandwidth to 2 %
     assert_close(r.margins["position"].gm_db, 16.2, rel=0.0125)
     assert_close(r.margins["position"].pm_deg, 60.9, rel=0.0165)
@@ -144,10 +145,10 @@ def test_lqg_on_a_reduced_plant_closes_the_full_plant_near_one_hertz(azimuth45):
     ctrl = lqg.design(azimuth45, weights=rs.LQG_WEIGHTS)
     assert ctrl.reduced.nstates < azimuth45.system.nstates / 3
     closed = lqg.lqg_system(azimuth45, ctrl)
-    assert loops.stable(closed)
-    m = loops.margins(lqg.input_loop(azimuth45, ctrl))
-    assert m.pm_deg >= 60.0 and m.gm_db >= loops.MIN_GM_DB
-    assert_close(loops.bandwidth_hz(closed["axis_angle", "reference"]), 1.39, rel=0.03)
+    assert loop_measures.stable(closed)
+    m = loop_measures.margins(lqg.input_loop(azimuth45, ctrl))
+    assert m.pm_deg >= 60.0 and m.gm_db >= loop_measures.MIN_GM_DB
+    assert_close(loop_measures.bandwidth_hz(closed["axis_angle", "reference"]), 1.39, rel=0.03)
 
 
 def test_reduction_keeps_the_low_frequency_response(azimuth45):
@@ -155,8 +156,8 @@ def test_reduction_keeps_the_low_frequency_response(azimuth45):
     red = lqg.reduce_plant(azimuth45.system)
     f = np.array([0.01, 0.1, 0.5, 1.0, 2.0])
     for out in ("axis_angle", "motor_speed"):
-        full = loops.frequency_response(azimuth45.system[out, "voltage"], f)
-        reduced = loops.frequency_response(red[out, "voltage"], f)
+        full = loop_measures.frequency_response(azimuth45.system[out, "voltage"], f)
+        reduced = loop_measures.frequency_response(red[out, "voltage"], f)
         # complex, frequency by frequency: each response on its own modulus
         error = np.abs(reduced - full)
         assert_close(error, np.zeros_like(error), rel=3e-3, scale=np.abs(full), what=out)
@@ -180,6 +181,6 @@ def test_elevation_axis_cascade_and_lqg(scene):
     assert_close(r.bandwidth_hz, 0.327, rel=0.02)
     ctrl = lqg.design(ap, weights=rs.LQG_WEIGHTS)
     closed = lqg.lqg_system(ap, ctrl)
-    assert loops.stable(closed)
-    assert_close(loops.margins(lqg.input_loop(ap, ctrl)).pm_deg, 89.5, rel=0.0112)  # ±1°
-    assert_close(loops.bandwidth_hz(closed["axis_angle", "reference"]), 0.775, rel=0.03)
+    assert loop_measures.stable(closed)
+    assert_close(loop_measures.margins(lqg.input_loop(ap, ctrl)).pm_deg, 89.5, rel=0.0112)  # ±1°
+    assert_close(loop_measures.bandwidth_hz(closed["axis_angle", "reference"]), 0.775, rel=0.03)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rt70.control import loops, lqg
+from rt70.control import loop_measures, loops, lqg
 from rt70.control import servo_compare as sc
 from rt70.guards.atomic import atomic_write, atomic_write_text
 from rt70.model.scene import load_scene
@@ -34,13 +34,13 @@ FIGURE_ELEVATION = 10.0
 
 def _figures(scene, axis: str) -> dict[str, object]:
     ap = rs.axis_plant(scene, axis, FIGURE_ELEVATION)
-    f = loops.FREQ_HZ
+    f = loop_measures.FREQ_HZ
     gains = loops.cascade_design(ap, rs.CASCADE_POSITION_HZ)
     ctrl = lqg.design(ap, weights=rs.LQG_WEIGHTS)
     open_loops = {f"cascade {k} loop": loops.loop_transfer(ap, gains, k) for k in loops.LOOPS}
     open_loops["LQG at the plant input"] = lqg.input_loop(ap, ctrl)
-    responses = {k: loops.frequency_response(L) for k, L in open_loops.items()}
-    margins = {k: loops.margins(L) for k, L in open_loops.items()}
+    responses = {k: loop_measures.frequency_response(L) for k, L in open_loops.items()}
+    margins = {k: loop_measures.margins(L) for k, L in open_loops.items()}
     where = f"RT-70 {axis}, elevation {FIGURE_ELEVATION:.0f}°"
     fig_open = plot_open_loops(
         f,
@@ -59,7 +59,7 @@ def _figures(scene, axis: str) -> dict[str, object]:
         f"cascade: reference → −{sym} (pointing)": -cascade[name, "reference"] / sc.ARCSEC_PER_RAD,
         f"LQG: reference → −{sym} (pointing)": -closed[name, "reference"] / sc.ARCSEC_PER_RAD,
     }
-    curves = {k: loops.frequency_response(T) for k, T in curves.items()}
+    curves = {k: loop_measures.frequency_response(T) for k, T in curves.items()}
     fig_closed = plot_closed_loops(
         f, curves, f"{where}: closed loops, PI cascade against LQG (full plant)"
     )
@@ -98,8 +98,8 @@ def main(argv: list[str]) -> int:
             print(f"wrote {path}")
     if figures_only:
         return 0
-    result: dict = {"scene": "rt70_servo", "min_gm_db": loops.MIN_GM_DB}
-    result["min_pm_deg"] = loops.MIN_PM_DEG
+    result: dict = {"scene": "rt70_servo", "min_gm_db": loop_measures.MIN_GM_DB}
+    result["min_pm_deg"] = loop_measures.MIN_PM_DEG
     if not quick:
         plants = [rs.axis_plant(scene, a, e) for a in AXES for e in ELEVATIONS]
         say("bisection of the cascade's design position bandwidth")

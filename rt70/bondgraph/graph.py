@@ -138,6 +138,16 @@ class BondGraph:
 
         Give exactly one of ``stiffness`` (k) or ``compliance`` (C = 1/k); the
         stiffness is stored, so a stiffness given is used without rounding.
+
+        Parameters
+        ----------
+        name : str
+            The element's name, unique in the graph (its state is ``q_<name>``).
+        stiffness : float, optional
+            k, effort per displacement (N/m, N·m/rad; 1/F for a capacitor): finite and
+            positive.
+        compliance : float, optional
+            C = 1/k, displacement per effort (m/N, rad/(N·m); F for a capacitor).
         """
         if (stiffness is None) == (compliance is None):
             raise BondGraphError(
@@ -169,7 +179,16 @@ class BondGraph:
 
     # --- bonds ------------------------------------------------------------------------
     def bond(self, tail: str, head: str, name: str | None = None) -> str:
-        """Join ``tail`` to ``head`` (power positive from tail to head); return its name."""
+        """Join ``tail`` to ``head`` (power positive from tail to head); return its name.
+
+        Parameters
+        ----------
+        tail, head : str
+            Names of two different elements of the graph: the bond's half-arrow points
+            from ``tail`` to ``head``.
+        name : str, optional
+            The bond's name, unique in the graph (default ``"tail->head"``).
+        """
         for end in (tail, head):
             if end not in self.elements:
                 raise BondGraphError(f"bond graph '{self.name}': no element named {end!r}")

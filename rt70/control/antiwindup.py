@@ -59,13 +59,37 @@ class BackCalculationServo(ServoDrive):
         return (e_p, e_v, e_i), excess, u
 
     def voltage_of(self, t: float, q: np.ndarray, s: np.ndarray) -> float:
-        """The armature voltage the cascade applies at state ``s`` (V)."""
+        """The armature voltage the cascade applies at state ``s`` (V).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the position reference is taken at t).
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates, m or rad, book order.
+        s : numpy.ndarray, shape (6,)
+            ``[I, α_m, ω_m]`` (A, rad, rad/s), then the integrals of the position (rad·s),
+            rate (rad, on the motor speed) and current (A·s) errors.
+        """
         return self._clamped_loops(t, q, s)[2]
 
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The drive's ``[İ, α̇_m, ω̇_m]``, then the integrators' rates (module docstring)."""
+        """The drive's ``[İ, α̇_m, ω̇_m]``, then the integrators' rates (module docstring).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the position reference is taken at t).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray, shape (6,)
+            ``[I, α_m, ω_m]`` (A, rad, rad/s), then the integrals of the position (rad·s),
+            rate (rad, on the motor speed) and current (A·s) errors.
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         (e_p, e_v, e_i), (x_p, x_v, x_i), u = self._clamped_loops(t, q, s)
         g = self.g
         drive = self.motor_rates(q, qd, s[:3], u)

@@ -58,13 +58,35 @@ class AuditedDrive(StateComponent):
         self.atol = np.concatenate([np.asarray(drive.atol, dtype=float), np.full(4, atol)])
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The drive's generalised force, from its own states."""
+        """The drive's generalised force, from its own states.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (passed to the drive).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's own states (A, rad, rad/s, …), then the four flows of :data:`FLOWS`, J.
+        """
         return self.drive.force(t, q, qd, s[: self.k])
 
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The drive's rates, then ``[u I, R_a I², D_m ω_m², D_r Δ̇²]``."""
+        """The drive's rates, then ``[u I, R_a I², D_m ω_m², D_r Δ̇²]``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (passed to the drive).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's own states (A, rad, rad/s, …), then the four flows of :data:`FLOWS`, J.
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (passed to the drive).
+        """
         own = s[: self.k]
         ds = np.asarray(self.drive.derivative(t, q, qd, own, forces), dtype=float)
         p = self.drive.p
@@ -76,7 +98,17 @@ class AuditedDrive(StateComponent):
 
 
 def stored_energy(drive: DcDrive, q: np.ndarray, s: np.ndarray) -> float:
-    """``½ L_a I² + ½ J_m ω_m² + ½ C_r Δ²`` at q and the drive's states s, J."""
+    """``½ L_a I² + ½ J_m ω_m² + ½ C_r Δ²`` at q and the drive's states s, J.
+
+    Parameters
+    ----------
+    drive : DcDrive
+        The drive (its parameters and coupling).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, m or rad, book order.
+    s : numpy.ndarray
+        The drive's states ``[I, α_m, ω_m, …]``: A, rad, rad/s.
+    """
     p = drive.p
     twist = drive.coupling.angle(q) - s[1] / p.i_r
     return 0.5 * (p.L_a * s[0] ** 2 + p.J_m * s[2] ** 2 + p.C_r * twist**2)

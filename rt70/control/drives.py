@@ -102,6 +102,15 @@ class DcDrive(StateComponent):
 
         The reducer is twisted by ``torque / C_r`` and the motor supplies
         ``torque / i_r``: ``I = torque / (i_r c_m)``, ``α_m = i_r (angle + torque / C_r)``.
+
+        Parameters
+        ----------
+        parameters : DriveParameters
+            The drive's parameters (i_r, c_m, C_r are used).
+        angle : float
+            The driven angle α the load is held at, rad.
+        torque : float
+            The torque held on the driven coordinate, N·m.
         """
         p = parameters
         return np.array([torque / (p.i_r * p.c_m), p.i_r * (angle + torque / p.C_r), 0.0])
@@ -130,27 +139,75 @@ class DcDrive(StateComponent):
         return (rate if np.isfinite(rate) else np.inf), label
 
     def twist(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> tuple[float, float]:
-        """The reducer's twist and its rate, ``(Δ, Δ̇) = (α − α_m/i_r, α̇ − ω_m/i_r)`` (4.139)."""
+        """The reducer's twist and its rate, ``(Δ, Δ̇) = (α − α_m/i_r, α̇ − ω_m/i_r)`` (4.139).
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m, …]``: A, rad, rad/s (:attr:`STATES`).
+        """
         p, c = self.p, self.coupling
         return c.angle(q) - s[1] / p.i_r, c.rate(q, qd) - s[2] / p.i_r
 
     def reducer_torque(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> float:
-        """``τ_r = C_r (α_m/i_r − α) + D_r (ω_m/i_r − α̇) = −C_r Δ − D_r Δ̇`` (4.143)."""
+        """``τ_r = C_r (α_m/i_r − α) + D_r (ω_m/i_r − α̇) = −C_r Δ − D_r Δ̇`` (4.143).
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m, …]``: A, rad, rad/s (:attr:`STATES`).
+        """
         delta, rate = self.twist(q, qd, s)
         return -self.p.C_r * delta - self.p.D_r * rate
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The reducer torque as a generalised force, ``τ_r ∂α/∂q``."""
+        """The reducer torque as a generalised force, ``τ_r ∂α/∂q``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m, …]``: A, rad, rad/s (:attr:`STATES`).
+        """
         return self.coupling.force(q, self.reducer_torque(q, qd, s))
 
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """``[İ, α̇_m, ω̇_m]`` of the armature and the rotor (4.137)–(4.143)."""
+        """``[İ, α̇_m, ω̇_m]`` of the armature and the rotor (4.137)–(4.143).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (used by the voltage law only).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m, …]``: A, rad, rad/s (:attr:`STATES`).
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         return self.motor_rates(q, qd, s, float(self.voltage(t, q, qd, s)))
 
     def motor_rates(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray, u: float) -> np.ndarray:
-        """``[İ, α̇_m, ω̇_m]`` under the armature voltage ``u`` (s = ``[I, α_m, ω_m]``)."""
+        """``[İ, α̇_m, ω̇_m]`` under the armature voltage ``u`` (s = ``[I, α_m, ω_m]``).
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m, …]``: A, rad, rad/s (:attr:`STATES`).
+        u : float
+            The armature voltage, V.
+        """
         p = self.p
         current, _, speed = s[0], s[1], s[2]
         tau = self.reducer_torque(q, qd, s)
@@ -234,6 +291,15 @@ def drive_parameters(drive, load_inertia: float = 1.0, load_damping: float = 0.0
 
     The load's ``J_l``, ``D_l`` are not in the element (the scene is the load): pass
     them when a design needs them (:func:`rt70.control.servo.cascade_gains` takes its own).
+
+    Parameters
+    ----------
+    drive : rt70.urdf.Drive
+        The ``<rt70:drive>`` element: L_a, R_a, c_m, c_e, J_m, D_m, i_r, C_r, D_r.
+    load_inertia : float
+        ``J_l``, the load's inertia about the driven axis, kg·m².
+    load_damping : float
+        ``D_l``, the load's viscous damping about it, N·m·s/rad.
     """
     return DriveParameters(
         **{k: getattr(drive, k) for k in DRIVE_PARAMETERS}, J_l=load_inertia, D_l=load_damping

@@ -97,6 +97,17 @@ def creep_speed(friction: DryFriction, torque: float, width: float, kind: str = 
 
     The ideal axis sticks (speed 0); this is the regularisation's error. Solved from
     ``τ + τ_f(ω) = 0`` by bisection (the law is monotonic in ω).
+
+    Parameters
+    ----------
+    friction : DryFriction
+        F_s (``static_torque``, N·m), k (``slope``, N·m·s/rad).
+    torque : float
+        The steady torque on the axis, N·m, ``|torque| < F_s``.
+    width : float
+        ω_ε, rad/s.
+    kind : {"tanh", "linear"}
+        The regularisation (module docstring).
     """
     check_width(width, kind)
     F_s = friction.static_torque
@@ -171,7 +182,19 @@ class AxisFriction(StateComponent):
         return friction_torque(self.friction, qd[self.index], self.width, self.kind)
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """τ_f as a generalised force on the axis's coordinate."""
+        """τ_f as a generalised force on the axis's coordinate.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates, m or rad (unused).
+        qd : numpy.ndarray, shape (nv,)
+            Generalised velocities, m/s or rad/s; the axis's is ``qd[index]``.
+        s : numpy.ndarray, shape (1,)
+            The heat dissipated so far, J (unused).
+        """
         Q = np.zeros(self.n)
         Q[self.index] = self.torque(qd)
         return Q
@@ -179,7 +202,21 @@ class AxisFriction(StateComponent):
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The heat rate ``−τ_f ω`` (≥ 0)."""
+        """The heat rate ``−τ_f ω`` (≥ 0).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates, m or rad (unused).
+        qd : numpy.ndarray, shape (nv,)
+            Generalised velocities, m/s or rad/s; the axis's is ``qd[index]``.
+        s : numpy.ndarray, shape (1,)
+            The heat dissipated so far, J (unused).
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         return np.array([-self.torque(qd) * qd[self.index]])
 
 
@@ -229,10 +266,7 @@ def switched_rigid_axis(
     rtol : float
         Relative tolerance of each phase.
     """
-    from scipy.integrate import solve_ivp
-    from scipy.optimize import brentq
-
-    F_s, k = friction.static_torque, friction.slope
+    F_s = friction.static_torque
     t_eval = np.asarray(t_eval, dtype=float)
     t, t_end = float(t_eval[0]), float(t_eval[-1])
     angle = np.zeros_like(t_eval)
@@ -242,40 +276,19 @@ def switched_rigid_axis(
     scale = F_s / inertia * (t_end - t_eval[0]) + 1e-300
     while t < t_end:
         if stuck:
-            # leave when |τ| reaches F_s: scan the output grid, then refine
-            later = t_eval[t_eval > t]
-            grid = np.concatenate([[t], later])
-            over = np.flatnonzero(np.abs([torque(s) for s in grid]) > F_s)
-            if over.size == 0:
+            t_go = _breakaway(torque, F_s, t, t_eval)
+            if t_go is None:
                 angle[t_eval >= t] = a
                 break
-            j = over[0]
-
-            def excess(s):
-                return abs(torque(s)) - F_s
-
-            t_go = grid[0] if j == 0 else brentq(excess, grid[j - 1], grid[j])
             angle[(t_eval >= t) & (t_eval <= t_go)] = a
             t, sigma, stuck = t_go, float(np.sign(torque(t_go))), False
             switches += 1
             continue
-
-        def rhs(s, y, sigma=sigma):
-            return [y[1], (torque(s) - sigma * (F_s + k * abs(y[1]))) / inertia]
-
-        def stop(s, y, sigma=sigma):
-            return y[1] * sigma  # the speed falls back through zero (it starts at zero)
-
-        stop.terminal, stop.direction = True, -1
-        sol = solve_ivp(
-            rhs, (t, t_end), [a, 0.0], method="DOP853", rtol=rtol, atol=rtol * scale,
-            events=stop, dense_output=True,
-        )  # fmt: skip
-        t_stop = sol.t_events[0][0] if sol.t_events[0].size else t_end
+        t_stop, path = _slip(inertia, friction, torque, sigma, (t, t_end), a, rtol, rtol * scale)
         mask = (t_eval > t) & (t_eval <= t_stop)
-        y = sol.sol(t_eval[mask])
+        y = path(t_eval[mask])
         angle[mask], speed[mask] = y[0], y[1]
-        a, t = float(sol.sol(t_stop)[0]), float(t_stop)
+        a, t = float(path(t_stop)[0]), float(t_stop)
         if t >= t_end:
             break
         switches += 1
@@ -284,3 +297,61 @@ def switched_rigid_axis(
         else:  # passes through zero speed: slips on in the direction of τ
             sigma = float(np.sign(torque(t)))
     return SwitchedRun(t_eval, angle, speed, switches)
+
+
+def _breakaway(
+    torque: Callable[[float], float], F_s: float, t: float, t_eval: np.ndarray
+) -> float | None:
+    """When a stuck axis leaves: the first time from t on that ``|τ|`` reaches F_s.
+
+    The output grid after t is scanned, then the crossing refined by Brent's method;
+    None if ``|τ|`` stays at or below F_s to the end of the grid.
+    """
+    from scipy.optimize import brentq
+
+    later = t_eval[t_eval > t]
+    grid = np.concatenate([[t], later])
+    over = np.flatnonzero(np.abs([torque(s) for s in grid]) > F_s)
+    if over.size == 0:
+        return None
+    j = over[0]
+
+    def excess(s):
+        return abs(torque(s)) - F_s
+
+    return grid[0] if j == 0 else brentq(excess, grid[j - 1], grid[j])
+
+
+def _slip(
+    inertia: float,
+    friction: DryFriction,
+    torque: Callable[[float], float],
+    sigma: float,
+    span: tuple[float, float],
+    angle: float,
+    rtol: float,
+    atol: float,
+) -> tuple[float, Callable[[np.ndarray], np.ndarray]]:
+    """One slip phase from rest: ``J ω̇ = τ(t) − σ (F_s + k |ω|)`` until ω returns to 0.
+
+    Integrated by DOP853 over ``span`` from ``(angle, 0)``, with the return of the
+    speed through zero as a terminal event. Returns the phase's end (the event, or the
+    end of ``span``) and the dense solution ``t ↦ (angle, speed)``.
+    """
+    from scipy.integrate import solve_ivp
+
+    F_s, k = friction.static_torque, friction.slope
+
+    def rhs(s, y):
+        return [y[1], (torque(s) - sigma * (F_s + k * abs(y[1]))) / inertia]
+
+    def stop(s, y):
+        return y[1] * sigma  # the speed falls back through zero (it starts at zero)
+
+    stop.terminal, stop.direction = True, -1
+    sol = solve_ivp(
+        rhs, span, [angle, 0.0], method="DOP853", rtol=rtol, atol=atol,
+        events=stop, dense_output=True,
+    )  # fmt: skip
+    t_stop = sol.t_events[0][0] if sol.t_events[0].size else span[1]
+    return t_stop, sol.sol

@@ -66,6 +66,19 @@ def backlash_torque(
     ``C dz(Δ) + D Δ̇`` while the teeth touch, zero inside the gap; in contact it never
     pulls (clipped at zero on the contact side). ``half_width = 0``: the linear reducer
     (no gap: the other flank is already in contact, so the torque may change sign).
+
+    Parameters
+    ----------
+    twist : float
+        Δ = α_m / i_r − α, the train's twist, rad (axis side).
+    rate : float
+        Δ̇, rad/s.
+    stiffness : float
+        C, the train's stiffness, N·m/rad.
+    damping : float
+        D, its damping, N·m·s/rad.
+    half_width : float
+        b, half the gap, rad (axis side; 0: no backlash).
     """
     if half_width == 0.0:
         return stiffness * twist + damping * rate
@@ -111,6 +124,20 @@ def train_gains(
     inertia ``2 J_m + J_l / i_r²`` over the pair's torque constant ``2 c_m``: the rate
     loop commands one motor's current); each motor's current loop is that of one motor
     (``K_p = L_a ω_c``, ``K_i = R_a ω_c``), its voltage limit a motor's.
+
+    Parameters
+    ----------
+    p : DriveParameters
+        ONE motor of the pair, the ratio i_r and the axis's total C_r, D_r.
+    load_inertia : float
+        Inertia of the axis, kg·m².
+    position_hz : float
+        Position-loop bandwidth, Hz.
+    ratio : float
+        Bandwidth ratio between a loop and the one inside it.
+    **limits : float
+        ``current_limit`` (A, per motor), ``rate_limit`` (rad/s) and ``voltage_limit``
+        (V, of the series pair: each motor gets half) of :func:`rt70.control.servo.cascade_gains`.
     """
     g = cascade_gains(equivalent_drive(p), load_inertia, position_hz, ratio, **limits)
     return replace(g, kp_i=g.kp_i / 2, ki_i=g.ki_i / 2, voltage_limit=g.voltage_limit / 2)
@@ -174,7 +201,16 @@ class TwoTrainDrive(StateComponent):
         self.atol = np.full(k, 1e-9) if atol is None else np.asarray(atol, dtype=float)
 
     def train_torques(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> tuple[float, float]:
-        """``(τ₁, τ₂)``: each train's torque on the axis (:func:`backlash_torque`)."""
+        """``(τ₁, τ₂)``: each train's torque on the axis (:func:`backlash_torque`).
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s); the axis's
+            are ``q[index]``, ``qd[index]``.
+        s : numpy.ndarray
+            ``[I₁, α_m1, ω_m1, I₂, α_m2, ω_m2, …]``: A, rad, rad/s per motor (:attr:`STATES`).
+        """
         p, k = self.p, self.index
         C, D = 0.5 * p.C_r, 0.5 * p.D_r
         return tuple(
@@ -185,7 +221,18 @@ class TwoTrainDrive(StateComponent):
         )  # type: ignore[return-value]
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """``τ₁ + τ₂`` as a generalised force on the driven coordinate."""
+        """``τ₁ + τ₂`` as a generalised force on the driven coordinate.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s); the axis's
+            are ``q[index]``, ``qd[index]``.
+        s : numpy.ndarray
+            ``[I₁, α_m1, ω_m1, I₂, α_m2, ω_m2, …]``: A, rad, rad/s per motor (:attr:`STATES`).
+        """
         Q = np.zeros(self.n)
         Q[self.index] = sum(self.train_torques(q, qd, s))
         return Q
@@ -193,11 +240,35 @@ class TwoTrainDrive(StateComponent):
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """``[İ₁, α̇_m1, ω̇_m1, İ₂, α̇_m2, ω̇_m2]`` under the two voltages."""
+        """``[İ₁, α̇_m1, ω̇_m1, İ₂, α̇_m2, ω̇_m2]`` under the two voltages.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (used by the voltage law only).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s); the axis's
+            are ``q[index]``, ``qd[index]``.
+        s : numpy.ndarray
+            ``[I₁, α_m1, ω_m1, I₂, α_m2, ω_m2, …]``: A, rad, rad/s per motor (:attr:`STATES`).
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         return self.motor_rates(q, qd, s, self.voltages(t, q, qd, s))
 
     def motor_rates(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray, u) -> np.ndarray:
-        """Both motors' rates (4.137) under the voltages ``u = (u₁, u₂)``."""
+        """Both motors' rates (4.137) under the voltages ``u = (u₁, u₂)``.
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s); the axis's
+            are ``q[index]``, ``qd[index]``.
+        s : numpy.ndarray
+            ``[I₁, α_m1, ω_m1, I₂, α_m2, ω_m2, …]``: A, rad, rad/s per motor (:attr:`STATES`).
+        u : tuple of float
+            The two armature voltages ``(u₁, u₂)``, V.
+        """
         p = self.p
         taus = self.train_torques(q, qd, s)
         out = np.empty(6)
@@ -212,6 +283,15 @@ class TwoTrainDrive(StateComponent):
         """The states holding the axis at ``angle`` at rest, trains at ``±bias`` + half the load.
 
         Train 1 carries ``load/2 + bias`` (twist past +b), train 2 ``load/2 − bias``.
+
+        Parameters
+        ----------
+        angle : float
+            The axis angle held, rad.
+        bias_torque : float
+            The counter-torque of each train, N·m, axis side.
+        load_torque : float
+            The torque the pair holds on the axis together, N·m (shared equally).
         """
         p, b = self.p, self.backlash
         out = np.zeros(6)
@@ -273,7 +353,21 @@ class TwoTrainServo(TwoTrainDrive):
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The motors' rates under the cascade's voltages, then the four integrators."""
+        """The motors' rates under the cascade's voltages, then the four integrators.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the position reference is taken at t).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s); the axis's
+            are ``q[index]``, ``qd[index]``.
+        s : numpy.ndarray, shape (10,)
+            The two motors' ``[I, α_m, ω_m]`` (A, rad, rad/s), then the integrals of the
+            position (rad·s) and rate (rad) errors and of the two current errors (A·s).
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         g, p = self.g, self.p
         e_p = float(self.reference(t)) - q[self.index]
         rate_ref, sat_p = clamped_pi(g.kp_p, g.ki_p, e_p, s[6], g.rate_limit)

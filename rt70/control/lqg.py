@@ -7,7 +7,7 @@ Antennas and Telescopes*, Springer 2008: LQG and H∞ about 10× better than PI 
 antenna-servo.md).
 
 - :func:`reduce_plant` keeps the slow modes of the drive + structure plant
-  (:class:`rt70.control.loops.AxisPlant`) that the measurements see, by modal truncation
+  (:class:`rt70.control.axis_plant.AxisPlant`) that the measurements see, by modal truncation
   with static correction (the fast or invisible modes residualised: their DC
   contribution kept as feedthrough). It is the one place a reduction enters: a better
   one (balanced truncation, Hankel singular values) replaces this function alone.
@@ -19,7 +19,7 @@ antenna-servo.md).
   equations are well conditioned.
 - :func:`lqg_system` closes the controller around the FULL plant; :func:`input_loop`
   breaks it at the plant input (the armature voltage) for margins. The checks (poles,
-  margins, bandwidth) use :mod:`rt70.control.loops`, the step and wind numbers
+  margins, bandwidth) use :mod:`rt70.control.loop_measures`, the step and wind numbers
   :mod:`rt70.control.servo_compare`.
 """
 
@@ -31,7 +31,7 @@ import control
 import numpy as np
 import scipy.linalg
 
-from rt70.control.loops import POINTING, AxisPlant
+from rt70.control.axis_plant import POINTING, AxisPlant
 from rt70.errors import Rt70Error
 
 #: Measurements the controller reads: the encoder's axis angle, the tachometer's motor
@@ -84,6 +84,18 @@ def reduce_plant(
     ``outputs`` names the outputs whose channels select the modes (default all): the
     LQG design selects by its measurements, so that a mode seen only in the pointing
     (a structural mode the axis torque does not excite) is not kept unobservable.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        The full plant (for an axis: :attr:`rt70.control.axis_plant.AxisPlant.system`, inputs
+        ``voltage`` and ``wind_torque``).
+    f_max_hz : float
+        The fastest mode kept, Hz.
+    rel_peak : float
+        The smallest modal peak kept, relative to the channel's largest.
+    outputs : tuple of str, optional
+        The outputs whose channels select the modes (default all).
 
     Raises
     ------
@@ -231,6 +243,15 @@ def design(
     The LQR state is ``[x_r; z]``, ``ż = axis_angle − reference``; the control
     ``u = −K_x (x̂ − N_x r) − K_z z + N_u r`` where ``(N_x, N_u)`` is the reduced
     plant's steady state for a unit angle (least squares, exact when it exists).
+
+    Parameters
+    ----------
+    ap : AxisPlant
+        The plant of one axis (drive and structure).
+    f_max_hz : float
+        The fastest mode of the reduced plant the design uses, Hz (:func:`reduce_plant`).
+    weights : LqgWeights, optional
+        The LQR and Kalman weights (default :class:`LqgWeights`' values).
     """
     w = weights or LqgWeights()
     red = _scaled(reduce_plant(ap.system, f_max_hz, outputs=MEASURED), w)
@@ -286,6 +307,15 @@ def lqg_system(
     Returns inputs ``reference``, ``wind_torque`` (and ``w``, the plant's voltage, when
     broken); outputs ``axis_angle``, :data:`POINTING`, ``voltage``, ``current``,
     ``motor_speed``.
+
+    Parameters
+    ----------
+    ap : AxisPlant
+        The FULL plant of the axis.
+    lqg : LqgController
+        The controller (:func:`design`).
+    open_at_input : bool
+        Break the loop at the plant's voltage input (for :func:`input_loop`).
     """
     P = ap.system
     if open_at_input:

@@ -155,7 +155,15 @@ class LqgDrive(DcDrive):
         self.b_clamp = b_u + b_aw
 
     def measure(self, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The measurements (:attr:`measured`, absolute) at a state (``s`` = ``[I, α_m, ω_m]``)."""
+        """The measurements (:attr:`measured`, absolute) at a state (``s`` = ``[I, α_m, ω_m]``).
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray, shape (3,)
+            The drive's ``[I, α_m, ω_m]``: A, rad, rad/s.
+        """
         values = {
             "axis_angle": lambda: self.coupling.angle(q),
             "axis_rate": lambda: self.coupling.rate(q, qd),
@@ -166,7 +174,17 @@ class LqgDrive(DcDrive):
         return np.array([values[k]() for k in self.measured], dtype=float)
 
     def controller_inputs(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray):
-        """``v = [r − y₀_angle, y − y₀]``: the controller's inputs as deviations."""
+        """``v = [r − y₀_angle, y − y₀]``: the controller's inputs as deviations.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the reference is taken at t).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m]`` (A, rad, rad/s), then the controller's ``x_c``.
+        """
         y = self.measure(q, qd, s[:3]) - self.y0
         return np.concatenate(([float(self.reference(t)) - self.r0], y))
 
@@ -178,20 +196,52 @@ class LqgDrive(DcDrive):
         return v, u_lin, u
 
     def voltage_of(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> float:
-        """The armature voltage applied at a state (V), after the clamp."""
+        """The armature voltage applied at a state (V), after the clamp.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the reference is taken at t).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m]`` (A, rad, rad/s), then the controller's ``x_c``.
+        """
         return self._voltages(t, q, qd, s)[2]
 
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The drive's ``[İ, α̇_m, ω̇_m]`` under the clamped voltage, then ``ẋ_c``."""
+        """The drive's ``[İ, α̇_m, ω̇_m]`` under the clamped voltage, then ``ẋ_c``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the reference is taken at t).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m]`` (A, rad, rad/s), then the controller's ``x_c``.
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         v, u_lin, u = self._voltages(t, q, qd, s)
         drive = self.motor_rates(q, qd, s[:3], u)
         xc = self.A_c @ s[3:] + self.B_c @ v + self.b_clamp * (u - self.u0 - u_lin)
         return np.concatenate([drive, xc])
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The reducer torque on the driven coordinate (from the drive's own states)."""
+        """The reducer torque on the driven coordinate (from the drive's own states).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray
+            The drive's states ``[I, α_m, ω_m]`` (A, rad, rad/s), then the controller's ``x_c``.
+        """
         return super().force(t, q, qd, s[:3])
 
     @staticmethod
@@ -202,6 +252,17 @@ class LqgDrive(DcDrive):
 
         Solves ``A_c x + B_c v = 0``, ``C_c x + D_c v = voltage`` (least squares; with
         integral action ``A_c`` is singular and the integral state takes the voltage).
+
+        Parameters
+        ----------
+        matrices : (A_c, B_c, C_c, D_c)
+            The controller (shapes as :class:`LqgDrive`'s).
+        inputs : numpy.ndarray, shape (1 + m,)
+            Its inputs ``v`` at rest (:meth:`controller_inputs`: deviations).
+        voltage : float
+            The output wanted, V (the holding voltage less ``u₀``).
+        tol : float
+            Relative residual above which an equation counts as unsolved.
 
         Raises
         ------

@@ -16,7 +16,7 @@ The structure (``x = [δq; δq̇]``, all the scene's coordinates free)::
 with ``g_d = ∂θ_d/∂q`` at q0 (:class:`rt70.model.couplings.SceneCoupling`, textbook side),
 τ_d the reducer torque of drive d, ``b_j`` the disturbance columns and ``K_extra`` a
 stiffness the caller adds (the wind's aerodynamic stiffness, not symmetric). Each drive
-(:func:`rt70.control.loops.drive_block`) is fed ``θ_d = g_dᵀ δq`` and ``θ̇_d = g_dᵀ δq̇``;
+(:func:`rt70.control.axis_plant.drive_block`) is fed ``θ_d = g_dᵀ δq`` and ``θ̇_d = g_dᵀ δq̇``;
 its cascade reads the encoder δq_k of the drive's joint, exactly as the nonlinear servo
 (:class:`rt70.control.antiwindup.BackCalculationServo` while no loop is clamped). The sector's
 geometric stiffness ``τ_d ∂²θ_d/∂q²`` is left out, as in
@@ -31,7 +31,8 @@ import control
 import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
-from rt70.control.loops import drive_block, pi_block
+from rt70.control.axis_plant import drive_block
+from rt70.control.loops import pi_block
 from rt70.control.servo import CascadeGains
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
@@ -88,7 +89,7 @@ def structure_system(
         Inputs ``<drive>_reducer_torque`` (τ_d) then the disturbances; outputs
         ``<drive>_axis_angle`` (θ_d), ``<drive>_axis_rate`` (θ̇_d), ``<drive>_encoder``
         (the joint's coordinate) for each drive, then the outputs' components. The
-        names match :func:`rt70.control.loops.drive_block`'s, prefixed by the drive's
+        names match :func:`rt70.control.axis_plant.drive_block`'s, prefixed by the drive's
         name, so :func:`closed_loop` connects them by name.
     """
     if lm.locked:

@@ -109,6 +109,19 @@ def cascade_gains(
 def clamped_pi(kp: float, ki: float, error: float, integral: float, limit: float):
     """A loop's PI output ``K_p e + K_i ∫e`` clamped to ±limit, and whether it was clamped.
 
+    Parameters
+    ----------
+    kp : float
+        Proportional gain K_p (output unit per error unit).
+    ki : float
+        Integral gain K_i (output unit per error unit and second).
+    error : float
+        The loop's error e.
+    integral : float
+        ``∫e dt``, the loop's integrator state.
+    limit : float
+        The clamp: the output is kept within ±limit (``numpy.inf``: none).
+
     Returns
     -------
     (float, bool)
@@ -170,7 +183,20 @@ class ServoDrive(DcDrive):
     def derivative(
         self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray, forces: MechanicsForces
     ) -> np.ndarray:
-        """The drive's ``[İ, α̇_m, ω̇_m]`` under the cascade's voltage, then the integrators."""
+        """The drive's ``[İ, α̇_m, ω̇_m]`` under the cascade's voltage, then the integrators.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the position reference is taken at t).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray, shape (6,)
+            ``[I, α_m, ω_m]`` (A, rad, rad/s), then the integrals of the position (rad·s),
+            rate (rad, on the motor speed) and current (A·s) errors.
+        forces : MechanicsForces
+            The mechanics' forces at this evaluation (unused).
+        """
         errors, saturated, u = self._loops(t, q, s)
         drive = self.motor_rates(q, qd, s[:3], u)
         # conditional integration: an integrator holds while its loop's output is clamped
@@ -178,5 +204,16 @@ class ServoDrive(DcDrive):
         return np.concatenate([drive, integrals])
 
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
-        """The reducer torque on the driven coordinate (from the drive's own states)."""
+        """The reducer torque on the driven coordinate (from the drive's own states).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q, qd : numpy.ndarray, shape (nv,)
+            Generalised coordinates (m or rad) and velocities (m/s or rad/s), book order.
+        s : numpy.ndarray, shape (6,)
+            ``[I, α_m, ω_m]`` (A, rad, rad/s), then the integrals of the position (rad·s),
+            rate (rad, on the motor speed) and current (A·s) errors.
+        """
         return super().force(t, q, qd, s[:3])

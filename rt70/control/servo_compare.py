@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from rt70.control import loops
+from rt70.control import loop_measures
+from rt70.control.axis_plant import POINTING
 
 #: Arc seconds per radian.
 ARCSEC_PER_RAD = 180.0 * 3600.0 / np.pi
@@ -58,22 +59,29 @@ def performance(
 ) -> Performance:
     """Measure a closed loop around the full plant (see :class:`Performance`).
 
-    ``closed`` has the inputs ``reference``, ``wind_torque`` and the outputs
-    ``axis_angle`` and :data:`rt70.control.loops.POINTING`; ``wind_torque`` is the step's
-    size, N·m.
+    Parameters
+    ----------
+    closed : control.StateSpace
+        The closed loop, with the inputs ``reference`` (rad) and ``wind_torque`` (N·m)
+        and the outputs ``axis_angle`` (rad) and :data:`rt70.control.axis_plant.POINTING`
+        (arc seconds).
+    wind_torque : float
+        The size of the disturbance step, N·m.
+    times : numpy.ndarray
+        The time grid of the step responses, s, from 0.
     """
     T = closed["axis_angle", "reference"]
-    mag = np.abs(loops.frequency_response(T))
+    mag = np.abs(loop_measures.frequency_response(T))
     step = control.step_response(T, T=times)
     info = control.step_info(
         np.asarray(step.outputs).reshape(-1), times, SettlingTimeThreshold=0.02
     )
-    wind = control.step_response(closed[["axis_angle", *loops.POINTING], "wind_torque"], T=times)
+    wind = control.step_response(closed[["axis_angle", *POINTING], "wind_torque"], T=times)
     y = np.asarray(wind.outputs).reshape(3, -1) * wind_torque
     axis = np.abs(y[0]) * ARCSEC_PER_RAD
     pointing = np.hypot(y[1], y[2])  # the pointing outputs are in arc seconds
     return Performance(
-        bandwidth_hz=loops.bandwidth_hz(T),
+        bandwidth_hz=loop_measures.bandwidth_hz(T),
         peak_db=float(20 * np.log10(mag.max())),
         overshoot_pct=float(info["Overshoot"]),
         settling_s=float(info["SettlingTime"]),
@@ -81,5 +89,5 @@ def performance(
         wind_axis_final_arcsec=float(axis[-1]),
         wind_pointing_peak_arcsec=float(pointing.max()),
         wind_pointing_final_arcsec=float(pointing[-1]),
-        stable=loops.stable(closed),
+        stable=loop_measures.stable(closed),
     )

@@ -7,7 +7,8 @@ closure Φ(q) = 0. Each side computes the closure with its own kinematics:
 functions **as arguments** (any pair with that signature: a hand-written closure of an
 existing scene serves as well) and gives what ``rt70 modes`` gives for a tree:
 
-1. the static equilibrium on the manifold (:func:`rt70.linear.constrained.equilibrium`),
+1. the static equilibrium on the manifold
+   (:func:`rt70.linear.constrained_equilibrium.equilibrium`),
    with the held coordinates (the RT-70's pointing) added as the linear constraints
    ``q_h = value`` — their multipliers are the torques that hold them, as the drives'
    are in :func:`rt70.linear.linearize.equilibrium`;
@@ -32,8 +33,8 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.linear import constrained as cm
+from rt70.linear import constrained_equilibrium, manifold, modal, mode_table
 from rt70.linear import linearize as lin
-from rt70.linear import modal, mode_table
 from rt70.model.scene import Scene
 from rt70.textbook import dynamics
 
@@ -61,22 +62,33 @@ def scene_constraints(
     loop_jacobian: LoopFunction,
     side: str = "textbook",
     loop_bias: BiasFunction | None = None,
-) -> cm.Constraints:
-    """The scene's loop closures on ``side`` as :class:`~rt70.linear.constrained.Constraints`.
+) -> manifold.Constraints:
+    """The scene's loop closures on ``side`` as :class:`~rt70.linear.manifold.Constraints`.
 
     With ``loop_bias`` (``(model, data, q, q̇) → C``, ``B_c q̈ + C = 0``) the geometric
     stiffness is formed exactly from it; without, by differences of the Jacobian.
+
+    Parameters
+    ----------
+    scene : Scene
+        The tree the loops close.
+    loop_residual, loop_jacobian : callable
+        ``(model, data, q) → Φ``, shape (m,), and ``→ B_c``, shape (m, n), of ``side``.
+    side : {"textbook", "reference"}
+        Whose model and data the loop functions are called with.
+    loop_bias : callable, optional
+        ``(model, data, q, q̇) → C``, shape (m,), of ``side``.
     """
     model, data = _side(scene, side)
     bias = None if loop_bias is None else (lambda q, qd: loop_bias(model, data, q, qd))
-    return cm.Constraints(
+    return manifold.Constraints(
         residual=lambda q: loop_residual(model, data, q),
         jacobian=lambda q: loop_jacobian(model, data, q),
         bias=bias,
     )
 
 
-def _static_force(scene: Scene, side: str) -> cm.Vector:
+def _static_force(scene: Scene, side: str) -> manifold.Vector:
     if side == "textbook":
         return lambda q: lin.static_force(scene, q)
     return lambda q: lin.reference_static_force(scene, q)
@@ -100,7 +112,7 @@ class SceneConstrainedModel:
         Scene name.
     coordinates : list of str
         The full (tree) coordinates the shapes are given in.
-    equilibrium : rt70.linear.constrained.Equilibrium
+    equilibrium : rt70.linear.constrained_equilibrium.Equilibrium
         q*, the multipliers (the loop rows first, then the held coordinates').
     M, K, D : ndarray, shape (n, n)
         Full-coordinate mass, stiffness (with the locked rotor's) and damping at q*.
@@ -118,7 +130,7 @@ class SceneConstrainedModel:
 
     scene: str
     coordinates: list[str]
-    equilibrium: cm.Equilibrium
+    equilibrium: constrained_equilibrium.Equilibrium
     M: np.ndarray
     K: np.ndarray
     D: np.ndarray
@@ -164,12 +176,13 @@ def constrained_linearize(
     q_start : array_like, optional
         Start of Newton (default zeros, the held values set).
     tol : float
-        Relative tolerance of the equilibrium (:func:`rt70.linear.constrained.equilibrium`).
+        Relative tolerance of the equilibrium
+        (:func:`rt70.linear.constrained_equilibrium.equilibrium`).
     loop_bias : callable, optional
         ``(model, data, q, q̇) → C`` of ``side``: the geometric stiffness exactly, in
         n(n+1)/2 calls, instead of 2n differenced Jacobians.
     descend : bool
-        Look for a stable equilibrium (:func:`rt70.linear.constrained.equilibrium`).
+        Look for a stable equilibrium (:func:`rt70.linear.constrained_equilibrium.equilibrium`).
 
     Raises
     ------
@@ -178,62 +191,110 @@ def constrained_linearize(
     """
     if method not in METHODS:
         raise Rt70Error(f"unknown method {method!r} (choose from {', '.join(METHODS)})")
-    names = list(scene.textbook.coordinate_names)
-    n = len(names)
     held = dict(held or {})
     hold_idx = lin.coordinate_indices(scene, list(held))
     loops = scene_constraints(scene, loop_residual, loop_jacobian, side, loop_bias)
-    hold = cm.fixed(n, hold_idx, list(held.values()))
-    q = np.zeros(n) if q_start is None else np.array(q_start, dtype=float)
-    if q.shape != (n,):
-        raise Rt70Error(f"{scene.name}: q_start has shape {q.shape}, the scene has {n} coordinates")
-    q[hold_idx] = list(held.values())
-    force = _static_force(scene, side)
-    K_of = lambda x: lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
-    try:
-        both = cm.combine(loops, hold) if held else loops
-        eq = cm.equilibrium(force, both, q, stiffness=K_of, tol=tol, descend=descend)
-    except Rt70Error as exc:
-        raise Rt70Error(f"{scene.name}: {exc}") from None
+    hold = manifold.fixed(len(scene.textbook.coordinate_names), hold_idx, list(held.values()))
+    q = _start(scene, q_start, hold_idx, list(held.values()))
+    both = manifold.combine(loops, hold) if held else loops
+    eq = _scene_equilibrium(scene, side, both, q, tol, descend)
     m_loop = np.atleast_1d(loops.residual(eq.q)).size
-    K0 = K_of(eq.q)
-    full = lin.Linearization(
-        scene=scene.name,
-        q0=eq.q,
-        coordinates=names,
-        M=_mass_matrix(scene, side, eq.q),
-        K=K0,
-        D=lin.damping_matrix(scene, eq.q),
-        K_gravity=np.full((n, n), np.nan),  # not formed: only M, K and D are used
-    )
     drives = bool(scene.description.drives) and not lock_held
-    if drives:
-        full = lin.locked_rotor(scene, full)
-    constraints, lam = loops, eq.lam[:m_loop]
-    if lock_held and held:
-        constraints, lam = cm.combine(loops, hold), eq.lam
-    try:
-        if method == "null-space":
-            reduced = cm.linearize(constraints, eq.q, lam, full.M, full.K, full.D)
-        else:
-            extra = full.K - K0  # the locked rotor's springs about q*
-            with_rotor = lambda x: force(x) - extra @ (x - eq.q)  # noqa: E731
-            reduced = cm.partition_linearize(with_rotor, constraints, eq.q, full.M, full.D)
-    except Rt70Error as exc:
-        raise Rt70Error(f"{scene.name}: {exc}") from None
+    full, K0 = _full_model(scene, side, eq.q, drives)
+    constraints, lam = (both, eq.lam) if lock_held and held else (loops, eq.lam[:m_loop])
     return SceneConstrainedModel(
         scene=scene.name,
-        coordinates=names,
+        coordinates=list(scene.textbook.coordinate_names),
         equilibrium=eq,
         M=full.M,
         K=full.K,
         D=full.D,
-        reduced=reduced,
+        reduced=_reduce(scene, side, method, constraints, eq.q, lam, full, K0),
         loop_rows=m_loop,
         held=held,
         lock_held=lock_held,
         locked_rotor=drives,
     )
+
+
+def _start(
+    scene: Scene, q_start: np.ndarray | None, hold_idx: np.ndarray, values: list[float]
+) -> np.ndarray:
+    """Newton's start: ``q_start`` (default zeros) with the held coordinates at their values."""
+    n = len(scene.textbook.coordinate_names)
+    q = np.zeros(n) if q_start is None else np.array(q_start, dtype=float)
+    if q.shape != (n,):
+        raise Rt70Error(f"{scene.name}: q_start has shape {q.shape}, the scene has {n} coordinates")
+    q[hold_idx] = values
+    return q
+
+
+def _scene_equilibrium(
+    scene: Scene,
+    side: str,
+    constraints: manifold.Constraints,
+    q: np.ndarray,
+    tol: float,
+    descend: bool,
+) -> constrained_equilibrium.Equilibrium:
+    """The equilibrium on the manifold under ``side``'s static force and stiffness."""
+    force = _static_force(scene, side)
+    K_of = lambda x: lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
+    try:
+        return constrained_equilibrium.equilibrium(
+            force, constraints, q, stiffness=K_of, tol=tol, descend=descend
+        )
+    except Rt70Error as exc:
+        raise Rt70Error(f"{scene.name}: {exc}") from None
+
+
+def _full_model(
+    scene: Scene, side: str, q: np.ndarray, locked_rotor: bool
+) -> tuple[lin.Linearization, np.ndarray]:
+    """M, K and D in the tree coordinates at q, and K without the locked rotor's springs.
+
+    K is differenced from ``side``'s static force, M is ``side``'s, D the textbook's; with
+    ``locked_rotor`` the scene's drives' reducer springs are added
+    (:func:`rt70.linear.linearize.locked_rotor`).
+    """
+    K0 = lin.stiffness_matrix(scene, q, side=side)
+    n = K0.shape[0]
+    full = lin.Linearization(
+        scene=scene.name,
+        q0=q,
+        coordinates=list(scene.textbook.coordinate_names),
+        M=_mass_matrix(scene, side, q),
+        K=K0,
+        D=lin.damping_matrix(scene, q),
+        K_gravity=np.full((n, n), np.nan),  # not formed: only M, K and D are used
+    )
+    return (lin.locked_rotor(scene, full) if locked_rotor else full), K0
+
+
+def _reduce(
+    scene: Scene,
+    side: str,
+    method: str,
+    constraints: manifold.Constraints,
+    q: np.ndarray,
+    lam: np.ndarray,
+    full: lin.Linearization,
+    K0: np.ndarray,
+) -> cm.ConstrainedLinearization:
+    """The model on the manifold by ``method`` (:data:`METHODS`) about (q, λ).
+
+    The partition differences the static force, so the locked rotor's springs about q
+    (``full.K − K0``) are added to it.
+    """
+    try:
+        if method == "null-space":
+            return cm.linearize(constraints, q, lam, full.M, full.K, full.D)
+        force = _static_force(scene, side)
+        extra = full.K - K0  # the locked rotor's springs about q*
+        with_rotor = lambda x: force(x) - extra @ (x - q)  # noqa: E731
+        return cm.partition_linearize(with_rotor, constraints, q, full.M, full.D)
+    except Rt70Error as exc:
+        raise Rt70Error(f"{scene.name}: {exc}") from None
 
 
 def spectrum(model: SceneConstrainedModel) -> tuple[modal.Modes, np.ndarray, Any, dict]:

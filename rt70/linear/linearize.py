@@ -85,6 +85,15 @@ def negative_jacobian(force, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
 
     Not symmetrised: a non-conservative force (the wind's, :mod:`rt70.telescope.pointing`) has a
     non-symmetric stiffness.
+
+    Parameters
+    ----------
+    force : callable
+        ``q ↦ Q(q)``, shape (n,): a generalised force, N or N·m per coordinate.
+    q : array_like, shape (n,)
+        The point, m or rad per coordinate.
+    h : float
+        The difference step per coordinate, m or rad.
     """
     q = np.asarray(q, dtype=float)
     K = np.empty((q.size, q.size))
@@ -106,8 +115,16 @@ def stiffness_matrix(
 ) -> np.ndarray:
     """``K = −∂(Q_g + Q_c)/∂q`` by central differences, symmetrised (see module docstring).
 
-    ``side`` chooses whose static forces are differenced: ``"reference"`` (Pinocchio,
-    fast) or ``"textbook"``.
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q : array_like, shape (nv,)
+        Generalised coordinates in the book's order, m or rad.
+    h : float
+        The difference step per coordinate, m or rad.
+    side : {"reference", "textbook"}
+        Whose static forces are differenced: Pinocchio's (fast) or the book's.
     """
     _check_side(side)
     force = reference_static_force if side == "reference" else static_force
@@ -177,6 +194,27 @@ def equilibrium(
     only when the residual fell by less than ``1/REUSE_RATIO`` in the last step (the
     RT-70's sag is small: one K usually suffices).
 
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    held : dict of str to float, optional
+        Coordinates held at values, m or rad (the RT-70's azimuth and elevation,
+        :func:`rt70.scenes.rt70_state.rt70_pointing`); none by default.
+    q_start : array_like, shape (nv,), optional
+        Newton's start (default zeros; the held values are set in it).
+    tol : float
+        Relative tolerance of the force residual (above).
+    max_iter : int
+        Newton steps allowed.
+    side : {"reference", "textbook"}
+        Whose static forces the stiffness is differenced from.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nv,)
+        The equilibrium, in the book's coordinates.
+
     Raises
     ------
     Rt70Error
@@ -191,36 +229,47 @@ def equilibrium(
     scale = max(float(np.max(np.abs(static_force(scene, q)))), 1.0)
     K, previous = None, np.inf
     for _ in range(max_iter):
-        with np.errstate(over="ignore", invalid="ignore"):  # checked just below
-            residual = hold.reduce_force(static_force(scene, q))
-        size = float(np.max(np.abs(residual), initial=0.0))
-        if not np.isfinite(size):
-            raise Rt70Error(
-                f"{scene.name}: static equilibrium: the forces are not finite on Newton's "
-                "way (a load or a number in the model beyond what its stiffness can hold?)"
-            )
+        residual, size = _free_residual(scene, hold, q)
         if size <= tol * scale:
             return q
         if K is not None and size <= REUSE_RATIO * previous:
             previous = size  # the last K still converges fast: keep it (modified Newton)
         else:
             K, previous = hold.reduce_matrix(stiffness_matrix(scene, q, side=side)), size
-        if not np.isfinite(K).all():
-            raise Rt70Error(
-                f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
-                "largest floating-point number?)"
-            )
-        try:
-            step = scipy.linalg.solve(K, residual, assume_a="sym")
-        except (np.linalg.LinAlgError, ValueError):
-            raise Rt70Error(
-                f"{scene.name}: no static equilibrium: the free coordinates have no "
-                "stiffness in some direction (hold or lock it)"
-            ) from None
+        step = _newton_step(scene, K, residual)
         q += hold.expand(step, offset=False)
         if float(np.max(np.abs(step), initial=0.0)) <= STEP_TOL * max(1.0, np.abs(q).max()):
             return q  # the position is fixed to rounding; what is left is the forces' rounding
     raise Rt70Error(f"{scene.name}: static equilibrium not found in {max_iter} Newton steps")
+
+
+def _free_residual(scene: Scene, hold: HolonomicMap, q: np.ndarray) -> tuple[np.ndarray, float]:
+    """The static force on the free coordinates at q and its largest magnitude (finite)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # checked just below
+        residual = hold.reduce_force(static_force(scene, q))
+    size = float(np.max(np.abs(residual), initial=0.0))
+    if not np.isfinite(size):
+        raise Rt70Error(
+            f"{scene.name}: static equilibrium: the forces are not finite on Newton's "
+            "way (a load or a number in the model beyond what its stiffness can hold?)"
+        )
+    return residual, size
+
+
+def _newton_step(scene: Scene, K: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    """Newton's step ``K⁻¹ r`` on the free coordinates (a clear error if K cannot give it)."""
+    if not np.isfinite(K).all():
+        raise Rt70Error(
+            f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
+            "largest floating-point number?)"
+        )
+    try:
+        return scipy.linalg.solve(K, residual, assume_a="sym")
+    except (np.linalg.LinAlgError, ValueError):
+        raise Rt70Error(
+            f"{scene.name}: no static equilibrium: the free coordinates have no "
+            "stiffness in some direction (hold or lock it)"
+        ) from None
 
 
 @dataclass
@@ -249,8 +298,18 @@ def linearize(
     Locking a coordinate of the pair structure is the book's holonomic constraint in 3-D:
     its column of the mobility matrix f is deleted, so its rows and columns of A, K and
     D are deleted — ``Tᵀ M T`` of :func:`locking_map` (:mod:`rt70.physics.constraints`).
-    ``side`` is whose static forces K is differenced from (:func:`stiffness_matrix`);
     M and D are the textbook's.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q0 : array_like, shape (nv,)
+        The state linearised about (an equilibrium, :func:`equilibrium`), m or rad.
+    locked : tuple of str
+        Coordinates removed from the model (the drives infinitely stiff).
+    side : {"reference", "textbook"}
+        Whose static forces K is differenced from (:func:`stiffness_matrix`).
     """
     _check_side(side)
     model, data = scene.textbook, scene.textbook_data
@@ -332,6 +391,16 @@ def sag(scene: Scene, q_eq: np.ndarray, held: dict[str, float]) -> list[Sag]:
 
     The rigid pose has the held coordinates at their values and every other coordinate
     at 0; displacements are in mm, rotations in arc seconds.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q_eq : numpy.ndarray, shape (nv,)
+        The equilibrium under gravity (:func:`equilibrium`), m or rad.
+    held : dict of str to float
+        The held coordinates and their values, m or rad (as given to
+        :func:`equilibrium`).
     """
     model, data = scene.textbook, scene.textbook_data
     q_rigid = np.zeros(model.nv)
@@ -355,6 +424,27 @@ def force_input(
     The generalised force of the wrench (:class:`rt70.physics.loads.Wrench`, applied at ``xyz``
     in the link frame) is ``Q_u = S U`` (4.129)–(4.131),
     :func:`rt70.textbook.points.generalized_force`. Rows follow ``lm.coordinates``.
+
+    Parameters
+    ----------
+    lm : Linearization
+        The linear model (its q0 and coordinates).
+    scene : Scene
+        The scene it was taken of.
+    link : str
+        The URDF link the load acts on.
+    direction : array_like, shape (3,)
+        The load's direction in ground axes (normalised here).
+    torque : bool
+        A unit torque (N·m) instead of a unit force (N).
+    xyz : array_like, shape (3,)
+        The force's point of application in the link frame, m.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        ``Q_u`` of the unit load on each coordinate of ``lm.coordinates`` (N or N·m per
+        N, or per N·m for a torque).
     """
     a = np.asarray(direction, dtype=float)
     unit = a / np.linalg.norm(a)
@@ -370,12 +460,33 @@ def point_output(lm: Linearization, scene: Scene, link: str, xyz) -> np.ndarray:
 
     ``δr = J_p δq`` about q0 — e.g. the foci and vertices of the mirrors (§4.1.8,
     ``<rt70:optical_point>``).
+
+    Parameters
+    ----------
+    lm : Linearization
+        The linear model (its q0 and coordinates: the columns).
+    scene : Scene
+        The scene it was taken of.
+    link : str
+        The URDF link the point is fixed in.
+    xyz : array_like, shape (3,)
+        The point in the link frame, m.
     """
     Jv, _ = points.point_jacobian(scene.textbook, scene.textbook_data, lm.q0, link, xyz)
     return Jv[:, coordinate_indices(scene, lm.coordinates)]
 
 
 def rotation_output(lm: Linearization, scene: Scene, link: str) -> np.ndarray:
-    """Output rows (3 × n) of the small rotation of ``link`` about the ground axes."""
+    """Output rows (3 × n) of the small rotation of ``link`` about the ground axes.
+
+    Parameters
+    ----------
+    lm : Linearization
+        The linear model (its q0 and coordinates: the columns).
+    scene : Scene
+        The scene it was taken of.
+    link : str
+        The URDF link.
+    """
     _, Jw = points.point_jacobian(scene.textbook, scene.textbook_data, lm.q0, link, np.zeros(3))
     return Jw[:, coordinate_indices(scene, lm.coordinates)]

@@ -163,52 +163,19 @@ def modes(
     diagonal to that level. Damping that couples distinct, merely close modes is
     reported as non-proportional, as it physically is.
     """
-    M, _ = _mass(M)
-    n = M.shape[0]
-    K = _symmetric("K", K, n)
-    if D is not None:
-        D = _symmetric("D", D, n)
-    try:
-        omega2, V = scipy.linalg.eigh(K, M)
-    except np.linalg.LinAlgError as exc:  # pragma: no cover - M was checked by Cholesky
-        raise Rt70Error(f"generalised eigenproblem failed: {exc}") from None
+    omega2, V, D = _eigh(M, K, D)
     scale = float(np.max(np.abs(omega2)))
-    if rigid_tol is None:
-        rigid_tol = RIGID_RTOL * scale
-    elif not (np.isfinite(rigid_tol) and rigid_tol >= 0):
-        raise Rt70Error(f"rigid_tol must be a finite non-negative number, got {rigid_tol}")
-    rigid_tol = float(rigid_tol)
-
+    rigid_tol = _rigid_tolerance(rigid_tol, scale)
     rigid = np.abs(omega2) <= rigid_tol
     negative = omega2 < -rigid_tol
     Z = None
     if D is not None:
-        Z = V.T @ D @ V
-        for idx in _clusters(np.where(rigid, 0.0, omega2), CLUSTER_RTOL * scale):
-            _, R = np.linalg.eigh(Z[np.ix_(idx, idx)])
-            V[:, idx] = V[:, idx] @ R
-        Z = V.T @ D @ V
-    # Deterministic sign: largest-magnitude entry of each column positive.
-    big = np.argmax(np.abs(V), axis=0)
-    sign = np.where(V[big, np.arange(n)] < 0, -1.0, 1.0)
-    V = V * sign
-    if Z is not None:
-        Z = sign[:, None] * Z * sign[None, :]
-        Z = 0.5 * (Z + Z.T)
-
-    omega = np.sqrt(np.where(rigid, 0.0, np.abs(omega2)))
-    omega[negative] = np.nan
-    freq_hz = omega / (2.0 * np.pi)
-
+        Z = _diagonalise_clusters(V, D, np.where(rigid, 0.0, omega2), CLUSTER_RTOL * scale)
+    V, Z = _fix_signs(V, Z)
+    omega, freq_hz = _frequencies(omega2, rigid, negative)
     zeta = offdiag = proportional = None
     if Z is not None:
-        zeta = np.full(n, np.nan)
-        el = ~(rigid | negative)
-        zeta[el] = np.diag(Z)[el] / (2.0 * omega[el])
-        zmax = float(np.max(np.abs(Z)))
-        off = Z - np.diag(np.diag(Z))
-        offdiag = float(np.max(np.abs(off)) / zmax) if zmax > 0 else 0.0
-        proportional = offdiag <= PROPORTIONAL_RTOL
+        zeta, offdiag, proportional = _modal_damping(Z, omega, ~(rigid | negative))
     return Modes(
         omega2=omega2,
         omega=omega,
@@ -222,6 +189,82 @@ def modes(
         damping_offdiag=offdiag,
         proportional=proportional,
     )
+
+
+def _eigh(
+    M: np.ndarray, K: np.ndarray, D: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``(ω², V, D)``: M, K (and D) checked, then ``K v = ω² M v`` by eigh."""
+    M, _ = _mass(M)
+    n = M.shape[0]
+    K = _symmetric("K", K, n)
+    if D is not None:
+        D = _symmetric("D", D, n)
+    try:
+        omega2, V = scipy.linalg.eigh(K, M)
+    except np.linalg.LinAlgError as exc:  # pragma: no cover - M was checked by Cholesky
+        raise Rt70Error(f"generalised eigenproblem failed: {exc}") from None
+    return omega2, V, D
+
+
+def _rigid_tolerance(rigid_tol: float | None, scale: float) -> float:
+    """The rigid-mode tolerance: ``RIGID_RTOL · scale`` by default, else checked."""
+    if rigid_tol is None:
+        rigid_tol = RIGID_RTOL * scale
+    elif not (np.isfinite(rigid_tol) and rigid_tol >= 0):
+        raise Rt70Error(f"rigid_tol must be a finite non-negative number, got {rigid_tol}")
+    return float(rigid_tol)
+
+
+def _diagonalise_clusters(
+    V: np.ndarray, D: np.ndarray, omega2: np.ndarray, tol: float
+) -> np.ndarray:
+    """Rotate V (in place) within each eigenvalue cluster to diagonalise ``VᵀDV``; return it.
+
+    ``omega2`` has the rigid modes' eigenvalues set to 0 (they form one cluster); the
+    rotations are orthogonal, so ``VᵀMV = 1`` is kept (:func:`modes`, Notes).
+    """
+    Z = V.T @ D @ V
+    for idx in _clusters(omega2, tol):
+        _, R = np.linalg.eigh(Z[np.ix_(idx, idx)])
+        V[:, idx] = V[:, idx] @ R
+    return V.T @ D @ V
+
+
+def _fix_signs(V: np.ndarray, Z: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Deterministic sign: each column's largest-magnitude entry positive; Z follows."""
+    n = V.shape[1]
+    big = np.argmax(np.abs(V), axis=0)
+    sign = np.where(V[big, np.arange(n)] < 0, -1.0, 1.0)
+    V = V * sign
+    if Z is not None:
+        Z = sign[:, None] * Z * sign[None, :]
+        Z = 0.5 * (Z + Z.T)
+    return V, Z
+
+
+def _frequencies(
+    omega2: np.ndarray, rigid: np.ndarray, negative: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(ω, ω/2π)``: exactly 0 for rigid modes, NaN for unstable ones (:class:`Modes`)."""
+    omega = np.sqrt(np.where(rigid, 0.0, np.abs(omega2)))
+    omega[negative] = np.nan
+    return omega, omega / (2.0 * np.pi)
+
+
+def _modal_damping(
+    Z: np.ndarray, omega: np.ndarray, elastic: np.ndarray
+) -> tuple[np.ndarray, float, bool]:
+    """``(ξ, off-diagonal fraction, proportional)`` of the modal damping ``Z = VᵀDV``.
+
+    ξ_i = Z_ii / (2 ω_i) for the elastic modes, NaN for the others.
+    """
+    zeta = np.full(omega.size, np.nan)
+    zeta[elastic] = np.diag(Z)[elastic] / (2.0 * omega[elastic])
+    zmax = float(np.max(np.abs(Z)))
+    off = Z - np.diag(np.diag(Z))
+    offdiag = float(np.max(np.abs(off)) / zmax) if zmax > 0 else 0.0
+    return zeta, offdiag, offdiag <= PROPORTIONAL_RTOL
 
 
 def residuals(M: np.ndarray, K: np.ndarray, modes: Modes) -> dict[str, float]:

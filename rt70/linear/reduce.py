@@ -89,6 +89,15 @@ def rescaled(
     ``y_new = S_y y`` and ``u = S_u u_new``: e.g. ``output_scale = 206264.8`` turns
     radians into arc seconds, ``input_scale = 1e6`` makes the input MN·m. The
     second-order model is scaled with it, so :func:`modal_truncation` still applies.
+
+    Parameters
+    ----------
+    ss : StateSpace
+        The plant (p outputs, m inputs).
+    output_scale : float or sequence of float
+        ``S_y``: one factor for all outputs or p of them (finite, non-zero).
+    input_scale : float or sequence of float
+        ``S_u``: one factor for all inputs or m of them (finite, non-zero).
     """
     sy = np.broadcast_to(np.asarray(output_scale, dtype=float), (ss.n_outputs,))
     su = np.broadcast_to(np.asarray(input_scale, dtype=float), (ss.n_inputs,))
@@ -307,8 +316,17 @@ def balanced_truncation(ss: StateSpace, order: int, offset: float = 0.0) -> Redu
     ``P = L_p L_pᵀ``, ``Q = L_q L_qᵀ`` and ``L_qᵀ L_p = U Σ Wᵀ``, the projections
     ``T_r = L_p W_k Σ_k^{-1/2}`` and ``T_l = L_q U_k Σ_k^{-1/2}`` give
     ``A_k = T_lᵀ A T_r``, ``B_k = T_lᵀ B``, ``C_k = C T_r`` (Laub et al. 1987;
-    Antoulas 2005 §7.2). The bound ``2 Σ_{i>k} σ_i`` is returned with it. ``offset``
-    moves nearly undamped modes into ``G_u`` (:func:`additive_split`).
+    Antoulas 2005 §7.2). The bound ``2 Σ_{i>k} σ_i`` is returned with it.
+
+    Parameters
+    ----------
+    ss : StateSpace
+        The plant.
+    order : int
+        Number of states kept, ``n_u`` of them those of ``G_u``.
+    offset : float
+        Moves nearly undamped modes into ``G_u`` (ζ below about ``offset``,
+        :func:`additive_split`); 0 keeps only the rigid and unstable ones there.
 
     Raises
     ------
@@ -421,6 +439,17 @@ def hinf_error(
     lightly damped resonances), the reduced by its state space. Rigid or unstable modes
     make ``G`` unbounded at 0, so ``f_min > 0`` is required; their parts cancel in the
     error when both methods keep them whole.
+
+    Parameters
+    ----------
+    full, reduced : StateSpace
+        The plant G and its reduction G_r (the same inputs and outputs).
+    f_min : float
+        The lowest frequency, Hz (positive).
+    f_max : float, optional
+        The highest frequency, Hz (default twice the highest pole frequency of ``full``).
+    n_grid : int
+        Number of log-spaced grid points.
     """
     if not (np.isfinite(f_min) and f_min > 0):
         raise Rt70Error(f"f_min must be a positive frequency, got {f_min!r}")

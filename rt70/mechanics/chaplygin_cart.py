@@ -146,6 +146,19 @@ def servo(
     ``D = [𝔅ᵀ e_φ1, 𝔅ᵀ e_φ2, (A_lat 𝔅)ᵀ]``: the wheel torques act on the wheel
     coordinates, projected by the rolling constraints; the lateral reaction along the
     reduced row of (4.3).
+
+    Parameters
+    ----------
+    scene : Scene
+        The cart (:func:`check_scene`: urdf/two_wheeled_cart.urdf).
+    q : numpy.ndarray, shape (5,)
+        ``(x, y, θ, φ1, φ2)``: position m, heading and wheel angles rad.
+    qd_ind : numpy.ndarray, shape (3,)
+        The independent velocities ``(ẋ, ẏ, θ̇)``, m/s and rad/s.
+    gains : Gains
+        The perturbation gains ω, ζ, κ and the Baumgarte k_b of (4.3).
+    side : {"reference", "textbook"}
+        Whose constraint rows and reduced dynamics.
     """
     q = np.asarray(q, dtype=float)
     qd_ind = np.asarray(qd_ind, dtype=float)
@@ -204,6 +217,26 @@ def simulate(
     The state is ``[q (5), q̇_ind (3)]``; ``q̇ = 𝔅 q̇_ind`` turns the wheels. With
     ``stop_radius`` > 0 the run stops where M comes that close to the target (the
     origin, where the programmed speed vanishes and S becomes singular).
+
+    Parameters
+    ----------
+    scene : Scene
+        The cart (:func:`check_scene`).
+    q0 : numpy.ndarray, shape (5,)
+        Initial ``(x, y, θ, φ1, φ2)``, m and rad (:func:`on_manifold_start`).
+    qd0_ind : numpy.ndarray, shape (3,)
+        Initial ``(ẋ, ẏ, θ̇)``, m/s and rad/s.
+    times : numpy.ndarray
+        Increasing output times from 0, s; the run ends at the last.
+    gains : Gains
+        The perturbation gains (:func:`servo`).
+    side : {"reference", "textbook"}
+        Whose constraint rows and reduced dynamics.
+    rtol, atol : float
+        DOP853's relative and absolute tolerances.
+    stop_radius : float
+        Distance of the cart's point M from the origin at which the run stops, m
+        (0: it does not stop early).
     """
     n = len(q0)
 

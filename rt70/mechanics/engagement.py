@@ -78,6 +78,15 @@ def audit_across(result: SimulationResult, impact: Impact, kinetic_after: float)
     ``kinetic_after`` is T⁺ as the simulation's side computes it (so that T⁻ and T⁺ come
     from one function); the impact's own T⁻ → T⁺ is :attr:`Impact.kinetic_before`,
     :attr:`Impact.kinetic_after`.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The simulation up to the engagement: its last sample is the state at impact.
+    impact : Impact
+        The impact of the locks at that state (its ``energy_lost``, J).
+    kinetic_after : float
+        T⁺, J, from the simulation's side at ``q̇⁺``.
     """
     T0, Ug, Uc = float(result.kinetic[-1]), float(result.gravity[-1]), float(result.elastic[-1])
     E_psi, W_u = float(result.dissipated[-1]), float(result.input_work[-1])

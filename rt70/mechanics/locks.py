@@ -148,7 +148,19 @@ def check_locks(scene: Scene, locks: Sequence[Lock]) -> None:
 
 
 def constraint_rows(scene: Scene, q: np.ndarray, locks: Sequence[Lock], side: str) -> np.ndarray:
-    """The locks' rows ``B_c`` (m, nv) in the book's coordinates, computed by ``side``."""
+    """The locks' rows ``B_c`` (m, nv) in the book's coordinates, computed by ``side``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates in the book's order, m or rad.
+    locks : sequence of Lock
+        The brakes and stow pins, rows in this order (:func:`labels`).
+    side : {"textbook", "reference"}
+        Whose kinematics (and, for :func:`engage`, whose impact solve).
+    """
     brakes, pins = _split(locks)
     if side == "reference":
         from rt70.reference.impact import book_rows
@@ -183,6 +195,30 @@ def engage(
     :func:`rt70.physics.impact.solve_impact`; ``"reference"``: Pinocchio's ``impulseDynamics``
     (:func:`rt70.reference.impact.impulse_dynamics`), its energies from Pinocchio's A.
     Impulses are in the order of :func:`labels`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates in the book's order, m or rad.
+    qd : numpy.ndarray, shape (nv,)
+        ``q̇⁻``, the velocities just before the engagement, m/s or rad/s.
+    locks : sequence of Lock
+        The brakes and stow pins, rows in this order (:func:`labels`).
+    side : {"textbook", "reference"}
+        Whose kinematics (and, for :func:`engage`, whose impact solve).
+    restitution : float
+        e in [0, 1]; 0 (plastic) for brakes and stow pins.
+    gamma : numpy.ndarray, shape (nv,), optional
+        Known impulses Γ of external forces in the coordinates, N·s or N·m·s (sign:
+        :mod:`rt70.physics.impact`); none by default.
+
+    Raises
+    ------
+    Rt70Error
+        On an unknown side, a lock the scene cannot take (:func:`check_locks`) or a
+        restitution outside [0, 1].
     """
     if side not in SIDES:
         raise Rt70Error(f"unknown side '{side}' (choose from {', '.join(SIDES)})")
@@ -239,6 +275,19 @@ def joint_impulses(
     impulses; :mod:`rt70.reference.reactions`: ``rnea(q, 0, Δv, fext)`` with gravity
     off). A brake's impulse is the braked joint's own: its axis component. Per joint
     ``[F; M]`` in N·s and N·m·s, the joint's axes, about its origin (docs/reactions.md).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q : numpy.ndarray, shape (nv,)
+        The configuration of the impact, m or rad.
+    impact : Impact
+        The impact of ``locks`` there (:func:`engage`).
+    locks : sequence of Lock
+        The brakes and stow pins, rows in this order (:func:`labels`).
+    side : {"textbook", "reference"}
+        Whose kinetostatics.
     """
     from rt70.physics.loads import Wrench
 

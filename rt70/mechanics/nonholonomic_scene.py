@@ -64,7 +64,27 @@ def _side(side: str) -> None:
 def constraint_rows(
     scene: Scene, side: str, q: np.ndarray, qd: np.ndarray, names: Sequence[str] | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``A(q)`` and ``Ȧ q̇`` of the constraints on one side."""
+    """``A(q)`` and ``Ȧ q̇`` of the constraints on one side.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:no_slip>`` elements.
+    side : {"textbook", "reference"}
+        Whose kinematics and dynamics: the book's algorithm or Pinocchio's.
+    q : numpy.ndarray, shape (n,)
+        Generalised coordinates in the book's order, m or rad.
+    qd : numpy.ndarray, shape (n,)
+        Generalised velocities, m/s or rad/s.
+    names : sequence of str, optional
+        The ``<rt70:no_slip>`` elements used, rows in this order (default: all, in the
+        file's order).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        A, shape (m, n), and ``Ȧ q̇``, shape (m,) in m/s² (rad/s² for an angular row).
+    """
     _side(side)
     els = elements(scene, names)
     if side == "textbook":
@@ -88,7 +108,19 @@ class SideDynamics:
 
 
 def side_dynamics(scene: Scene, side: str, q: np.ndarray, qd: np.ndarray) -> SideDynamics:
-    """``M(q)``, ``B(q, q̇) q̇`` and ``Q_g(q)`` on one side (gravity on the right-hand side)."""
+    """``M(q)``, ``B(q, q̇) q̇`` and ``Q_g(q)`` on one side (gravity on the right-hand side).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    side : {"textbook", "reference"}
+        Whose kinematics and dynamics: the book's algorithm or Pinocchio's.
+    q : numpy.ndarray, shape (n,)
+        Generalised coordinates in the book's order, m or rad.
+    qd : numpy.ndarray, shape (n,)
+        Generalised velocities, m/s or rad/s.
+    """
     _side(side)
     if side == "textbook":
         from rt70.textbook import dynamics
@@ -118,6 +150,25 @@ def reduced_system(
 
     ``Q`` is the generalised force in full coordinates besides gravity (default zero);
     ``Q*`` includes gravity, ``𝔅ᵀ (Q + Q_g)``.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:no_slip>`` elements.
+    side : {"textbook", "reference"}
+        Whose kinematics and dynamics: the book's algorithm or Pinocchio's.
+    q : numpy.ndarray, shape (n,)
+        Generalised coordinates in the book's order, m or rad.
+    qd_ind : numpy.ndarray, shape (p,)
+        The independent velocities, m/s or rad/s.
+    independent : sequence of int
+        Indices in q of the p independent coordinates (the others are dependent, one
+        per constraint row).
+    Q : numpy.ndarray, shape (n,), optional
+        Generalised force besides gravity, N or N·m per coordinate (default zero).
+    names : sequence of str, optional
+        The ``<rt70:no_slip>`` elements used, rows in this order (default: all, in the
+        file's order).
     """
     _side(side)
     q = np.asarray(q, dtype=float)
@@ -149,7 +200,32 @@ def reduced_forward_dynamics(
     Q: np.ndarray | None = None,
     names: Sequence[str] | None = None,
 ) -> np.ndarray:
-    """``q̈_ind = A*⁻¹ (Q* − a)`` of the reduced system on one side."""
+    """``q̈_ind = A*⁻¹ (Q* − a)`` of the reduced system on one side.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:no_slip>`` elements.
+    side : {"textbook", "reference"}
+        Whose kinematics and dynamics: the book's algorithm or Pinocchio's.
+    q : numpy.ndarray, shape (n,)
+        Generalised coordinates in the book's order, m or rad.
+    qd_ind : numpy.ndarray, shape (p,)
+        The independent velocities, m/s or rad/s.
+    independent : sequence of int
+        Indices in q of the p independent coordinates (the others are dependent, one
+        per constraint row).
+    Q : numpy.ndarray, shape (n,), optional
+        Generalised force besides gravity, N or N·m per coordinate (default zero).
+    names : sequence of str, optional
+        The ``<rt70:no_slip>`` elements used, rows in this order (default: all, in the
+        file's order).
+
+    Returns
+    -------
+    numpy.ndarray, shape (p,)
+        The independent accelerations, m/s² or rad/s².
+    """
     return reduced_system(scene, side, q, qd_ind, independent, Q, names)[1].acceleration()
 
 
@@ -165,6 +241,22 @@ def constrained_forward_dynamics(
 
     ``M q̈ + B q̇ = Q_g + Q + Aᵀ λ``, ``A q̈ + Ȧ q̇ = 0``
     (:func:`rt70.physics.nonholonomic.constrained_dynamics`).
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:no_slip>`` elements.
+    side : {"textbook", "reference"}
+        Whose kinematics and dynamics: the book's algorithm or Pinocchio's.
+    q : numpy.ndarray, shape (n,)
+        Generalised coordinates in the book's order, m or rad.
+    qd : numpy.ndarray, shape (n,)
+        Generalised velocities, m/s or rad/s (admissible: ``A q̇ = 0``).
+    Q : numpy.ndarray, shape (n,), optional
+        Generalised force besides gravity, N or N·m per coordinate (default zero).
+    names : sequence of str, optional
+        The ``<rt70:no_slip>`` elements used, rows in this order (default: all, in the
+        file's order).
     """
     q = np.asarray(q, dtype=float)
     A, A_dot_qd = constraint_rows(scene, side, q, qd, names)
@@ -197,6 +289,15 @@ def validate_pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict:
     ``q̈_ind`` (002-A; the independent coordinates by :func:`choose_independent` of
     Pinocchio's A, the independent velocities those of q̇) and the multipliers λ of the
     full equations at the admissible ``q̇ = 𝔅 q̇_ind``.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:no_slip>`` elements.
+    q : numpy.ndarray, shape (n,)
+        The random state's coordinates, m or rad.
+    qd : numpy.ndarray, shape (n,)
+        Its velocities, m/s or rad/s (need not be admissible).
     """
     from rt70.reference import no_slip as ref_no_slip
 
@@ -234,6 +335,23 @@ def simulate_constrained(
     The acceleration-level constraint is stabilised by a first-order perturbation
     equation (2.2): ``d/dt (A q̇) = −k (A q̇)``, k = ``baumgarte`` (0: none). The state
     is ``[q, q̇]``; returns scipy's solution (DOP853) at ``times``.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``<rt70:no_slip>`` elements.
+    side : {"textbook", "reference"}
+        Whose kinematics and dynamics: the book's algorithm or Pinocchio's.
+    q0 : numpy.ndarray, shape (n,)
+        Initial coordinates, m or rad.
+    qd0 : numpy.ndarray, shape (n,)
+        Initial velocities, m/s or rad/s (admissible: ``A q̇ = 0``).
+    times : numpy.ndarray
+        Increasing output times from 0, s; the run ends at the last.
+    baumgarte : float
+        k, 1/s: the decay rate of the constraints' velocity error (0: none).
+    rtol, atol : float
+        DOP853's relative and absolute tolerances.
     """
     from scipy.integrate import solve_ivp
 

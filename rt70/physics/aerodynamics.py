@@ -399,9 +399,27 @@ def body_load(
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(F, M)`` of the axisymmetric model, in the axes ``axis`` and ``flow`` are given in.
 
-    ``axis`` is the unit body axis a, ``flow`` the unit flow vector u, ``force_scale``
-    is ``q S`` (N) and ``length`` l (m): ``F = qS[−C_A a + (C_N/sinθ)(u − (u·a)a)]``,
-    ``M = qSl (C_M/sinθ) (u × a)`` with ``cos θ = −u·a``, ``sin θ = |u × a|``.
+    ``F = qS[−C_A a + (C_N/sinθ)(u − (u·a)a)]``, ``M = qSl (C_M/sinθ) (u × a)`` with
+    ``cos θ = −u·a``, ``sin θ = |u × a|`` (θ the angle of attack, 0 when the flow
+    meets the body head on).
+
+    Parameters
+    ----------
+    table : CoefficientTable
+        ``C_A(θ)``, ``C_N(θ)``, ``C_M(θ)`` of the body's shape.
+    axis : ndarray, shape (3,)
+        The unit body (symmetry) axis a.
+    flow : ndarray, shape (3,)
+        The unit flow direction u, in the same axes as ``axis``.
+    force_scale : float
+        ``q S``, N: the dynamic pressure ``½ ρ |v|²`` (Pa) times the reference area (m²).
+    length : float
+        The reference length l of the moment, m.
+
+    Returns
+    -------
+    tuple of ndarray, shape (3,)
+        The force F (N) and the free moment M (N·m), in those axes.
     """
     a, u = axis, flow
     cross = np.cross(u, a)
@@ -422,6 +440,25 @@ def wind_wrench(
     (ρ the condition's, else ``density``); :func:`body_load` gives F and M in body axes,
     turned back to ground axes by R. F acts at ``surface.xyz``; M is a free moment. A
     uniform flow does not depend on the origin p (kept for a sheared profile).
+
+    Parameters
+    ----------
+    surface : WindSurface
+        The exposed body (a ``<rt70:wind>``): its link, reference point ``xyz`` (link
+        frame, m), unit axis, area (m²), length (m) and coefficient table.
+    pose : Pose
+        The link's pose in ground axes: rotation R, shape (3, 3), and origin p,
+        shape (3,), m.
+    condition : WindCondition
+        The steady wind: speed (m/s), direction and, optionally, the air density.
+    density : float
+        The scene's air density ρ, kg/m³, used when ``condition`` gives none.
+
+    Returns
+    -------
+    Wrench
+        On ``surface.link`` at ``surface.xyz``: force (N) and moment (N·m) in ground
+        axes (zero in still air).
     """
     R = np.asarray(pose[0], dtype=float)
     v = R.T @ condition.velocity()

@@ -67,7 +67,18 @@ class Baumgarte:
         return self.omega**2, 2.0 * self.zeta * self.omega
 
     def rhs(self, C: np.ndarray, rate: np.ndarray, residual: np.ndarray) -> np.ndarray:
-        """``g = −C − Kd Φ̇ − Kp Φ`` of ``B_c q̈ = g`` (``rate = Φ̇ = B_c q̇``)."""
+        """``g = −C − Kd Φ̇ − Kp Φ`` of ``B_c q̈ = g`` (``rate = Φ̇ = B_c q̇``).
+
+        Parameters
+        ----------
+        C : ndarray, shape (m,)
+            ``Ḃ_c q̇`` of ``B_c q̈ + C = 0``: the constraints' acceleration at q̈ = 0,
+            m/s² or rad/s² per row.
+        rate : ndarray, shape (m,)
+            ``Φ̇ = B_c q̇``, m/s or rad/s per row.
+        residual : ndarray, shape (m,)
+            ``Φ(q)``, m or rad per row.
+        """
         kp, kd = self.gains()
         return -C - kd * rate - kp * residual
 
@@ -75,7 +86,19 @@ class Baumgarte:
 def constraint_rhs(
     C: np.ndarray, rate: np.ndarray, residual: np.ndarray, stabilization: Baumgarte | None
 ) -> np.ndarray:
-    """``g`` of ``B_c q̈ = g``: ``−C`` without stabilisation, (2.2) with it."""
+    """``g`` of ``B_c q̈ = g``: ``−C`` without stabilisation, (2.2) with it.
+
+    Parameters
+    ----------
+    C : ndarray, shape (m,)
+        ``Ḃ_c q̇`` of ``B_c q̈ + C = 0``, m/s² or rad/s² per row.
+    rate : ndarray, shape (m,)
+        ``Φ̇ = B_c q̇``, m/s or rad/s per row (unused without stabilisation).
+    residual : ndarray, shape (m,)
+        ``Φ(q)``, m or rad per row (unused without stabilisation).
+    stabilization : Baumgarte or None
+        The gains of (2.2); None: the bare ``Φ̈ = 0``.
+    """
     if stabilization is None:
         return -np.asarray(C, dtype=float)
     return stabilization.rhs(C, rate, residual)
@@ -88,6 +111,17 @@ def consistent_rhs(B_c: np.ndarray, g: np.ndarray, rtol: float = 1e-10) -> np.nd
     that depend on each other on the manifold need not do so off it, and (2.2) would
     demand contradicting accelerations; the stabilisation then acts in the least-squares
     sense: ``B_c q̈ = B_c B_c⁺ g``. Exact at Φ = 0 and for independent rows.
+
+    Parameters
+    ----------
+    B_c : ndarray, shape (m, n)
+        The constraint Jacobian ``∂Φ/∂q`` (m rows, n velocity coordinates).
+    g : ndarray, shape (m,)
+        The right-hand side of ``B_c q̈ = g`` (:func:`constraint_rhs`), m/s² or rad/s²
+        per row.
+    rtol : float
+        Singular values of B_c below ``rtol`` times the largest count as zero
+        (``rcond`` of :func:`numpy.linalg.lstsq`).
     """
     if B_c.size == 0:
         return g

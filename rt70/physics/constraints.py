@@ -128,5 +128,16 @@ def locking(names: Sequence[str], locked: Mapping[str, float] | Sequence[str]) -
 def rigid_link_map(
     S_star: np.ndarray, full_names: Sequence[str], names: Sequence[str]
 ) -> HolonomicMap:
-    """Rigid links of a linear graph model: ``α = S*ᵀ α**`` (3.17), no offset."""
+    """Rigid links of a linear graph model: ``α = S*ᵀ α**`` (3.17), no offset.
+
+    Parameters
+    ----------
+    S_star : numpy.ndarray, shape (k, n)
+        ``S* = f*ᵀ L`` (3.17): the non-zero rows of the structure matrix, k reduced
+        coordinates α** by n body coordinates α.
+    full_names : sequence of str
+        The n body coordinates' names (the graph model's).
+    names : sequence of str
+        The k reduced coordinates' names (relative motions the rigid links allow).
+    """
     return HolonomicMap(S_star.T, np.zeros(S_star.shape[1]), tuple(full_names), tuple(names))

@@ -158,6 +158,24 @@ def impact_energies(
 
     For an impact solved elsewhere (the reference side's ``impulseDynamics``) as for
     :func:`solve_impact`'s own.
+
+    Parameters
+    ----------
+    A : numpy.ndarray
+        Mass matrix at the impact's configuration, (n, n).
+    B_c : numpy.ndarray
+        Rows of the engaged constraints, (m, n).
+    qd_before, qd_after : numpy.ndarray
+        ``q̇⁻`` and ``q̇⁺``, (n,): m/s or rad/s per coordinate.
+    impulses : numpy.ndarray
+        ``Λ``, the reactions' impulses, (m,): N·s or N·m·s per row.
+    rank : int
+        Number of independent constraint rows.
+    restitution : float
+        ``e`` in [0, 1].
+    gamma : numpy.ndarray, optional
+        Known impulses Γ of external forces in the coordinates, (n,) (sign: module
+        docstring); none by default.
     """
     qd0, qd1 = np.asarray(qd_before, dtype=float), np.asarray(qd_after, dtype=float)
     gam = np.zeros(qd0.size) if gamma is None else np.asarray(gamma, dtype=float)

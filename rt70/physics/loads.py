@@ -107,6 +107,22 @@ class SectorMesh:
         The centre lies at ``xyz + radius (axis × direction)`` in the link: the tangent
         ``direction`` turns positively about ``axis``.
 
+        Parameters
+        ----------
+        xyz : array_like, shape (3,)
+            The mesh point on the sector, in the sector link's frame, m.
+        direction : array_like, shape (3,)
+            The unit tangent of the pitch circle at the mesh point, link axes.
+        axis : array_like, shape (3,)
+            The unit axis the sector turns about, link axes (normal to ``direction``).
+        radius : float
+            The pitch radius r, m (positive).
+        link, stator : Pose
+            The poses ``(R, p)`` of the sector's link and of the stator (the link that
+            carries the pinion) in ground axes at q = 0: R (3, 3), p (3,) in m.
+        where : str
+            The sector as messages name it.
+
         Raises
         ------
         Rt70Error
@@ -138,6 +154,20 @@ class SectorMesh:
         ``P`` is the mesh point ``xyz`` of the link in stator axes (where the pinion
         touches it); ``∂θ_d/∂P = (x v − y u)/(x² + y²)`` with ``x = u·d``, ``y = v·d``,
         turned to ground axes.
+
+        Parameters
+        ----------
+        xyz : array_like, shape (3,)
+            The mesh point on the sector, in the sector link's frame, m.
+        link, stator : Pose
+            The poses ``(R, p)`` of the sector's link and of the stator in ground axes at
+            the state: R (3, 3), p (3,) in m.
+
+        Returns
+        -------
+        tuple
+            θ_d (rad), ∂θ_d/∂P (rad/m, shape (3,), ground axes) and P (m, shape (3,),
+            stator axes).
         """
         (R_l, p_l), (R_s, p_s) = link, stator
         P = R_s.T @ (p_l + R_l @ np.asarray(xyz, dtype=float) - p_s)
@@ -154,6 +184,22 @@ class SectorMesh:
         ``F = K ∂θ_d/∂P`` (magnitude K/ρ, ρ the mesh point's distance from the axis,
         ``r`` when undeformed) on the link at ``xyz``, ``−F`` on the stator at the same
         point ``P``: their generalised force is ``K ∂θ_d/∂q`` on either side.
+
+        Parameters
+        ----------
+        link_name, stator_name : str
+            The URDF links of the sector and of the stator (the wrenches' links).
+        xyz : array_like, shape (3,)
+            The mesh point on the sector, in the sector link's frame, m.
+        torque : float
+            The reducer torque K, N·m.
+        link, stator : Pose
+            The poses ``(R, p)`` of the two links in ground axes at the state.
+
+        Returns
+        -------
+        list of Wrench
+            ``F`` on the link at ``xyz`` and ``−F`` on the stator at ``P``, N.
         """
         _, grad, P = self.angle(xyz, link, stator)
         force = torque * grad

@@ -124,6 +124,19 @@ def reduce(
 
     ``A* = 𝔅ᵀ M 𝔅``, ``a = 𝔅ᵀ (M 𝔅̇ q̇_ind + h)``, ``Q* = 𝔅ᵀ Q``, with ``h`` the
     velocity-product force at ``q̇ = 𝔅 q̇_ind`` (gravity belongs to Q).
+
+    Parameters
+    ----------
+    M : numpy.ndarray, shape (n, n)
+        The mass matrix at q, full coordinates.
+    h : numpy.ndarray, shape (n,)
+        The velocity-product force ``h(q, 𝔅 q̇_ind)``, N or N·m per coordinate.
+    Q : numpy.ndarray, shape (n,)
+        The generalised force (gravity, springs, inputs), N or N·m per coordinate.
+    basis : numpy.ndarray, shape (n, p)
+        ``𝔅`` of the partition (:attr:`Projection.basis`).
+    basis_rate_qd : numpy.ndarray, shape (n,)
+        ``𝔅̇ q̇_ind`` (:meth:`Projection.rate`), m/s² or rad/s² per coordinate.
     """
     return ReducedSystem(
         basis.T @ M @ basis, basis.T @ (M @ basis_rate_qd + h), basis.T @ np.asarray(Q)
@@ -139,6 +152,19 @@ def constrained_dynamics(
     range-space KKT solve of :func:`rt70.physics.kkt.solve_kkt`; ``Aᵀ λ`` are the generalised
     reactions (for a ``<rt70:no_slip>`` row, λ is the contact force along its unit
     direction, in N).
+
+    Parameters
+    ----------
+    M : numpy.ndarray, shape (n, n)
+        The mass matrix at q.
+    h : numpy.ndarray, shape (n,)
+        The velocity-product force ``h(q, q̇)``, N or N·m per coordinate.
+    Q : numpy.ndarray, shape (n,)
+        The generalised force, N or N·m per coordinate.
+    A : numpy.ndarray, shape (m, n)
+        The constraint rows of ``A(q) q̇ = 0`` (1.1).
+    A_dot_qd : numpy.ndarray, shape (m,)
+        ``Ȧ q̇``, m/s² per row (rad/s² for an angular row).
     """
     return solve_kkt(M, np.atleast_2d(A), np.asarray(Q) - h, -np.asarray(A_dot_qd))
 
@@ -157,6 +183,21 @@ def chaplygin_property(
     by each of ``shifts``; the system is a Chaplygin system at q if they all agree to
     ``rtol`` relative to their max-norm. (A sampled check: it proves dependence, and
     is evidence of independence.)
+
+    Parameters
+    ----------
+    constraint_matrix : callable
+        ``q ↦ A(q)``, shape (m, n), the rows of ``A(q) q̇ = 0``.
+    mass_matrix : callable
+        ``q ↦ M(q)``, shape (n, n).
+    q : numpy.ndarray, shape (n,)
+        The configuration checked, m or rad per coordinate.
+    independent : sequence of int
+        Indices of the independent coordinates (:func:`partition`).
+    shifts : sequence of float
+        The shifts given to every dependent coordinate in turn, m or rad.
+    rtol : float
+        Relative tolerance of the agreement.
     """
     q = np.asarray(q, dtype=float)
     base = partition(constraint_matrix(q), independent)
@@ -181,6 +222,19 @@ def perturbation_matrix(
     ``m`` holonomic constraints follow ``α̈ = −2ζω α̇ − ω² α`` (poles
     ``ω(−ζ ± √(ζ²−1))``), ``k`` first-order ones ``α̇'_i = −κ_i α'_i`` (one κ for all,
     or one per constraint). P is ``(m + k) × (2m + k)``.
+
+    Parameters
+    ----------
+    m : int
+        Number of holonomic (second-order) program constraints α.
+    k : int
+        Number of first-order program constraints α'.
+    omega : float
+        Natural frequency ω of the holonomic ones, rad/s.
+    zeta : float
+        Their damping ratio ζ.
+    kappa : float or sequence of float
+        Decay rates κ of the first-order ones, 1/s: one for all or ``k`` of them.
 
     Raises
     ------
@@ -213,6 +267,30 @@ def program_multipliers(
     ``S = V A*⁻¹ D``. ``D = Fᵀ`` (F = V) for ideal program constraints (2.4), the
     actuators' force directions for servo constraints.
 
+    Parameters
+    ----------
+    A_star : numpy.ndarray, shape (p, p)
+        The mass matrix of the coordinates the program acts on (positive definite): the
+        reduced ``A*`` of Algorithm 002-A, or a full M.
+    h : numpy.ndarray, shape (p,)
+        The velocity-product force on them (the reduced ``a``), N or N·m.
+    Q : numpy.ndarray, shape (p,)
+        The generalised force on them (the reduced ``Q*``), N or N·m.
+    V : numpy.ndarray, shape (r, p)
+        The program constraints' rows at the acceleration level, ``V q̈ + w = β``.
+    w : numpy.ndarray, shape (r,)
+        Their velocity-product terms.
+    beta : numpy.ndarray, shape (r,)
+        The perturbation equations' right-hand sides (``P (α, α̇, α')``,
+        :func:`perturbation_matrix`).
+    D : numpy.ndarray, shape (p, r)
+        The force directions of the multipliers, one column each.
+
+    Returns
+    -------
+    numpy.ndarray, shape (r,)
+        λ, in the units of each column of D (N·m for a torque, N for a force).
+
     Raises
     ------
     ConstraintSingularityError
@@ -234,6 +312,20 @@ def program_multipliers(
 def program_acceleration(
     A_star: np.ndarray, h: np.ndarray, Q: np.ndarray, D: np.ndarray, lam: np.ndarray
 ) -> np.ndarray:
-    """``q̈ = A*⁻¹ (Q − h + D λ)`` (2.5)."""
+    """``q̈ = A*⁻¹ (Q − h + D λ)`` (2.5).
+
+    Parameters
+    ----------
+    A_star : numpy.ndarray, shape (p, p)
+        The mass matrix of the coordinates (positive definite).
+    h : numpy.ndarray, shape (p,)
+        The velocity-product force, N or N·m per coordinate.
+    Q : numpy.ndarray, shape (p,)
+        The generalised force, N or N·m per coordinate.
+    D : numpy.ndarray, shape (p, r)
+        The force directions of the multipliers.
+    lam : numpy.ndarray, shape (r,)
+        The multipliers (:func:`program_multipliers`).
+    """
     rhs = np.asarray(Q) - h + np.atleast_2d(D) @ lam
     return scipy.linalg.cho_solve(scipy.linalg.cho_factor(A_star), rhs)

@@ -27,7 +27,21 @@ def bearing_loads_figure(
 ) -> Figure:
     """The four loads against elevation (degrees), one line per case of ``rows``.
 
-    ``rows[label]`` holds one :meth:`rt70.telescope.bearing_loads.BearingLoads.row` per elevation.
+    Parameters
+    ----------
+    elevations : sequence of float
+        The elevations of the rows, degrees (0 horizon to 90 zenith).
+    rows : mapping of str to sequence of mapping
+        Per case label (a wind case), one
+        :meth:`rt70.telescope.bearing_loads.BearingLoads.row` per elevation: the loads
+        in kN and kN·m, plotted in MN and MN·m.
+    title : str, optional
+        The figure's title (default: "bearing and reducer loads against elevation").
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Four panels (:data:`PANELS`), not shown.
     """
     e = np.asarray(elevations, dtype=float)
     fig = Figure(figsize=(10, 7), constrained_layout=True)

@@ -1,8 +1,8 @@
 """Figures of the servo loops: open-loop Bode with margins, closed-loop Bode compared.
 
 Each helper returns a new :class:`matplotlib.figure.Figure` (no pyplot state; saving is
-left to the caller). The data come from :mod:`rt70.control.loops` (frequency responses,
-:class:`rt70.control.loops.Margins`) and :mod:`rt70.control.lqg`.
+left to the caller). The data come from :mod:`rt70.control.loop_measures` (frequency
+responses, :class:`rt70.control.loop_measures.Margins`) and :mod:`rt70.control.lqg`.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from collections.abc import Mapping
 import numpy as np
 from matplotlib.figure import Figure
 
-from rt70.control.loops import Margins
+from rt70.control.loop_measures import Margins
 
 
 def _bode_axes(title: str) -> tuple[Figure, object, object]:

@@ -25,8 +25,22 @@ def error_vs_speed_figure(
 ) -> Figure:
     """Steady and gust pointing error (″) against wind speed (m/s), one line per elevation.
 
-    ``steady[E]``, ``gust[E]``: values at ``speeds`` for elevation E (degrees).
-    ``target``: a horizontal line (e.g. a tenth of the beam width).
+    Parameters
+    ----------
+    speeds : sequence of float
+        Mean wind speeds, m/s, ascending (the x ticks).
+    steady, gust : mapping of float to sequence of float
+        Per elevation E (degrees), the steady error and the gust rms error at
+        ``speeds``, arcseconds (″).
+    target : float, optional
+        A horizontal line at this error, ″ (e.g. a tenth of the beam width).
+    title : str, optional
+        The axes' title (default: "wind pointing error against wind speed").
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Log–log axes with the v² law drawn for reference, not shown.
     """
     from matplotlib.ticker import FixedLocator, NullFormatter, ScalarFormatter
 
@@ -69,8 +83,27 @@ def maps_figure(
 ) -> Figure:
     """Maps over elevation × wind direction (relative to the dish's azimuth).
 
-    ``frequency[i, j]`` (Hz) and ``pointing[i, j]`` (″, total: steady + gust rms in
-    quadrature or as the caller says) at ``elevations[i]``, ``directions[j]``.
+    Parameters
+    ----------
+    elevations : sequence of float
+        The rows' elevations, degrees.
+    directions : sequence of float
+        The columns' wind directions relative to the dish's azimuth, degrees (0: wind
+        from the front).
+    frequency : ndarray, shape (len(elevations), len(directions))
+        The first locked-rotor frequency at each point, Hz.
+    pointing : ndarray, shape (len(elevations), len(directions))
+        The pointing error at each point, ″ (total: steady and gust rms in quadrature,
+        or as the caller says).
+    speed : float
+        The mean wind speed of ``pointing``, m/s (in its panel's label).
+    title : str, optional
+        The figure's title (default: "RT-70 over elevation × wind direction").
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two panels side by side, not shown.
     """
     e = np.asarray(elevations, dtype=float)
     d = np.asarray(directions, dtype=float)

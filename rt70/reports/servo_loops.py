@@ -1,9 +1,9 @@
 """The RT-70's servo loops in frequency analysis: its axis plants, PI cascade against LQG.
 
-One job: put the RT-70 into the generic servo analyses (:mod:`rt70.control.loops`,
-:mod:`rt70.control.lqg`, :mod:`rt70.control.servo_compare`): its axis plants at a
-pointing on the ``rt70_servo`` scene, its drives (docs/drives.md), its wind torque, and
-the designs compared (:func:`compare`, used by validation/servo_loops.py).
+One job: put the RT-70 into the generic servo analyses (:mod:`rt70.control.axis_plant`,
+:mod:`rt70.control.loops`, :mod:`rt70.control.lqg`, :mod:`rt70.control.servo_compare`):
+its axis plants at a pointing on the ``rt70_servo`` scene, its drives (docs/drives.md),
+its wind torque, and the designs compared (:func:`compare`, used by validation/servo_loops.py).
 
 - :func:`axis_plant`: the structure linearised at :func:`rt70.linear.linearize.equilibrium`
   of :func:`rt70.scenes.rt70_state.rt70_pointing`, the driven axis free and the other
@@ -23,7 +23,8 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
-from rt70.control import loops, lqg
+from rt70.control import loop_measures, loops, lqg
+from rt70.control.axis_plant import AxisPlant, connect_drive, structure_plant
 from rt70.control.geartrains import parallel_drive
 from rt70.control.servo_compare import performance
 from rt70.errors import Rt70Error
@@ -79,7 +80,7 @@ def wind_wrench(axis: str, azimuth_deg: float) -> Wrench:
 
 def axis_plant(
     scene: Scene, axis: str, elevation_deg: float, azimuth_deg: float = 0.0
-) -> loops.AxisPlant:
+) -> AxisPlant:
     """The linear plant of one RT-70 axis (drive + structure) at a pointing.
 
     Parameters
@@ -98,12 +99,12 @@ def axis_plant(
     q0 = lin.equilibrium(scene, rt70_pointing(elevation_deg, azimuth_deg))
     optics = {o.name: o for o in rt70_mirror_outputs(scene, elevation_deg, azimuth_deg)}
     pointing = replace(optics["pointing_correction"], name="pointing")
-    structure, load_inertia = loops.structure_plant(
+    structure, load_inertia = structure_plant(
         scene, q0, coordinate, wind_wrench(axis, azimuth_deg), pointing, locked=other
     )
     p = drive_parameters(DRIVES[axis], load_inertia)
-    system = loops.connect_drive(structure, p)
-    return loops.AxisPlant(system, structure, p, axis, elevation_deg, azimuth_deg, q0)
+    system = connect_drive(structure, p)
+    return AxisPlant(system, structure, p, axis, elevation_deg, azimuth_deg, q0)
 
 
 def compare(
@@ -134,7 +135,7 @@ def compare(
             **asdict(performance(closed_cascade, WIND_TORQUE)),
         },
         "lqg": {
-            "input_margins": asdict(loops.margins(lqg.input_loop(ap, ctrl))),
+            "input_margins": asdict(loop_measures.margins(lqg.input_loop(ap, ctrl))),
             **asdict(performance(lqg.lqg_system(ap, ctrl), WIND_TORQUE)),
         },
     }

@@ -3,7 +3,7 @@
 :func:`azimuth_model` (§2.3, 7 masses) and :func:`elevation_model` (§2.4, 6 masses)
 build :class:`rt70.linear.topology.LinearModel` objects from the tables in
 :mod:`rt70.scenes.rt70_data` (technical units: inertia kgf·s²·m, stiffness kgf·m/rad;
-the frequencies do not depend on the unit). :func:`rt70.linear.topology.from_scene`
+the frequencies do not depend on the unit). :func:`rt70.linear.torsion_scene.from_scene`
 reads the same models back from their URDF scenes (SI), so that the tables and the
 files can be compared.
 """

@@ -22,7 +22,8 @@ from rt70.urdf.description import (
     RobotDescription,
     Wind,
 )
-from rt70.urdf.reader import RT70_NS, read_urdf, read_urdf_string
+from rt70.urdf.reader import read_urdf, read_urdf_string
+from rt70.urdf.text import RT70_NS
 
 __all__ = [
     "RT70_NS",

@@ -3,7 +3,7 @@
 One job: turn the XML of a drive — a DC motor with a compliant reducer on one axis
 (formalism §4.5, (4.137)–(4.150)) — into a :class:`~rt70.urdf.description.Drive`, or
 refuse it with an :class:`~rt70.errors.ExtensionError` naming the file and the element.
-Called by :mod:`rt70.urdf.reader` once the joints and links are known.
+Called by :mod:`rt70.urdf.extensions` once the joints and links are known.
 """
 
 from __future__ import annotations
@@ -28,6 +28,18 @@ def read_drive(
     reader: ElementReader, elem: ET.Element, desc: RobotDescription, joints: dict[str, Joint]
 ) -> Drive:
     """The :class:`Drive` of one ``<rt70:drive>`` element.
+
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages, the attribute readers).
+    elem : xml.etree.ElementTree.Element
+        The ``<rt70:drive>`` element.
+    desc : RobotDescription
+        The description read so far: its links, and the drives already read (a name
+        may not repeat).
+    joints : dict of str to Joint
+        The file's joints by name.
 
     Raises
     ------

@@ -1,9 +1,9 @@
 """What every element reader of a URDF file needs: numbers, names, links, joints, errors.
 
 :class:`ElementReader` is the part of the reader (:mod:`rt70.urdf.reader`) that the readers
-of single extension elements (:mod:`rt70.urdf.drives`, :mod:`rt70.urdf.no_slip`,
-:mod:`rt70.urdf.wind`) use: each error it raises names the file, the element and the
-attribute (docs/urdf-reader.md).
+of the extension elements (:mod:`rt70.urdf.extensions`, :mod:`rt70.urdf.drives`,
+:mod:`rt70.urdf.no_slip`, :mod:`rt70.urdf.wind`) use: each error it raises names the
+file, the element and the attribute (docs/urdf-reader.md).
 """
 
 from __future__ import annotations
@@ -97,7 +97,19 @@ class ElementReader:
     def number(
         self, elem: ET.Element, attr: str, default: float | None = None, owner: str = ""
     ) -> float:
-        """The one number of attribute ``attr`` (:meth:`numbers` with ``count`` = 1)."""
+        """The one number of attribute ``attr`` (:meth:`numbers` with ``count`` = 1).
+
+        Parameters
+        ----------
+        elem : xml.etree.ElementTree.Element
+            The element that carries the attribute.
+        attr : str
+            The attribute's name.
+        default : float, optional
+            The value of an absent attribute; None: the attribute is required.
+        owner : str, optional
+            The element that holds ``elem``, for messages.
+        """
         value = self.numbers(elem, attr, 1, None if default is None else [default], owner)
         return float(value[0])
 
@@ -117,7 +129,19 @@ class ElementReader:
         return self.numbers(o, "xyz", 3, ZERO3, owner), self.numbers(o, "rpy", 3, ZERO3, owner)
 
     def link_ref(self, elem: ET.Element, attr: str, desc: RobotDescription, where: str) -> str:
-        """The link that attribute ``attr`` names; a missing or unknown link is an error."""
+        """The link that attribute ``attr`` names; a missing or unknown link is an error.
+
+        Parameters
+        ----------
+        elem : xml.etree.ElementTree.Element
+            The element that names the link.
+        attr : str
+            The attribute that holds the link's name (``link``, ``parent``, ``stator``).
+        desc : RobotDescription
+            The description whose links the name must be one of.
+        where : str
+            The element as messages name it (``<rt70:bushing name='b'>``).
+        """
         link = elem.get(attr)
         if not link:
             raise self.fail(ExtensionError, f"{where} lacks attribute '{attr}'")
@@ -126,7 +150,17 @@ class ElementReader:
         return link
 
     def gains(self, elem: ET.Element, count: int, where: str) -> tuple[np.ndarray, np.ndarray]:
-        """``(stiffness, damping)``, ``count`` numbers each (zero when absent, never negative)."""
+        """``(stiffness, damping)``, ``count`` numbers each (zero when absent, never negative).
+
+        Parameters
+        ----------
+        elem : xml.etree.ElementTree.Element
+            The element with the ``stiffness`` and ``damping`` attributes.
+        count : int
+            How many numbers each holds (1 for a joint spring, 6 for a bushing).
+        where : str
+            The element as messages name it.
+        """
         out = []
         for attr in ("stiffness", "damping"):
             values = self.numbers(elem, attr, count, np.zeros(count))
@@ -137,6 +171,15 @@ class ElementReader:
 
     def one_dof_joint(self, elem: ET.Element, joints: dict[str, Joint], where: str) -> Joint:
         """The 1-DOF joint an extension element names in its ``joint`` attribute.
+
+        Parameters
+        ----------
+        elem : xml.etree.ElementTree.Element
+            The extension element.
+        joints : dict of str to Joint
+            The file's joints by name.
+        where : str
+            The element as messages name it.
 
         Raises
         ------

@@ -61,7 +61,22 @@ def inertia_scale(tensor: np.ndarray, mass: float = 0.0, com=(0.0, 0.0, 0.0)) ->
 
 
 def zero_moment_tolerance(tensor: np.ndarray, mass: float = 0.0, com=(0.0, 0.0, 0.0)) -> float:
-    """Principal moments within ± this of zero are zero to rounding: ``ZERO_ULPS · ε · scale``."""
+    """Principal moments within ± this of zero are zero to rounding: ``ZERO_ULPS · ε · scale``.
+
+    Parameters
+    ----------
+    tensor : numpy.ndarray
+        Rotational inertia about the centre of mass, (3, 3), kg·m².
+    mass : float
+        The link's mass, kg (0 for a tensor judged on its own).
+    com : array_like
+        The centre of mass in the link frame, (3,), m.
+
+    Returns
+    -------
+    float
+        The tolerance, kg·m² (the scale is :func:`inertia_scale`'s).
+    """
     return ZERO_ULPS * float(np.finfo(float).eps) * inertia_scale(tensor, mass, com)
 
 
@@ -73,6 +88,15 @@ def is_point_mass(tensor: np.ndarray, mass: float, com=(0.0, 0.0, 0.0)) -> bool:
     2.4e-35`` on 1.34 kg at 0.11 m, moments ±2.4e-35 against a scale of 0.017 kg·m²).
     A noise tensor at ``c = 0`` has only its own moments as a scale, so it is no point
     mass.
+
+    Parameters
+    ----------
+    tensor : numpy.ndarray
+        Rotational inertia about the centre of mass, (3, 3), kg·m².
+    mass : float
+        The link's mass, kg.
+    com : array_like
+        The centre of mass in the link frame, (3,), m.
     """
     if not np.any(tensor):
         return True

@@ -6,7 +6,7 @@ point of a wheel of given radius) has no velocity along a direction fixed in a l
 or refuse it with an :class:`~rt70.errors.ExtensionError` naming the file and the
 element. Each side builds the constraint row ``A(q)`` from its own kinematics
 (:mod:`rt70.textbook.no_slip`, :mod:`rt70.reference.no_slip`). Called by
-:mod:`rt70.urdf.reader`.
+:mod:`rt70.urdf.extensions`.
 """
 
 from __future__ import annotations
@@ -33,6 +33,17 @@ def read_no_slip(
     link, default ``link``), ``radius`` (≥ 0, default 0: a wheel's contact point lies
     ``radius`` below ``xyz`` along ``−normal``), ``normal`` (ground axes, default
     ``0 0 1``, normalised).
+
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages, the attribute readers).
+    elem : xml.etree.ElementTree.Element
+        The ``<rt70:no_slip>`` element.
+    desc : RobotDescription
+        The description read so far (its links).
+    seen : list of NoSlip
+        The no-slip constraints already read from the file (a name may not repeat).
 
     Raises
     ------

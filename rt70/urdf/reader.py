@@ -6,41 +6,32 @@ starts with the source file, so the command line can print it as one readable li
 
 from __future__ import annotations
 
-import dataclasses
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
 from rt70.errors import (
-    ExtensionError,
     InertiaError,
     JointTypeError,
     TopologyError,
     UrdfError,
 )
-from rt70.physics.rotations import rpy_matrix, rpy_of_matrix
+from rt70.physics.rotations import rpy_matrix
 from rt70.urdf.description import (
     URDF_JOINT_TYPES,
-    Bushing,
-    FrameRef,
     Inertial,
     InertiaRepair,
     Joint,
-    JointSpring,
     Link,
-    Loop,
     Mimic,
-    OpticalPoint,
     RobotDescription,
 )
-from rt70.urdf.drives import read_drive
-from rt70.urdf.elements import ONE_DOF_JOINT_TYPES, ZERO3, ElementReader
+from rt70.urdf.elements import ONE_DOF_JOINT_TYPES, ElementReader
+from rt70.urdf.extensions import read_extensions
 from rt70.urdf.inertia import balanced_moments, inertia_defect, principal_moments
-from rt70.urdf.no_slip import read_no_slip
 from rt70.urdf.schema import check_scene
 from rt70.urdf.text import (
-    RT70_NS,
     parse,
     prepare_text,
     read_source,
@@ -48,13 +39,9 @@ from rt70.urdf.text import (
     refuse_xacro,
     warn,
 )
-from rt70.urdf.wind import read_air, read_wind
 
 #: Joint types rt70 models on both sides (the others are rejected with a clear error).
 SUPPORTED_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-
-#: Kinds of ``<rt70:loop>`` and their number of constraint rows.
-LOOP_TYPES = {"point": 3, "frame": 6}
 
 
 def read_urdf(path: str | Path, balance_inertia: bool = False) -> RobotDescription:
@@ -91,6 +78,22 @@ def read_urdf_string(
     :func:`rt70.urdf.schema.check_scene` refuses (an unknown or missing attribute of an
     rt70 element, a namespace that looks like rt70's but is not it); unknown attributes
     of standard elements are warned about.
+
+    Parameters
+    ----------
+    text : str
+        The URDF document.
+    source : str
+        The name every message gives the text (a file's path, or ``<string>``); a
+        relative ``coefficients`` file of ``<rt70:wind>`` is found beside it.
+    balance_inertia : bool
+        Repair an impossible rotational inertia of a moving link instead of refusing it
+        (:func:`read_urdf`).
+
+    Raises
+    ------
+    UrdfError
+        (or a subclass) as :func:`read_urdf`.
     """
     text = prepare_text(text, source)
     refuse_entities(text, source)
@@ -140,7 +143,7 @@ class _Reader(ElementReader):
             gravity=np.array([0.0, 0.0, -9.81]),
             inertia_repairs=repairs,
         )
-        return self.extensions(root, desc)
+        return read_extensions(self, root, desc)
 
     def link(self, elem: ET.Element) -> Link:
         name = self.name_of(elem)
@@ -347,145 +350,6 @@ class _Reader(ElementReader):
                 f"expected one root link, found {len(roots)}: {', '.join(roots[:5])}",
             )
         return roots[0]
-
-    # --- rt70 extension elements ---------------------------------------------------
-    def extensions(self, root: ET.Element, desc: RobotDescription) -> RobotDescription:
-        ns = "{" + RT70_NS + "}"
-        winds: list = []
-        air: list[float] = []
-        no_slips: list = []
-        joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
-        for elem in root:
-            if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
-                continue
-            kind = elem.tag[len(ns) :]  # one of rt70.urdf.schema.RT70's, checked
-            if kind == "gravity":
-                desc.gravity[:] = self.numbers(elem, "xyz", 3)
-            elif kind == "joint_spring":
-                desc.joint_springs.append(self.joint_spring(elem, joints))
-            elif kind == "bushing":
-                desc.bushings.append(self.bushing(elem, desc))
-            elif kind == "loop":
-                desc.loops.append(self.loop(elem, desc))
-            elif kind == "strut_package":
-                desc.bushings.extend(self.strut_package(elem, desc))
-            elif kind == "drive":
-                desc.drives.append(read_drive(self, elem, desc, joints))
-            elif kind == "wind":
-                winds.append(read_wind(self, elem, desc, winds))
-            elif kind == "air":
-                air.append(read_air(self, elem))
-            elif kind == "no_slip":
-                no_slips.append(read_no_slip(self, elem, desc, no_slips))
-            elif kind == "optical_point":
-                name = self.name_of(elem)
-                link = self.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
-                desc.optical_points.append(OpticalPoint(name, link, self.numbers(elem, "xyz", 3)))
-            else:  # a kind declared in RT70 must be read here, never skipped
-                raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
-        self.check_unique_names(desc)
-        if not (winds or air or no_slips):
-            return desc
-        return dataclasses.replace(
-            desc,
-            winds=tuple(winds),
-            air_density=air[0] if air else desc.air_density,
-            no_slips=tuple(no_slips),
-        )
-
-    def check_unique_names(self, desc: RobotDescription) -> None:
-        """Refuse two elements of one kind with one name: results are named by them.
-
-        Springs, bushings (a strut is ``package/strut``) and optical points each name an
-        output, a row or a column; a second one of a name would silently shadow the
-        first. (Drives, winds and loops are checked where they are read.)
-        """
-        for kind, elements in (
-            ("<rt70:joint_spring>", desc.joint_springs),
-            ("<rt70:bushing> or <rt70:strut>", desc.bushings),
-            ("<rt70:optical_point>", desc.optical_points),
-        ):
-            seen: set[str] = set()
-            for element in elements:
-                if element.name in seen:
-                    raise self.fail(ExtensionError, f"two {kind} elements named '{element.name}'")
-                seen.add(element.name)
-
-    def joint_spring(self, elem: ET.Element, joints: dict[str, Joint]) -> JointSpring:
-        name = self.name_of(elem)
-        where = f"<rt70:joint_spring name='{name}'>"
-        joint = self.one_dof_joint(elem, joints, where)
-        k, d = self.gains(elem, 1, where)
-        return JointSpring(name, joint.name, float(k[0]), float(d[0]))
-
-    def frame(self, elem: ET.Element, tag: str, desc: RobotDescription, where: str) -> FrameRef:
-        sub = elem.find(f"{{{RT70_NS}}}{tag}")  # exactly one (RT70)
-        link = self.link_ref(sub, "link", desc, f"{where} <rt70:{tag}>")
-        return FrameRef(
-            link, self.numbers(sub, "xyz", 3, ZERO3), self.numbers(sub, "rpy", 3, ZERO3)
-        )
-
-    def bushing(self, elem: ET.Element, desc: RobotDescription) -> Bushing:
-        name = self.name_of(elem)
-        where = f"<rt70:bushing name='{name}'>"
-        f1 = self.frame(elem, "frame1", desc, where)
-        f2 = self.frame(elem, "frame2", desc, where)
-        k, d = self.gains(elem, 6, where)
-        return Bushing(name, f1, f2, k, d)
-
-    def loop(self, elem: ET.Element, desc: RobotDescription) -> Loop:
-        """``<rt70:loop>``: two frames that coincide (docs/loops.md)."""
-        name = self.name_of(elem)
-        where = f"<rt70:loop name='{name}'>"
-        if any(loop.name == name for loop in desc.loops):
-            raise self.fail(ExtensionError, f"{where}: two loops named '{name}'")
-        kind = elem.get("type", "point")
-        if kind not in LOOP_TYPES:
-            raise self.fail(
-                ExtensionError,
-                f"{where}: type '{kind}' is not one of {', '.join(LOOP_TYPES)}",
-            )
-        f1 = self.frame(elem, "frame1", desc, where)
-        sub = elem.find(f"{{{RT70_NS}}}frame2")
-        if sub is not None and sub.get("link") == "world" and "world" not in desc.links:
-            f2 = FrameRef(  # the ground: the root link, whatever its name
-                desc.root, self.numbers(sub, "xyz", 3, ZERO3), self.numbers(sub, "rpy", 3, ZERO3)
-            )
-        else:
-            f2 = self.frame(elem, "frame2", desc, where)
-        if f1.link == f2.link:
-            raise self.fail(
-                ExtensionError, f"{where}: frame1 and frame2 are both on link '{f1.link}'"
-            )
-        return Loop(name, kind, f1, f2)
-
-    def strut_package(self, elem: ET.Element, desc: RobotDescription) -> list[Bushing]:
-        name = self.name_of(elem)
-        where = f"<rt70:strut_package name='{name}'>"
-        parent = self.link_ref(elem, "parent", desc, where)
-        child = self.link_ref(elem, "child", desc, where)
-        origin_xyz = self.numbers(elem, "xyz", 3, ZERO3)
-        origin_rot = rpy_matrix(self.numbers(elem, "rpy", 3, ZERO3))
-        struts = []
-        for sub in elem.findall(f"{{{RT70_NS}}}strut"):
-            sname = self.name_of(sub)
-            r_s = self.numbers(sub, "xyz", 3, ZERO3)
-            rpy_s = self.numbers(sub, "rpy", 3, ZERO3)
-            k, d = self.gains(sub, 6, f"{where} <rt70:strut name='{sname}'>")
-            # frame 1 = package origin ∘ (r_s, c_s), expressed in the parent link
-            f1_xyz = origin_xyz + origin_rot @ r_s
-            f1_rpy = rpy_of_matrix(origin_rot @ rpy_matrix(rpy_s))
-            struts.append(
-                Bushing(
-                    f"{name}/{sname}",
-                    FrameRef(parent, f1_xyz, f1_rpy),
-                    FrameRef(child, r_s, rpy_s),
-                    k,
-                    d,
-                    package=name,
-                )
-            )
-        return struts
 
 
 def _rigid_bodies(links: dict[str, Link], joints: list[Joint], root: str) -> dict[str, str]:

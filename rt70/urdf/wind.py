@@ -6,7 +6,7 @@ reference area and length, and coefficient table — into a
 :class:`~rt70.errors.ExtensionError` naming the file and the element. The coefficient
 table is read and checked here (:class:`rt70.physics.aerodynamics.CoefficientTable`): a built-in
 ``shape`` or a ``coefficients`` CSV file, relative to the URDF file's directory.
-Called by :mod:`rt70.urdf.reader`.
+Called by :mod:`rt70.urdf.extensions`.
 """
 
 from __future__ import annotations
@@ -26,6 +26,18 @@ def read_wind(
     reader: ElementReader, elem: ET.Element, desc: RobotDescription, seen: list[Wind]
 ) -> Wind:
     """The :class:`Wind` of one ``<rt70:wind>`` element.
+
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages and the directory a relative
+        ``coefficients`` file is found in; the attribute readers).
+    elem : xml.etree.ElementTree.Element
+        The ``<rt70:wind>`` element.
+    desc : RobotDescription
+        The description read so far (its links).
+    seen : list of Wind
+        The winds already read from the file (a name may not repeat).
 
     Raises
     ------
