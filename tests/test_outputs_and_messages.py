@@ -287,6 +287,7 @@ def test_bench_writes_table_and_plot_as_a_set(tmp_path, monkeypatch, capsys):
 
 def test_bench_simulate_results_are_a_set(tmp_path, monkeypatch):
     from rt70.reports import work_precision as wp
+    from rt70.reports import work_precision_results as wpr
 
     row = wp.Row(
         "double_pendulum", 2, 1.0, "BDF", 1e-6, 1e-9, "ok", False, 1e-7, 0.1, "0.1", 10, 1, 1,
@@ -295,7 +296,7 @@ def test_bench_simulate_results_are_a_set(tmp_path, monkeypatch):
     expected = old_set(tmp_path, "work_precision.csv", "work_precision.png")
     fail_on_call(monkeypatch, Figure, "savefig", 1)
     with pytest.raises(OutputError, match=r"work_precision\.png: cannot write"):
-        wp.write_results([row], tmp_path)
+        wpr.write_results([row], tmp_path)
     assert listing(tmp_path) == expected
 
 

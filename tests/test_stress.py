@@ -18,6 +18,12 @@ from rt70.reports.stress.edits import (
     scale_springs,
     set_gravity,
 )
+from rt70.reports.stress.gimbal_cases import (
+    GIMBAL_BUSHING,
+    GIMBAL_COORDINATE,
+    gimbal_mass_matrix_cases,
+    gimbal_spring_cases,
+)
 from rt70.reports.stress.measures import (
     frequencies_hz,
     momentum_pinocchio,
@@ -25,12 +31,6 @@ from rt70.reports.stress.measures import (
     translational,
 )
 from rt70.reports.stress.report import write_report
-from rt70.reports.stress.rt70_cases import (
-    GIMBAL_BUSHING,
-    GIMBAL_COORDINATE,
-    gimbal_mass_matrix_cases,
-    gimbal_spring_cases,
-)
 from rt70.reports.stress.runs import count_bdf_steps, run_capped
 from rt70.reports.stress.scaling_cases import free_floating_state
 from rt70.scenes.rt70_state import listing_initial_state

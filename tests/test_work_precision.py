@@ -15,6 +15,7 @@ import pytest
 
 from rt70.model.scene import load_scene, scene_from_text
 from rt70.reports import work_precision as wp
+from rt70.reports import work_precision_results as wpr
 from rt70.reports import work_precision_worker as wpw
 from rt70.reports.work_precision_problems import QUICK_PROBLEMS, build_problem, light_damping_text
 from rt70.testing import MIN_REL, assert_close
@@ -38,7 +39,7 @@ def _com_scale(problem):
 
 @pytest.mark.slow
 def test_quick_run_writes_files(quick_rows, tmp_path):
-    paths = wp.write_results(quick_rows, tmp_path)
+    paths = wpr.write_results(quick_rows, tmp_path)
     assert [p.name for p in paths] == ["work_precision.csv", "work_precision.png"]
     with open(tmp_path / "work_precision.csv", newline="") as fh:
         table = list(csv.DictReader(fh))
@@ -46,7 +47,7 @@ def test_quick_run_writes_files(quick_rows, tmp_path):
     assert {r["problem"] for r in table} == {p.name for p in QUICK_PROBLEMS}
     assert {r["method"] for r in table} == set(wp.METHODS)
     assert (tmp_path / "work_precision.png").stat().st_size > 10_000
-    text = wp.format_table(quick_rows)
+    text = wpr.format_table(quick_rows)
     assert "fastest to error" in text and "references" in text
 
 
@@ -160,7 +161,7 @@ def test_runs_are_timed_with_pinned_threads(quick_rows):
     assert {r.threads for r in quick_rows} == {1}  # read back from the worker's pools
     unpinned = {r.threads_unpinned for r in quick_rows}
     assert len(unpinned) == 1 and "openblas" in unpinned.pop()
-    assert "BLAS/OpenMP threads in the worker: 1 (unpinned: " in wp.format_table(quick_rows)
+    assert "BLAS/OpenMP threads in the worker: 1 (unpinned: " in wpr.format_table(quick_rows)
     assert pools()  # the parent's pools are left as they were
 
 
@@ -179,20 +180,20 @@ def test_real_time_target_is_judged_on_the_fastest_run_to_the_error():
         _fake("rt70", "RK45", 1e-3, "over cap", math.nan, math.nan),
         _fake("chain", "RK45", 1e-3, "ok", 1e-9, 0.001),  # another problem: ignored
     ]
-    (check,) = wp.check_targets(rows)
+    (check,) = wpr.check_targets(rows)
     assert check.target.startswith("rt70 (listing damping, T = 2 s) to state error ≤ 1e-06 in")
     assert "≤ 0.04 s of integration, i.e. ≥ 50× real time" in check.target
     assert check.measured.startswith("0.450 s, 4.4× real time (BDF, rtol 1e-07")
     assert check.met is False and check.line().endswith("— NOT met")
     fast = [_fake("rt70", "BDF", 1e-7, "ok", 4e-7, 0.039)]
-    assert wp.check_targets(fast)[0].met is True
-    (none,) = wp.check_targets(rows[:1] + rows[3:])
+    assert wpr.check_targets(fast)[0].met is True
+    (none,) = wpr.check_targets(rows[:1] + rows[3:])
     assert none.met is False and "no method reached it" in none.measured
-    assert wp.check_targets(rows[-1:])[0].met is None
+    assert wpr.check_targets(rows[-1:])[0].met is None
     quick = [_fake("rt70", "BDF", 1e-6, "ok", 4e-7, 0.0001, t_end=0.05)]  # 500× but 0.05 s
-    assert wp.check_targets(quick)[0].met is None
-    assert wp.check_targets(quick)[0].line().endswith("under the report's 2 s — not judged")
-    text = wp.format_table(rows)
+    assert wpr.check_targets(quick)[0].met is None
+    assert wpr.check_targets(quick)[0].line().endswith("under the report's 2 s — not judged")
+    text = wpr.format_table(rows)
     assert check.line() in text and "not measured by this report" in text
 
 
@@ -215,10 +216,10 @@ def test_centre_of_mass_error_beside_the_state_error(quick_rows, tmp_path):
             if (r.problem, r.method) == (problem.name, "BDF")
         )
         assert bdf[0][1] < 0.1 * bdf[-1][1], (problem.name, bdf)
-    wp.write_results(quick_rows, tmp_path)
+    wpr.write_results(quick_rows, tmp_path)
     with open(tmp_path / "work_precision.csv", newline="") as fh:
         table = list(csv.DictReader(fh))
     assert {"com_error", "com_floor", "n_steps", "rhs_s", "jacobian_s", "integrator_s"} <= set(
         table[0]
     )
-    assert "COM m" in wp.format_table(quick_rows)
+    assert "COM m" in wpr.format_table(quick_rows)

@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from rt70.reports import simulation_targets, work_precision
+from rt70.reports import simulation_targets, work_precision, work_precision_results
 
 OUT = Path(__file__).resolve().parent / "results"
 
@@ -28,10 +28,10 @@ def main(argv: list[str]) -> int:
         print(f"  [{time.perf_counter() - start:6.1f} s] {msg}", file=sys.stderr, flush=True)
 
     rows = work_precision.run(quick=quick, progress=say)
-    print(work_precision.format_table(rows))
+    print(work_precision_results.format_table(rows))
     for check in simulation_targets.check(rows, quick=quick, progress=say):
         print(check.line())
-    for path in work_precision.write_results(rows, OUT):
+    for path in work_precision_results.write_results(rows, OUT):
         print(f"wrote {path}")
     print(f"total run time {time.perf_counter() - start:.1f} s")
     return 0

@@ -87,14 +87,14 @@ def _bench(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     if args.what == "simulate":
-        from rt70.reports import simulation_targets, work_precision
+        from rt70.reports import simulation_targets, work_precision, work_precision_results
 
         say = lambda msg: print(f"  {msg}", file=sys.stderr, flush=True)  # noqa: E731
         rows = work_precision.run(quick=args.quick, progress=say)
-        print(work_precision.format_table(rows))
+        print(work_precision_results.format_table(rows))
         for check in simulation_targets.check(rows, quick=args.quick, progress=say):
             print(check.line())
-        for path in work_precision.write_results(rows, Path(args.out)):
+        for path in work_precision_results.write_results(rows, Path(args.out)):
             print(f"wrote {path}")
         return 0
 

@@ -69,7 +69,23 @@ def compare(
     rounds: int = 7,
     budget_s: float = 0.02,
 ) -> tuple[float, float, float]:
-    """Interleaved timing: (best textbook s/call, best Pinocchio s/call, median ratio)."""
+    """Interleaved timing: (best textbook s/call, best Pinocchio s/call, median ratio).
+
+    Parameters
+    ----------
+    textbook, pinocchio : callable () -> object
+        The two calls to time, each with its arguments bound; their results are dropped.
+    rounds : int, optional
+        Rounds; each times the textbook call, then the Pinocchio call, back to back.
+    budget_s : float, optional
+        Wall time each side fills per round, s (as many calls as fit, at least one).
+
+    Returns
+    -------
+    tuple of float
+        The best seconds per call of each side over the rounds, and the median over
+        the rounds of the per-round ratio textbook / Pinocchio.
+    """
     t_tb, t_pin = [], []
     for _ in range(rounds):
         t_tb.append(_per_call(textbook, budget_s))
@@ -106,7 +122,25 @@ def first_call(scene: Scene) -> Row:
 
 
 def per_call(scene: Scene, rounds: int, budget_s: float, numpy_form: bool = False) -> Row:
-    """Textbook A(q) (the kernel, or the structured numpy form) against one ``pin.crba``."""
+    """Textbook A(q) (the kernel, or the structured numpy form) against one ``pin.crba``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene timed, at one random configuration (seed 0, q within ±0.5).
+    rounds : int
+        Interleaved rounds of :func:`compare`.
+    budget_s : float
+        Wall time per side and round, s.
+    numpy_form : bool, optional
+        Time :func:`rt70.textbook.structured.mass_matrix` instead of the compiled
+        :func:`rt70.textbook.mass_kernel.mass_matrix` (row ``per_call_numpy``).
+
+    Returns
+    -------
+    Row
+        Row ``per_call`` (or ``per_call_numpy``) with K = 1.
+    """
     model = scene.textbook
     q = np.random.default_rng(0).uniform(-0.5, 0.5, model.nv)
     if numpy_form:
@@ -122,7 +156,27 @@ def per_call(scene: Scene, rounds: int, budget_s: float, numpy_form: bool = Fals
 
 
 def batched(scene: Scene, K: int, rounds: int, budget_s: float, numpy_form: bool = False) -> Row:
-    """Textbook batched A for K configurations against K calls of ``pin.crba``."""
+    """Textbook batched A for K configurations against K calls of ``pin.crba``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene timed, at K random configurations (seed 1, q within ±0.5).
+    K : int
+        Number of configurations of the batch.
+    rounds : int
+        Interleaved rounds of :func:`compare`.
+    budget_s : float
+        Wall time per side and round, s.
+    numpy_form : bool, optional
+        Time :func:`rt70.textbook.structured.mass_matrix_batch` instead of the compiled
+        :func:`rt70.textbook.mass_kernel.mass_matrix_batch` (row ``batched_numpy``).
+
+    Returns
+    -------
+    Row
+        Row ``batched`` (or ``batched_numpy``): seconds per configuration on each side.
+    """
     import pinocchio as pin
 
     from rt70 import reference
@@ -154,6 +208,27 @@ def scaling(kind: str, sizes: list[int], rounds: int, budget_s: float, dense_max
     """Cost of A(q) on generated serial chains or balanced trees of the given sizes.
 
     The dense form (full L and S) is timed as well up to ``dense_max`` bodies.
+
+    Parameters
+    ----------
+    kind : {"chain", "tree"}
+        :func:`rt70.scenes.synthetic.serial_chain` or, for any other value,
+        :func:`rt70.scenes.synthetic.balanced_tree`.
+    sizes : list of int
+        Numbers of bodies of the generated scenes.
+    rounds : int
+        Interleaved rounds of the kernel's timing (half as many, at least 3, for the
+        numpy and dense forms).
+    budget_s : float
+        Wall time per side and round, s.
+    dense_max : int
+        Largest number of bodies at which the dense form is timed.
+
+    Returns
+    -------
+    list of Row
+        Per size the rows ``scaling_<kind>``, ``scaling_<kind>_numpy`` and, up to
+        ``dense_max``, ``scaling_<kind>_dense``.
     """
     from rt70.scenes import synthetic
 
@@ -180,7 +255,22 @@ def scaling(kind: str, sizes: list[int], rounds: int, budget_s: float, dense_max
 
 
 def fit_exponent(rows: list[Row], benchmark: str, min_nv: int = 0) -> float:
-    """Slope of log(time) against log(nv) over the rows of one benchmark."""
+    """Slope of log(time) against log(nv) over the rows of one benchmark.
+
+    Parameters
+    ----------
+    rows : list of Row
+        Benchmark rows; the textbook time ``t_textbook_s`` is fitted.
+    benchmark : str
+        The benchmark whose rows are fitted, e.g. ``"scaling_chain"``.
+    min_nv : int, optional
+        Only rows with at least this many coordinates are fitted.
+
+    Returns
+    -------
+    float
+        The least-squares slope; NaN with fewer than two rows.
+    """
     pts = [(r.nv, r.t_textbook_s) for r in rows if r.benchmark == benchmark and r.nv >= min_nv]
     if len(pts) < 2:
         return float("nan")
@@ -247,7 +337,31 @@ def run(
     dense_max: int = 100,
     progress: Callable[[str], None] | None = None,
 ) -> list[Row]:
-    """All mass-matrix benchmarks: per call, batched, and growth with size."""
+    """All mass-matrix benchmarks: per call, batched, and growth with size.
+
+    Parameters
+    ----------
+    robots : tuple of str, optional
+        Robots of example-robot-data timed beside the RT-70
+        (:func:`rt70.crosscheck.robots.load_robot`).
+    sizes : tuple of int, optional
+        Numbers of bodies of the generated chains and trees (:func:`scaling`).
+    K : int, optional
+        Batch size of :func:`batched`, on the RT-70 and the first robot.
+    rounds : int, optional
+        Interleaved rounds per comparison (half, at least 3, for the numpy forms).
+    budget_s : float, optional
+        Wall time per side and round, s.
+    dense_max : int, optional
+        Largest number of bodies at which the dense form is timed.
+    progress : callable (str) -> None, optional
+        Receives one line per stage.
+
+    Returns
+    -------
+    list of Row
+        Every row, with the pinned and unpinned thread counts of the timing.
+    """
     from rt70.crosscheck.robots import load_robot
 
     say = progress or (lambda _msg: None)

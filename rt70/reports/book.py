@@ -15,6 +15,7 @@ import numpy as np
 from rt70.guards.atomic import atomic_write, atomic_write_text
 from rt70.linear import linearize as lin
 from rt70.linear import modal, responses
+from rt70.linear.topology import LinearModel
 from rt70.model.scene import Scene, load_scene
 from rt70.plotting.modal import plot_bode
 from rt70.reports.book_azimuth import azimuth_section
@@ -133,9 +134,24 @@ def reduced_rotation_model(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The 42-DOF model with only the ``axis`` rotation of ``bodies`` kept, at q = 0.
 
-    Returns ``(M_abs, K_abs, K_gravity_abs)`` in absolute body angles: the pairs'
-    relative angles are mapped with the tree's Γ* (``M_abs = Γ*ᵀ M Γ*``); K_abs holds the
-    springs only, K_gravity_abs gravity's geometric stiffness.
+    Parameters
+    ----------
+    scene : Scene
+        The 42-DOF RT-70 (``rt70``), whose pairs name their coordinates ``<body>_<axis>``.
+    axis : {"rx", "ry", "rz"}
+        The rotation kept of each body's 6-DOF pair.
+    bodies : tuple of str
+        The bodies kept, in the order of the chapter-2 nodes
+        (:data:`AZIMUTH_BODIES`, :data:`ELEVATION_BODIES`).
+    full : Linearization, optional
+        The scene linearised at q = 0 (computed if omitted).
+
+    Returns
+    -------
+    M_abs, K_abs, K_gravity_abs : ndarray, shape (len(bodies), len(bodies))
+        In absolute body angles (rad; kg·m², N·m/rad): the pairs' relative angles are
+        mapped with the tree's Γ* (``M_abs = Γ*ᵀ M Γ*``); K_abs holds the springs only,
+        K_gravity_abs gravity's geometric stiffness.
     """
     full = full or lin.linearize(scene, np.zeros(scene.textbook.nv))
     idx = lin.coordinate_indices(scene, [f"{b}_{axis}" for b in bodies])
@@ -155,9 +171,15 @@ def reduction_section(scene: Scene) -> str:
         "angles to absolute body angles with the tree's Γ* (`M_abs = Γ*ᵀ M Γ*`). Gravity "
         "is left out of K, as in chapter 2 (its geometric stiffness is reported apart).\n"
     )
-    q0 = np.zeros(scene.textbook.nv)
-    full = lin.linearize(scene, q0)
-    for axis, bodies, nodes, links, printed_f, label in (
+    full = lin.linearize(scene, np.zeros(scene.textbook.nv))
+    for axis, bodies, nodes, links, printed, label in _reduced_axes():
+        out.append(_reduced_axis_text(scene, full, axis, bodies, nodes, links, printed, label))
+    return "\n".join(out)
+
+
+def _reduced_axes() -> tuple[tuple, ...]:
+    """Per chapter-2 model: (axis, bodies, its inertias, its links, the model, a label)."""
+    return (
         (
             "rz",
             AZIMUTH_BODIES,
@@ -174,43 +196,64 @@ def reduction_section(scene: Scene) -> str:
             rt70_chapter2.elevation_model(),
             "elevation (rotations about x; Tables 2.3–2.4)",
         ),
-    ):
-        M_abs, K_abs, K_g = reduced_rotation_model(scene, axis, bodies, full)
-        f_listing = frequencies(M_abs, K_abs)
-        f_table = frequencies(printed_f.m, printed_f.C)
-        rows = []
-        for k, b in enumerate(bodies):
-            rows.append(
-                [
-                    b,
-                    f"{M_abs[k, k]:.4e}",
-                    f"{nodes[k]:.4e}",
-                    relative_difference(M_abs[k, k], nodes[k]),
-                ]
-            )
-        inertia_table = markdown_table(
-            ["body", "listing M_abs (diag)", "chapter 2 I", "rel. difference"], rows
-        )
-        off = np.abs(M_abs - np.diag(np.diag(M_abs))).max() / np.abs(np.diag(M_abs)).max()
-        link_rows = []
-        for i, j in itertools.combinations(range(len(bodies)), 2):
-            if abs(K_abs[i, j]) > 1e-6 * np.abs(K_abs).max():
-                link_rows.append([f"{bodies[i]}–{bodies[j]}", f"{-K_abs[i, j]:.4e}"])
-        table_links = ", ".join(f"{name} {c:.4e}" for name, c in links)
-        spectra = markdown_table(
-            ["", "frequencies, Hz"],
+    )
+
+
+def _inertia_table(bodies: tuple[str, ...], M_abs: np.ndarray, nodes: list[float]) -> str:
+    """The reduced listing's diagonal inertias against the chapter-2 table's."""
+    rows = []
+    for k, b in enumerate(bodies):
+        rows.append(
             [
-                ["listing, reduced", ", ".join(f"{f:.4f}" for f in f_listing)],
-                ["chapter-2 tables", ", ".join(f"{f:.4f}" for f in f_table)],
-            ],
+                b,
+                f"{M_abs[k, k]:.4e}",
+                f"{nodes[k]:.4e}",
+                relative_difference(M_abs[k, k], nodes[k]),
+            ]
         )
-        coupling = (
-            "(the bodies' offsets couple them: each turns about its own axis, not a common one)"
-            if off > 1e-12
-            else "(the bodies turn about one common axis)"
-        )
-        listing_links = ", ".join(f"{a} {b}" for a, b in link_rows)
-        out.append(f"""### {label}
+    return markdown_table(["body", "listing M_abs (diag)", "chapter 2 I", "rel. difference"], rows)
+
+
+def _listing_links(bodies: tuple[str, ...], K_abs: np.ndarray) -> str:
+    """The listing's springs between ``bodies``: ``a–b −K_abs[a, b]`` for each non-zero."""
+    link_rows = []
+    for i, j in itertools.combinations(range(len(bodies)), 2):
+        if abs(K_abs[i, j]) > 1e-6 * np.abs(K_abs).max():
+            link_rows.append([f"{bodies[i]}–{bodies[j]}", f"{-K_abs[i, j]:.4e}"])
+    return ", ".join(f"{a} {b}" for a, b in link_rows)
+
+
+def _reduced_axis_text(
+    scene: Scene,
+    full: lin.Linearization,
+    axis: str,
+    bodies: tuple[str, ...],
+    nodes: list[float],
+    links: list[tuple[str, float]],
+    printed_f: LinearModel,
+    label: str,
+) -> str:
+    """One sub-section of :func:`reduction_section`: one rotation per body against a table."""
+    M_abs, K_abs, K_g = reduced_rotation_model(scene, axis, bodies, full)
+    f_listing = frequencies(M_abs, K_abs)
+    f_table = frequencies(printed_f.m, printed_f.C)
+    inertia_table = _inertia_table(bodies, M_abs, nodes)
+    off = np.abs(M_abs - np.diag(np.diag(M_abs))).max() / np.abs(np.diag(M_abs)).max()
+    table_links = ", ".join(f"{name} {c:.4e}" for name, c in links)
+    spectra = markdown_table(
+        ["", "frequencies, Hz"],
+        [
+            ["listing, reduced", ", ".join(f"{f:.4f}" for f in f_listing)],
+            ["chapter-2 tables", ", ".join(f"{f:.4f}" for f in f_table)],
+        ],
+    )
+    coupling = (
+        "(the bodies' offsets couple them: each turns about its own axis, not a common one)"
+        if off > 1e-12
+        else "(the bodies turn about one common axis)"
+    )
+    listing_links = _listing_links(bodies, K_abs)
+    return f"""### {label}
 
 Inertias (SI numbers of the listing vs the table's technical-unit numbers — the listing
 reuses the table's digits):
@@ -227,8 +270,7 @@ Chapter-2 links: {table_links}.
 
 Gravity's geometric stiffness on these coordinates at the zenith:
 max |K_g| = {np.abs(K_g).max():.3e} N·m/rad (left out above).
-""")
-    return "\n".join(out)
+"""
 
 
 def sweep_section(scene: Scene, elevations=(0, 15, 30, 45, 60, 75, 90)) -> str:

@@ -117,17 +117,43 @@ def _invariant_text(
     dev: Callable[[np.ndarray], float],
 ) -> tuple[str, dict]:
     """The sub-section proving what the search above could only sample (issue 8)."""
+    n, rows = _invariant_numbers(printed)
+    fit_table, best = _single_value_table(n["printed"], spectrum, dev)
+    numbers = {
+        "printed": n["printed"],
+        "tables_0": n["tables_0"],
+        "tables_90": n["tables_90"],
+        "ratio_0": n["ratio_0"],
+        "ratio_90": n["ratio_90"],
+        "rounding_bound": n["rounding_bound"],
+        "elevation_ratio": n["elevation_ratio"],
+        "elevation_bound": n["elevation_bound"],
+        "best_single_value": best,
+    }
+    return _proof_text(n, rows, fit_table, best), numbers
+
+
+def _azimuth_columns() -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per elevation column of Tables 2.1–2.2 (``"0"``, ``"90"``): (inertias, stiffnesses)."""
     d = rt70_data
-    names = [n["name"] for n in d.AZIMUTH_NODES]
-    cols = {
+    return {
         key: (
             np.array([n[f"I_el{key}"] for n in d.AZIMUTH_NODES]),
             np.array([c[f"C_el{key}"] for c in d.AZIMUTH_LINKS]),
         )
         for key in rt70_chapter2.AZIMUTH_ELEVATIONS
     }
+
+
+def _invariant_numbers(printed: np.ndarray) -> tuple[dict, list[list[str]]]:
+    """The products ``Π ω²`` of the printed spectrum and of the tables, and their table rows.
+
+    Returns the numbers of the sub-section (the keys of :func:`_invariant_text`'s second
+    value, and ``eig_check``: the 0° model's ``eigh`` product against the invariant) and
+    the rows of its table of products.
+    """
+    cols = _azimuth_columns()
     p_printed = tree_invariant.printed_omega2_product(printed)
-    bound = _rounding_bound(printed)
     invariants = {}
     rows = [["printed spectrum, Π(2πf)² over its six non-zero f", f"{p_printed:.5e}", "1"]]
     for label, i_key, c_key in (
@@ -141,16 +167,31 @@ def _invariant_text(
         rows.append([label, f"{value:.5e}", f"{p_printed / value:.4g}"])
     m0 = rt70_chapter2.azimuth_model("0")
     w = np.sort(scipy.linalg.eigh(m0.C, m0.m, eigvals_only=True))
-    eig_check = abs(float(np.prod(w[1:])) / tree_invariant.model_omega2_product(m0) - 1)
-    ratio0 = p_printed / invariants[("0", "0")]
-    ratio90 = p_printed / invariants[("90", "90")]
-    shortfall = f"{ratio0 - 1:.1%}".replace("-", "−")
-    eig_agrees = "to within 1e-12" if eig_check <= 1e-12 else f"only to {eig_check:.1e}"
     e_printed = tree_invariant.printed_omega2_product(rt70_data.ELEVATION_SPECTRUM_HZ)
-    e_ratio = e_printed / tree_invariant.model_omega2_product(rt70_chapter2.elevation_model())
-    e_bound = _rounding_bound(rt70_data.ELEVATION_SPECTRUM_HZ)
+    numbers = {
+        "printed": p_printed,
+        "tables_0": invariants[("0", "0")],
+        "tables_90": invariants[("90", "90")],
+        "ratio_0": p_printed / invariants[("0", "0")],
+        "ratio_90": p_printed / invariants[("90", "90")],
+        "rounding_bound": _rounding_bound(printed),
+        "elevation_ratio": e_printed
+        / tree_invariant.model_omega2_product(rt70_chapter2.elevation_model()),
+        "elevation_bound": _rounding_bound(rt70_data.ELEVATION_SPECTRUM_HZ),
+        "eig_check": abs(float(np.prod(w[1:])) / tree_invariant.model_omega2_product(m0) - 1),
+    }
+    return numbers, rows
 
-    inertia, C = cols["0"]
+
+def _single_value_table(
+    p_printed: float,
+    spectrum: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    dev: Callable[[np.ndarray], float],
+) -> tuple[str, float]:
+    """The table of single changed values giving the printed product, and the best deviation."""
+    d = rt70_data
+    names = [n["name"] for n in d.AZIMUTH_NODES]
+    inertia, C = _azimuth_columns()["0"]
     fit_rows, fit_devs = [], []
     for kind, k, value in _single_value_fits(p_printed, inertia, C):
         link = d.AZIMUTH_LINKS[k]["name"] if kind == "C" else ""
@@ -164,10 +205,19 @@ def _invariant_text(
         fit_devs.append(dev(spectrum(i2, c2)))
         fit_rows.append([what, f"{was:.4e}", f"{value:.4e}", f"{fit_devs[-1]:.1%}"])
     fit_header = ["value changed", "0° table", "value giving the printed product", "max deviation"]
-    fit_table = markdown_table(fit_header, fit_rows)
+    return markdown_table(fit_header, fit_rows), min(fit_devs)
+
+
+def _proof_text(n: dict, rows: list[list[str]], fit_table: str, best: float) -> str:
+    """The sub-section's text from :func:`_invariant_numbers` and the single-value table."""
+    bound, e_ratio, e_bound = n["rounding_bound"], n["elevation_ratio"], n["elevation_bound"]
+    ratio0, ratio90 = n["ratio_0"], n["ratio_90"]
+    shortfall = f"{ratio0 - 1:.1%}".replace("-", "−")
+    eig_check = n["eig_check"]
+    eig_agrees = "to within 1e-12" if eig_check <= 1e-12 else f"only to {eig_check:.1e}"
     n_trees = 7 ** (7 - 2)  # Cayley: labelled trees on 7 bodies
     n_models = n_trees * math.factorial(6)  # a tree and an order of the six stiffnesses
-    text = f"""### A proof instead of a search: the product of the ω² (issue 8)
+    return f"""### A proof instead of a search: the product of the ω² (issue 8)
 
 **Theorem** ([`docs/tree-invariant.md`](../../docs/tree-invariant.md),
 `rt70.linear.tree_invariant`, tested against `eigh` on random trees). For n bodies of
@@ -224,20 +274,8 @@ inertia or stiffness could take, and with Γα that value still misses the spect
 {fit_table}
 
 No single changed value, whatever its size, reproduces the printed spectrum with Γα
-(best {min(fit_devs):.1%}).
+(best {best:.1%}).
 """
-    numbers = {
-        "printed": p_printed,
-        "tables_0": invariants[("0", "0")],
-        "tables_90": invariants[("90", "90")],
-        "ratio_0": ratio0,
-        "ratio_90": ratio90,
-        "rounding_bound": bound,
-        "elevation_ratio": e_ratio,
-        "elevation_bound": e_bound,
-        "best_single_value": min(fit_devs),
-    }
-    return text, numbers
 
 
 def azimuth_section() -> tuple[str, dict]:

@@ -111,7 +111,24 @@ class RigRun:
 
 
 def run_case(case: Case, t_end: float, rtol: float = 1e-6, width: float = WIDTH) -> RigRun:
-    """Simulate ``case`` for ``t_end`` s from rest with the trains at their bias."""
+    """Simulate ``case`` for ``t_end`` s from rest with the trains at their bias.
+
+    Parameters
+    ----------
+    case : Case
+        What is in the drive train and what the servo does.
+    t_end : float
+        Length of the run, s; the output grid has 20 points per second.
+    rtol : float, optional
+        Relative tolerance of BDF.
+    width : float, optional
+        ω_ε of the friction law's regularisation, rad/s (axis side).
+
+    Returns
+    -------
+    RigRun
+        The error over the second half of the run and the trains' torques there.
+    """
     p = drive_parameters()
     scene = axis_scene(p.J_l)
     names = scene.coordinate_names
@@ -212,7 +229,25 @@ def stick_slip_torque(t: float) -> float:
 def regularisation_run(
     width: float, kind: str, method: str, t_end: float = 4.0
 ) -> tuple[SimulationResult, float]:
-    """The stick–slip rig with a regularised law: the run and its largest error (″)."""
+    """The stick–slip rig with a regularised law: the run and its largest error (″).
+
+    Parameters
+    ----------
+    width : float
+        ω_ε of the regularisation, rad/s (axis side).
+    kind : {"linear", "tanh"}
+        The regularisation (:func:`rt70.control.friction.friction_torque`).
+    method : str
+        ``solve_ivp`` method, ``"BDF"`` or ``"Radau"`` in the report.
+    t_end : float, optional
+        Length of the run, s; the output grid has 100 points per second.
+
+    Returns
+    -------
+    tuple of (SimulationResult, float)
+        The run, and the largest distance of its axis angle from the exact switched
+        motion (:func:`rt70.control.friction.switched_rigid_axis`), ″.
+    """
     inertia = AZIMUTH_DRIVE.reference_inertia + AZIMUTH_DRIVE.reflected_motor_inertia
     scene = axis_scene(inertia, "friction_rig")
     t = np.linspace(0.0, t_end, int(round(100 * t_end)) + 1)

@@ -34,7 +34,27 @@ def budget_table(
     azimuth_deg: float = 0.0,
     direction_deg: float | None = None,
 ) -> list[PointingBudget]:
-    """Budgets of every (elevation, speed) pair, elevation-major."""
+    """Budgets of every (elevation, speed) pair, elevation-major.
+
+    Parameters
+    ----------
+    scene : Scene
+        The control object, ``load_scene("rt70_servo")``.
+    speeds : sequence of float, optional
+        Mean wind speeds, m/s (> 0).
+    elevations : sequence of float, optional
+        Elevations of the pointing, degrees.
+    azimuth_deg : float, optional
+        Azimuth of the pointing, degrees.
+    direction_deg : float or None, optional
+        Azimuth the wind blows from, degrees; None: the pointing's azimuth, a front wind
+        into the dish.
+
+    Returns
+    -------
+    list of PointingBudget
+        One budget per case, the speeds varying fastest.
+    """
     return [
         pointing_budget(scene, PointingCase(e, azimuth_deg, v, direction_deg))
         for e in elevations

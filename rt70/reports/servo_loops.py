@@ -119,6 +119,19 @@ def compare(
     The LQG is designed on :func:`rt70.control.lqg.reduce_plant` of the plant and checked
     on the full plant; its margins are at the plant input (the armature voltage). The
     wind step is the book's nominal wind torque (``WIND_TORQUE``, 5·10⁵ kgf·m).
+
+    Parameters
+    ----------
+    scene : Scene
+        The control object, ``load_scene("rt70_servo")``.
+    axis : {"azimuth", "elevation"}
+        The driven axis (the other one is locked).
+    elevation_deg : float
+        Elevation of the pointing, degrees (azimuth 0°).
+    position_hz : float, optional
+        The cascade's position-loop bandwidth, Hz.
+    weights : LqgWeights, optional
+        The LQR and Kalman filter weights of the LQG.
     """
     ap = axis_plant(scene, axis, elevation_deg)
     cascade = loops.analyse_cascade(ap, position_hz)

@@ -70,6 +70,22 @@ def lqg_drives(
     The LQG is designed by :func:`rt70.control.lqg.design` on
     :func:`rt70.reports.servo_loops.axis_plant` ``(scene, "azimuth", elevation_deg)``
     when the factory is called (about 1 s).
+
+    Parameters
+    ----------
+    elevation_deg : float
+        Elevation of the pointing the LQG is designed at, degrees.
+    azimuth_deg : float, optional
+        Azimuth of that pointing, degrees.
+    weights : LqgWeights, optional
+        The LQR and Kalman filter weights.
+    tracking_time : float, optional
+        ``T_t`` of the integral state's back-calculation (anti-windup), s.
+
+    Returns
+    -------
+    DriveFactory
+        ``(scene, q0, torques, references) -> [azimuth LQG drive, elevation PI drive]``.
     """
     pi = servo_drives()
 
@@ -113,7 +129,17 @@ def lqg_drives(
 
 
 def step_scenario(step_arcsec: float, elevation_deg: float = 45.0, t_end: float = 15.0) -> Scenario:
-    """An azimuth step of ``step_arcsec`` at t = 0 from the pointing (a scenario)."""
+    """An azimuth step of ``step_arcsec`` at t = 0 from the pointing (a scenario).
+
+    Parameters
+    ----------
+    step_arcsec : float
+        Size of the azimuth step, ″ (positive or negative).
+    elevation_deg : float, optional
+        Elevation of the pointing, degrees (azimuth 0°).
+    t_end : float, optional
+        Length of the run, s.
+    """
     deg = step_arcsec / 3600.0
     return Scenario(
         name="step-azimuth",
@@ -131,8 +157,22 @@ def linear_step(
 ) -> dict[str, np.ndarray]:
     """The linear LQG closed loop's azimuth step (full linear plant, elevation locked).
 
-    Returns ``axis_arcsec`` (the axis angle's deviation), ``voltage`` (V, deviation),
-    ``current`` (A, deviation) on the times ``t``.
+    Parameters
+    ----------
+    scene : Scene
+        The control object, ``load_scene("rt70_servo")``.
+    step_arcsec : float
+        Size of the azimuth step, ″.
+    t : ndarray, shape (n_t,)
+        Times of the response, s, from 0.
+    elevation_deg : float, optional
+        Elevation of the pointing, degrees (azimuth 0°).
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n_t,)
+        ``axis_arcsec`` (the axis angle's deviation, ″), ``voltage`` (V, deviation),
+        ``current`` (A, deviation) on the times ``t``.
     """
     ap = rs.axis_plant(scene, "azimuth", elevation_deg)
     closed = lqg.lqg_system(ap, lqg.design(ap, weights=rs.LQG_WEIGHTS))
@@ -143,7 +183,23 @@ def linear_step(
 
 
 def step_numbers(t: np.ndarray, axis_arcsec: np.ndarray, step_arcsec: float) -> dict[str, float]:
-    """Settling to 1″ and overshoot (%) of an axis's step response (arc seconds)."""
+    """Settling to 1″ and overshoot (%) of an axis's step response (arc seconds).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_t,)
+        Times of the response, s.
+    axis_arcsec : ndarray, shape (n_t,)
+        The axis angle's deviation from the start, ″.
+    step_arcsec : float
+        Size of the step, ″ (not zero).
+
+    Returns
+    -------
+    dict of str to float
+        ``settle_1arcsec_s``: first time after which the error stays within 1″, s (NaN
+        if never); ``overshoot_pct``: largest overshoot past the step, % of the step.
+    """
     error = step_arcsec - axis_arcsec
     return {
         "settle_1arcsec_s": settling_time(t, error),

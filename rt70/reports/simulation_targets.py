@@ -37,10 +37,15 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rt70.reports.targets import COM_TARGET_M, REAL_TIME_TARGET, TRANSIENT_PROBLEM, TargetCheck
+
+if TYPE_CHECKING:
+    from rt70.model.scene import Scene
+    from rt70.telescope.scenarios import DriveFactory, Scenario
 
 #: Whole command, s.
 COMMAND_TARGET_S = 1.0
@@ -77,7 +82,7 @@ def integration_target(rows) -> tuple[TargetCheck, object | None]:
         ``com_error ≤ COM_TARGET_M`` (None when no row reached it, or the problem was
         not run).
     """
-    from rt70.reports.work_precision import time_to_reach
+    from rt70.reports.work_precision_results import time_to_reach
 
     mine = [r for r in rows if r.problem == TRANSIENT_PROBLEM]
     goal = (
@@ -105,6 +110,20 @@ def integration_target(rows) -> tuple[TargetCheck, object | None]:
 def command_seconds(method: str, rtol: float, repeats: int = COMMAND_REPEATS) -> list[float]:
     """Wall times of ``rt70 simulate rt70 --t-end 10 --method M --rtol R`` as a subprocess.
 
+    Parameters
+    ----------
+    method : str
+        The integrator, ``--method`` (a method of :data:`rt70.simulation.simulate.METHODS`).
+    rtol : float
+        Relative tolerance, ``--rtol``.
+    repeats : int, optional
+        Runs of the command.
+
+    Returns
+    -------
+    list of float
+        Wall time of each run, s, start-up included.
+
     Raises
     ------
     Rt70Error
@@ -126,7 +145,18 @@ def command_seconds(method: str, rtol: float, repeats: int = COMMAND_REPEATS) ->
 
 
 def command_target(win, repeats: int = COMMAND_REPEATS, quick: bool = False) -> TargetCheck:
-    """The whole-command target, with the method and tolerance of the integration's row."""
+    """The whole-command target, with the method and tolerance of the integration's row.
+
+    Parameters
+    ----------
+    win : Row or None
+        The work–precision row of :func:`integration_target` whose ``method`` and
+        ``rtol`` the command runs; None: no row reached the accuracy (not judged).
+    repeats : int, optional
+        Runs of the command; the best wall time counts.
+    quick : bool, optional
+        A quick run: the command is not timed (not judged).
+    """
     goal = f"whole command `rt70 simulate rt70 --t-end 10` ≤ {COMMAND_TARGET_S:g} s (≥ 10×)"
     if quick:
         return TargetCheck(goal, "— (not measured in a quick run)", None)
@@ -214,6 +244,18 @@ def servo_runs(
     the optical output of the servo scene) are taken against a reference run of LSODA
     at :data:`SERVO_REFERENCE_RTOL` on the same output grid.
 
+    Parameters
+    ----------
+    rtols : tuple of float, optional
+        Relative tolerances tried with each method.
+    methods : tuple of str, optional
+        Integrators tried; default LSODA and the compiled (CVODE) methods of
+        :data:`rt70.simulation.simulate.METHODS`.
+    t_end : float, optional
+        Length of the scenario, s.
+    progress : callable (str) -> None, optional
+        Receives one line per run.
+
     Returns
     -------
     list of dict
@@ -223,7 +265,6 @@ def servo_runs(
     from rt70.model.scene import load_scene
     from rt70.reports.threads import single_threaded
     from rt70.reports.work_precision import com_error
-    from rt70.reports.work_precision_worker import com_positions
     from rt70.simulation.simulate import METHODS
     from rt70.telescope import scenarios
     from rt70.telescope.scene_servo import choose_drives
@@ -237,30 +278,14 @@ def servo_runs(
     methods = methods or tuple(m for m in METHODS if m == "LSODA" or m.startswith("CVODE"))
     out = []
     with single_threaded():
-
-        def one(method: str, rtol: float) -> dict:
-            run = scenarios.run_scenario(scene, sc, drives=drives, rtol=rtol, method=method)
-            res = run.result
-            return dict(
-                method=method,
-                rtol=rtol,
-                wall_s=res.wall_time_s,
-                t_end=float(res.t[-1] - res.t[0]),
-                com=com_positions(scene, res.q),
-                pointing=run.pointing_error_total,
-                nfev=res.nfev,
-                njev=res.njev,
-                status="ok",
-            )
-
-        ref = one("LSODA", SERVO_REFERENCE_RTOL)
+        ref = _servo_run(scene, sc, drives, "LSODA", SERVO_REFERENCE_RTOL)
         ref.update(com_error=0.0, pointing_error=0.0, status="reference")
         say(f"rt70_servo: reference LSODA rtol {SERVO_REFERENCE_RTOL:g}: {ref['wall_s']:.2f} s")
         out.append(ref)
         for method in methods:
             for rtol in rtols:
                 try:
-                    got = one(method, rtol)
+                    got = _servo_run(scene, sc, drives, method, rtol)
                 except Exception as exc:  # a failed run is a row, not the end of the report
                     out.append(dict(method=method, rtol=rtol, status=f"failed: {exc}"))
                     continue
@@ -273,6 +298,26 @@ def servo_runs(
                 )
                 out.append(got)
     return out
+
+
+def _servo_run(scene: Scene, sc: Scenario, drives: DriveFactory, method: str, rtol: float) -> dict:
+    """One run of the servo scenario ``sc``: its wall time, centres of mass and pointing."""
+    from rt70.reports.work_precision_worker import com_positions
+    from rt70.telescope import scenarios
+
+    run = scenarios.run_scenario(scene, sc, drives=drives, rtol=rtol, method=method)
+    res = run.result
+    return dict(
+        method=method,
+        rtol=rtol,
+        wall_s=res.wall_time_s,
+        t_end=float(res.t[-1] - res.t[0]),
+        com=com_positions(scene, res.q),
+        pointing=run.pointing_error_total,
+        nfev=res.nfev,
+        njev=res.njev,
+        status="ok",
+    )
 
 
 def servo_target(runs: list[dict] | None) -> TargetCheck:
@@ -302,6 +347,21 @@ def check(rows, quick: bool = False, progress: Say | None = None) -> list[Target
 
     A quick run (``rows`` of the quick problems) judges only the right-hand side and
     Jacobian ratios (with fewer rounds); the rest is reported as not judged.
+
+    Parameters
+    ----------
+    rows : list of Row
+        The rows of the work–precision report
+        (:func:`rt70.reports.work_precision.run`).
+    quick : bool, optional
+        A quick run: the whole command and the servo runs are not timed.
+    progress : callable (str) -> None, optional
+        Receives one line per stage.
+
+    Returns
+    -------
+    list of TargetCheck
+        Integration, whole command, right-hand side, Jacobian, servo closed.
     """
     say = progress or _quiet
     integration, win = integration_target(rows)

@@ -183,7 +183,32 @@ class Worker:
             return ("error", "worker process died")
 
     def run(self, problem: Problem, method: str, rtol: float, atol: float | None, cap: float):
-        """One run; abandoned (worker killed) when not back within ``cap`` + slack."""
+        """One run; abandoned (worker killed) when not back within ``cap`` + slack.
+
+        Parameters
+        ----------
+        problem : Problem
+            The test problem; the worker builds its scene once and keeps it.
+        method : str
+            Integrator of :func:`~rt70.simulation.simulate.simulate`.
+        rtol : float
+            Relative tolerance.
+        atol : float or None
+            Absolute tolerance; None: the default of
+            :func:`~rt70.simulation.simulate.simulate`.
+        cap : float
+            Wall-time cap of the integration, s (``inf``: none).
+
+        Returns
+        -------
+        Attempt
+            ``ok``, ``over cap`` or ``failed: <message>``, with the run's statistics.
+
+        Raises
+        ------
+        Rt70Error
+            If the problem cannot be built in the worker.
+        """
         if self.process is None or not self.process.is_alive():
             self.kill()
             self._start()

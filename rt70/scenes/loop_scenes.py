@@ -55,7 +55,21 @@ def loop(
     xyz2: Sequence[float] = ZERO3,
     kind: str = "point",
 ) -> None:
-    """Write an ``<rt70:loop>``: the origins (point) or frames (frame) of two links coincide."""
+    """Write an ``<rt70:loop>``: the origins (point) or frames (frame) of two links coincide.
+
+    Parameters
+    ----------
+    w : Writer
+        The scene being written.
+    name : str
+        Name of the loop.
+    link1, link2 : str
+        Links of the two frames (``link2`` may be ``world``, the ground).
+    xyz1, xyz2 : sequence of float, optional
+        Origins of the two frames in their links, m (rpy zero).
+    kind : {"point", "frame"}, optional
+        ``point``: the origins coincide (3 rows); ``frame``: the frames coincide (6 rows).
+    """
     w.open("rt70:loop", ("name", check_name(name)), ("type", kind))
     w.empty("rt70:frame1", ("link", check_name(link1)), ("xyz", fmt_vec(xyz1)), ("rpy", "0 0 0"))
     w.empty("rt70:frame2", ("link", check_name(link2)), ("xyz", fmt_vec(xyz2)), ("rpy", "0 0 0"))

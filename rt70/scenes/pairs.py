@@ -3,7 +3,7 @@
 A body of the §4.2.3 listing hangs on its parent by six 1-DOF joints in series, the
 pair coordinates ``[x, y, z, β, θ, α]`` of the book: three prismatic joints along x, y,
 z, then three revolute joints about x, y, z. Both scene writers
-(:mod:`rt70.scenes.generate`, :mod:`rt70.scenes.synthetic`) build pairs from
+(:mod:`rt70.scenes.urdf_writer`, :mod:`rt70.scenes.synthetic`) build pairs from
 :data:`PAIR_JOINTS`, and :func:`pair_joint_names` names their coordinates.
 """
 

@@ -104,5 +104,20 @@ def pointing_source(elevation_deg: float, azimuth_deg: float = 0.0) -> np.ndarra
 def rt70_mirror_outputs(
     scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0
 ) -> list[Output]:
-    """The mirror-system outputs of the RT-70 for the source of a pointing (§4.1.8)."""
+    """The mirror-system outputs of the RT-70 for the source of a pointing (§4.1.8).
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene of the RT-70 with the listing's optical points (``rt70``, ``rt70_servo``).
+    elevation_deg : float
+        Elevation of the pointing, degrees: the source's β0 (4.153).
+    azimuth_deg : float, optional
+        Azimuth of the pointing, degrees: the source's α0 = A − 90°.
+
+    Returns
+    -------
+    list of Output
+        :func:`rt70.model.optics.mirror_outputs` of the scene's mirror system.
+    """
     return mirror_outputs(rt70_mirror_system(scene), pointing_source(elevation_deg, azimuth_deg))

@@ -54,6 +54,20 @@ def solid_cylinder(mass: float, moment_x: float, moment_z: float) -> tuple[float
 
     ``I_z = m r²/2`` and ``I_x = m (3 r² + L²)/12``: ``r = √(2 I_z/m)``,
     ``L = √(12 I_x/m − 3 r²)``, ``d = 2 r``.
+
+    Parameters
+    ----------
+    mass : float
+        m, kg.
+    moment_x : float
+        I_x, the transverse moment about the centre, kg·m².
+    moment_z : float
+        I_z, the moment about the cylinder's axis, kg·m².
+
+    Returns
+    -------
+    tuple of float
+        The length L and the diameter d, m.
     """
     r = thin_disc_radius(mass, moment_z)
     return math.sqrt(12.0 * moment_x / mass - 3.0 * r * r), 2.0 * r

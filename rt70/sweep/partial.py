@@ -23,7 +23,9 @@ import numpy as np
 from rt70.errors import OutputError, Rt70Warning
 from rt70.guards.atomic import atomic_write
 from rt70.sweep import store as sweep_store
-from rt70.sweep.plan import Chunk, ChunkResult, Sweep, SweepError
+from rt70.sweep.errors import SweepError
+from rt70.sweep.grid import Chunk
+from rt70.sweep.plan import ChunkResult, Sweep
 
 
 def sidecar(out: Path) -> Path:
@@ -226,6 +228,15 @@ def check_result(sweep: Sweep, chunk: Chunk, result: ChunkResult) -> None:
     the sweep) and the rule that a NaN has its error record: for each point and
     quantity, either an error record and every field NaN, or no record and every
     value finite (NaN only where :attr:`~rt70.sweep.quantities.Field.nan` allows it).
+
+    Parameters
+    ----------
+    sweep : Sweep
+        The sweep the result must belong to (its quantities and their fields).
+    chunk : Chunk
+        The chunk the result claims to be: its points ``start … stop − 1``.
+    result : ChunkResult
+        What came back from a worker or was read back from a chunk file.
 
     Raises
     ------

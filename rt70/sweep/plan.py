@@ -1,11 +1,10 @@
-"""The plan of a sweep, checked before any work: its grid, chunks, quantities and size.
+"""The plan of a sweep, checked before any work: its scene, quantities, chunks and size.
 
-What :mod:`rt70.sweep.run` computes and stores: the axes and their values
-(:func:`parse_values`, :func:`make_grid`), the chunks a grid is cut into
-(:meth:`Grid.chunks`), the scene a chunk is computed on (:class:`SceneSource`,
-:func:`build_scene`), one chunk's computation (:func:`compute_chunk`) and the sweep as a
-whole with its key (:class:`Sweep`, :func:`plan`), and the memory it will hold against
-what this machine has (:func:`peak_bytes`, :func:`check_size`). docs/sweeps.md.
+What :mod:`rt70.sweep.run` computes and stores, on a grid of :mod:`rt70.sweep.grid`: the
+scene a chunk is computed on (:class:`SceneSource`, :func:`build_scene`), one chunk's
+computation (:func:`compute_chunk`) and the sweep as a whole with its key
+(:class:`Sweep`, :func:`plan`), and the memory it will hold against what this machine
+has (:func:`peak_bytes`, :func:`check_size`). docs/sweeps.md.
 """
 
 from __future__ import annotations
@@ -24,19 +23,10 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.guards.resources import check_memory
 from rt70.model.scene import Scene, scene_from_text, scene_path
-from rt70.sweep.quantities import (
-    PARAMETERS,
-    QUANTITIES,
-    Quantity,
-    SweepPoint,
-    check_factors,
-    scaled_scene,
-)
+from rt70.sweep.errors import SweepError
+from rt70.sweep.grid import Chunk, Grid
+from rt70.sweep.quantities import QUANTITIES, Quantity, check_factors, scaled_scene
 from rt70.urdf.text import read_source
-
-#: The fixed axes of every grid, in order, with units and defaults (one value each).
-AXES = (("elevation", "deg", 90.0), ("azimuth", "deg", 0.0), ("wind", "m/s", 0.0))
-AXES += (("direction", "deg", 0.0),)
 
 #: Quantities computed when none is named.
 DEFAULT_QUANTITIES = ("first_frequency", "sag")
@@ -48,12 +38,9 @@ DEFAULT_CHUNK = 8
 #: :mod:`rt70.sweep.store` (their key and checksum inside).
 FORMAT = 2
 
-#: Largest magnitude of an azimuth or a wind direction, degrees: one turn either way
-#: holds every pointing; beyond it a float's spacing grows until the angle means nothing.
-MAX_TURN_DEG = 360.0
-
 #: Memory a sweep holds per number of its results, bytes: the grid's float64 arrays,
-#: filled as the chunks arrive. The four constants below are rounded up from
+#: filled as the chunks arrive. The three constants below (and
+#: :data:`rt70.sweep.grid.BYTES_PER_AXIS_VALUE`) are rounded up from
 #: ``python validation/sweep_memory.py --points 9000`` (tracemalloc, output written):
 #: 7.8 B per number, 2645 B per error record, 662 B per chunk, 90 B per axis value.
 BYTES_PER_NUMBER = 10
@@ -64,177 +51,6 @@ BYTES_PER_ERROR = 3_000
 
 #: Memory per chunk, bytes: its :class:`Chunk` and its share of the bookkeeping.
 BYTES_PER_CHUNK = 1_000
-
-#: Memory per value of an axis, bytes: the Python float, the tuple slot, the grid's
-#: JSON (key, metadata) and numpy's transient ``linspace``.
-BYTES_PER_AXIS_VALUE = 150
-
-
-class SweepError(Rt70Error):
-    """A sweep that cannot run as asked (bad grid, a foreign partial directory, no cluster)."""
-
-
-class ClusterError(SweepError):
-    """The Dask cluster cannot finish the sweep: its scheduler or its workers are gone."""
-
-
-# --- the grid ------------------------------------------------------------------------
-
-
-def parse_values(text: str) -> tuple[float, ...]:
-    """Values of an axis: ``A:B:N`` (N equally spaced, ends included), ``A,B,…`` or ``A``.
-
-    Raises
-    ------
-    SweepError
-        For anything else (``1:2``, N < 2 with A ≠ B, a non-finite number).
-    ResourceError
-        More values than this machine can hold (checked before they are made).
-    """
-
-    def number(s: str) -> float:
-        try:
-            v = float(s)
-        except ValueError:
-            raise SweepError(f"'{s}' is not a number (in '{text}')") from None
-        if not math.isfinite(v):
-            raise SweepError(f"'{s}' is not a finite number (in '{text}')")
-        return v
-
-    if ":" in text:
-        parts = text.split(":")
-        if len(parts) != 3:
-            raise SweepError(f"'{text}': a range is START:STOP:COUNT, e.g. 0:90:91")
-        a, b = number(parts[0]), number(parts[1])
-        try:
-            n = int(parts[2])
-        except ValueError:
-            raise SweepError(f"'{text}': COUNT '{parts[2]}' is not an integer") from None
-        if n < 1 or (n == 1 and a != b):
-            raise SweepError(f"'{text}': COUNT must be at least 2 (1 only when START = STOP)")
-        check_memory(n * BYTES_PER_AXIS_VALUE, f"{n} values of an axis", f"'{text}'")
-        return tuple(float(v) for v in np.linspace(a, b, n))
-    return tuple(number(s) for s in text.split(","))
-
-
-@dataclass(frozen=True)
-class Axis:
-    """One axis of a grid: its name (``scale:NAME`` for a scene parameter), unit, values."""
-
-    name: str
-    unit: str
-    values: tuple[float, ...]
-
-
-@dataclass(frozen=True)
-class Chunk:
-    """Points ``start … stop − 1`` along elevation at the indices ``rest`` of the other axes."""
-
-    number: int
-    rest: tuple[int, ...]
-    start: int
-    stop: int
-
-    def indices(self) -> list[tuple[int, ...]]:
-        """Grid indices of the chunk's points, in order of increasing elevation index."""
-        return [(i, *self.rest) for i in range(self.start, self.stop)]
-
-
-@dataclass(frozen=True)
-class Grid:
-    """The Cartesian product of :attr:`axes` (elevation first: the chunks run along it)."""
-
-    axes: tuple[Axis, ...]
-
-    @property
-    def shape(self) -> tuple[int, ...]:
-        """Number of values per axis."""
-        return tuple(len(a.values) for a in self.axes)
-
-    @property
-    def size(self) -> int:
-        """Number of points."""
-        return math.prod(self.shape)
-
-    def point(self, index: Sequence[int]) -> SweepPoint:
-        """The point at a grid index."""
-        values = {a.name: a.values[i] for a, i in zip(self.axes, index, strict=True)}
-        scales = {k.removeprefix("scale:"): v for k, v in values.items() if k.startswith("scale:")}
-        return SweepPoint(
-            values["elevation"], values["azimuth"], values["wind"], values["direction"], scales
-        )
-
-    def chunks(self, size: int) -> list[Chunk]:
-        """The grid cut into runs of at most ``size`` consecutive elevations, numbered."""
-        out = []
-        for rest in np.ndindex(*self.shape[1:]):
-            for start in range(0, self.shape[0], size):
-                stop = min(start + size, self.shape[0])
-                out.append(Chunk(len(out), tuple(int(i) for i in rest), start, stop))
-        return out
-
-    def chunk(self, size: int, number: int) -> Chunk:
-        """Chunk ``number`` of :meth:`chunks` (``size``), without listing the others."""
-        per_run = math.ceil(self.shape[0] / size)
-        run, k = divmod(number, per_run)
-        rest = (
-            tuple(int(i) for i in np.unravel_index(run, self.shape[1:])) if self.shape[1:] else ()
-        )
-        start = k * size
-        return Chunk(number, rest, start, min(start + size, self.shape[0]))
-
-    def as_dict(self) -> dict[str, Any]:
-        """The axes as JSON: ``{name: {"unit": …, "values": […]}}``, in order."""
-        return {a.name: {"unit": a.unit, "values": list(a.values)} for a in self.axes}
-
-
-def make_grid(
-    values: Mapping[str, Sequence[float]] | None = None,
-    scales: Mapping[str, Sequence[float]] | None = None,
-) -> Grid:
-    """A grid from axis values (missing axes take their default) and parameter factors.
-
-    Raises
-    ------
-    SweepError
-        An elevation outside 0…90°, an azimuth or direction beyond one turn, a
-        negative wind speed, an unknown axis or scene parameter, a factor ≤ 0, an empty
-        or repeated axis.
-    """
-    from rt70.scenes.rt70_state import ELEVATION_RANGE
-
-    values = dict(values or {})
-    unknown = [k for k in values if k not in {name for name, _, _ in AXES}]
-    if unknown:
-        raise SweepError(f"unknown sweep axis {', '.join(unknown)}")
-    axes = []
-    for name, unit, default in AXES:
-        axes.append(Axis(name, unit, tuple(float(v) for v in values.get(name, (default,)))))
-    for name, factors in (scales or {}).items():
-        if name not in PARAMETERS:
-            raise SweepError(
-                f"--scale {name}: unknown scene parameter (known: {', '.join(PARAMETERS)})"
-            )
-        if any(not f > 0.0 for f in factors):
-            raise SweepError(f"--scale {name}: factors must be greater than 0")
-        axes.append(Axis(f"scale:{name}", "1", tuple(float(f) for f in factors)))
-    low, high = ELEVATION_RANGE
-    for axis in axes:
-        if not axis.values:
-            raise SweepError(f"--{axis.name}: no values")
-        if len(set(axis.values)) != len(axis.values):
-            raise SweepError(f"--{axis.name}: a value is repeated")
-    if any(not low <= e <= high for e in axes[0].values):
-        raise SweepError(f"--elevation: the RT-70 points from {low:g}° to {high:g}°")
-    if any(w < 0.0 for w in axes[2].values):
-        raise SweepError("--wind: speeds must be at least 0 m/s")
-    for axis in (axes[1], axes[3]):
-        if any(abs(v) > MAX_TURN_DEG for v in axis.values):
-            raise SweepError(
-                f"--{axis.name}: angles from {-MAX_TURN_DEG:g}° to {MAX_TURN_DEG:g}° "
-                "(one turn either way holds every pointing)"
-            )
-    return Grid(tuple(axes))
 
 
 # --- the scene, as sent to the workers -----------------------------------------------
@@ -311,6 +127,24 @@ def compute_chunk(
     :class:`numpy.linalg.LinAlgError`, or returns a value that is not finite (a NaN
     its field does not declare, :attr:`~rt70.sweep.quantities.Field.nan`), leaves its
     fields NaN at that point with an error record.
+
+    Parameters
+    ----------
+    source : SceneSource
+        The scene's file content; each point's scene is built from it with the point's
+        scale factors (:func:`build_scene`, kept per process).
+    grid : Grid
+        The sweep's grid.
+    chunk : Chunk
+        The points computed.
+    quantities : sequence of Quantity
+        The quantities computed at each point.
+
+    Returns
+    -------
+    ChunkResult
+        ``arrays[field]`` shaped ``(stop − start, *field.shape)``, and the error records
+        (``index``, ``point``, ``quantity``, ``error``).
     """
     n = chunk.stop - chunk.start
     arrays = {f.name: np.full((n, *f.shape), np.nan) for q in quantities for f in q.fields}
@@ -392,6 +226,22 @@ def plan(
 ) -> Sweep:
     """Check the sweep can run and read its scene, before any work.
 
+    Parameters
+    ----------
+    target : str or Path
+        A scene name (``rt70_servo``) or the path of a URDF file.
+    grid : Grid
+        The points: elevation first, then azimuth, wind, direction and scale axes.
+    quantities : sequence of str
+        Names of registered quantities (:data:`rt70.sweep.quantities.QUANTITIES`).
+    chunk : int, optional
+        Points per chunk along elevation (≥ 1).
+
+    Returns
+    -------
+    Sweep
+        The scene's content, the grid, the quantities and the chunk size.
+
     Raises
     ------
     Rt70Error
@@ -432,6 +282,15 @@ def peak_bytes(grid: Grid, quantities: Sequence[Quantity], chunk: int) -> int:
 
     ``points × (BYTES_PER_NUMBER × numbers + BYTES_PER_ERROR × quantities) + chunks ×
     BYTES_PER_CHUNK``, every point counted as failed (the most it can hold).
+
+    Parameters
+    ----------
+    grid : Grid
+        The sweep's grid.
+    quantities : sequence of Quantity
+        The quantities computed at each point (their fields' numbers).
+    chunk : int
+        Points per chunk along elevation.
     """
     numbers = sum(math.prod(f.shape) for q in quantities for f in q.fields)
     chunks = math.ceil(grid.shape[0] / chunk) * math.prod(grid.shape[1:])
@@ -441,6 +300,15 @@ def peak_bytes(grid: Grid, quantities: Sequence[Quantity], chunk: int) -> int:
 
 def check_size(grid: Grid, quantities: Sequence[Quantity], chunk: int) -> None:
     """Refuse a sweep whose results this machine cannot hold (:func:`peak_bytes`).
+
+    Parameters
+    ----------
+    grid : Grid
+        The sweep's grid.
+    quantities : sequence of Quantity
+        The quantities computed at each point.
+    chunk : int
+        Points per chunk along elevation.
 
     Raises
     ------

@@ -407,6 +407,15 @@ PARAMETERS: dict[str, SceneParameter] = {
 def check_factors(scene: Scene, name: str, factors: Sequence[float]) -> None:
     """Refuse factors that take a number of the scene beyond what rt70 reads in a model.
 
+    Parameters
+    ----------
+    scene : Scene
+        The unscaled scene.
+    name : str
+        A scene parameter of :data:`PARAMETERS` (``--scale NAME``).
+    factors : sequence of float
+        The factors the sweep applies to it (dimensionless).
+
     Raises
     ------
     Rt70Error

@@ -44,26 +44,20 @@ import numpy as np
 import rt70
 from rt70.errors import OutputError
 from rt70.guards.atomic import atomic_write_all
+from rt70.sweep.errors import ClusterError, SweepError
+from rt70.sweep.grid import AXES, Axis, Chunk, Grid, make_grid, parse_values
 from rt70.sweep.partial import PartialResults, _cannot_write, check_output, check_result, sidecar
 from rt70.sweep.plan import (
-    AXES,
     DEFAULT_CHUNK,
     DEFAULT_QUANTITIES,
     SCENES_KEPT,
-    Axis,
-    Chunk,
     ChunkResult,
-    ClusterError,
-    Grid,
     SceneSource,
     Sweep,
-    SweepError,
     build_scene,
     check_size,
     compute_chunk,
-    make_grid,
     option_name,
-    parse_values,
     peak_bytes,
     plan,
 )

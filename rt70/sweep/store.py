@@ -70,6 +70,20 @@ def checksum(meta: Mapping[str, Any], errors_json: bytes, arrays: Mapping[str, n
 
     The fields enter by name (sorted), shape and little-endian float64 bytes, so the sum
     does not depend on the order of the ZIP members.
+
+    Parameters
+    ----------
+    meta : mapping
+        The chunk's ``meta.json`` record; a ``sha256`` entry in it is left out.
+    errors_json : bytes
+        The chunk's ``errors.json``, as written.
+    arrays : mapping of str to ndarray
+        The chunk's fields, ``(stop − start, *shape)`` each.
+
+    Returns
+    -------
+    str
+        The hexadecimal digest.
     """
     h = hashlib.sha256()
     fixed = {k: v for k, v in meta.items() if k != "sha256"}
@@ -87,7 +101,18 @@ def write_chunk(
 ) -> None:
     """Write a chunk file to ``path`` (a temporary file of :func:`rt70.guards.atomic.atomic_write`).
 
-    ``meta`` gets the layout version and the checksum added.
+    Parameters
+    ----------
+    path : Path
+        The file written (a ZIP of ``meta.json``, ``errors.json`` and one ``.npy`` per
+        field, stored uncompressed).
+    meta : mapping
+        The sweep's ``key`` and the chunk's ``chunk`` number, ``rest``, ``start``,
+        ``stop``; the layout version and the checksum are added.
+    arrays : mapping of str to ndarray
+        The chunk's fields, ``(stop − start, *shape)`` each, written as float64.
+    errors : list of dict
+        The chunk's error records (JSON, no NaN).
     """
     errors_json = json.dumps(errors, allow_nan=False).encode()
     record = {"format": CHUNK_FORMAT, **meta}

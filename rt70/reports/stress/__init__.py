@@ -21,8 +21,8 @@ Modules, one job each:
 - :mod:`~rt70.reports.stress.runs`: capped simulations and how rejected steps are
   counted; the report's sizes (:class:`~rt70.reports.stress.runs.Settings`);
 - :mod:`~rt70.reports.stress.tables`: the report's tables and their markdown;
-- :mod:`~rt70.reports.stress.rt70_cases` and :mod:`~rt70.reports.stress.scaling_cases`:
-  the families of cases;
+- :mod:`~rt70.reports.stress.rt70_cases`, :mod:`~rt70.reports.stress.gimbal_cases` and
+  :mod:`~rt70.reports.stress.scaling_cases`: the families of cases;
 - :mod:`~rt70.reports.stress.report`: the findings and the file
   (:func:`~rt70.reports.stress.report.write_report`).
 """

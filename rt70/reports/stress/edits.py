@@ -53,7 +53,21 @@ def _gain_elements(root: ET.Element) -> list[tuple[ET.Element, str]]:
 
 
 def scale_springs(text: str, stiffness: float = 1.0, damping: float = 1.0) -> str:
-    """Every spring's stiffness × ``stiffness`` and every damper × ``damping``."""
+    """Every spring's stiffness × ``stiffness`` and every damper × ``damping``.
+
+    Parameters
+    ----------
+    text : str
+        URDF text of the scene.
+    stiffness, damping : float, optional
+        Factors on every ``<rt70:joint_spring>``, ``<rt70:bushing>`` and
+        ``<rt70:strut>``'s stiffness and damping (all entries), dimensionless.
+
+    Returns
+    -------
+    str
+        The rewritten URDF text.
+    """
     root = _parse(text)
     for elem, _ in _gain_elements(root):
         _scale_attr(elem, "stiffness", stiffness)
@@ -69,7 +83,27 @@ def _link(root: ET.Element, name: str) -> ET.Element:
 
 
 def scale_link_inertia(text: str, link: str, factor: float) -> str:
-    """Mass and rotational inertia of ``link`` × ``factor`` (centre of mass kept)."""
+    """Mass and rotational inertia of ``link`` × ``factor`` (centre of mass kept).
+
+    Parameters
+    ----------
+    text : str
+        URDF text of the scene.
+    link : str
+        Name of the link, which must have an ``<inertial>``.
+    factor : float
+        Factor on its mass and its six inertia entries, dimensionless.
+
+    Returns
+    -------
+    str
+        The rewritten URDF text.
+
+    Raises
+    ------
+    Rt70Error
+        If there is no such link or it has no ``<inertial>``.
+    """
     root = _parse(text)
     inertial = _link(root, link).find("inertial")
     if inertial is None:
@@ -88,7 +122,26 @@ def _named(root: ET.Element, name: str) -> ET.Element:
 
 
 def set_spring_entry(text: str, name: str, index: int, stiffness: float, damping: float) -> str:
-    """Set entry ``index`` (0..5: x, y, z, rx, ry, rz) of a bushing's stiffness and damping."""
+    """Set entry ``index`` (0..5: x, y, z, rx, ry, rz) of a bushing's stiffness and damping.
+
+    Parameters
+    ----------
+    text : str
+        URDF text of the scene.
+    name : str
+        Name of the ``<rt70:bushing>`` (or strut, or joint spring: then index 0).
+    index : int
+        The entry set: 0..2 translations, 3..5 rotations.
+    stiffness : float
+        The entry's new stiffness, N/m or N·m/rad.
+    damping : float
+        The entry's new damping, N·s/m or N·m·s/rad.
+
+    Returns
+    -------
+    str
+        The rewritten URDF text.
+    """
     root = _parse(text)
     elem = _named(root, name)
     for attr, value in (("stiffness", stiffness), ("damping", damping)):
@@ -127,6 +180,20 @@ def convert_units(text: str, length: float = 1.0, mass: float = 1.0) -> str:
     × μλ². So mm/g/s: lengths × 1e3, masses × 1e3, inertias × 1e9, N/m × 1e3,
     N·m/rad × 1e9; m/kgf/s: every mass, inertia, stiffness and damping ÷ 9.80665.
     Joint ``<dynamics>`` and mesh files are not touched (rt70 uses neither).
+
+    Parameters
+    ----------
+    text : str
+        URDF text of the scene, in SI units.
+    length : float, optional
+        λ, new length units per metre (1e3 for mm).
+    mass : float, optional
+        μ, new mass units per kilogram (1e3 for g, 1/9.80665 for kgf·s²/m).
+
+    Returns
+    -------
+    str
+        The rewritten URDF text.
     """
     lam, mu = float(length), float(mass)
     root = _parse(text)

@@ -78,7 +78,23 @@ def frequencies_hz(scene: Scene, q: np.ndarray | None = None) -> np.ndarray:
 
 
 def cross_check_error(scene: Scene, samples: int = CROSS_CHECK_SAMPLES, seed: int = 0):
-    """Largest relative error of :func:`rt70.crosscheck.validate.cross_check` and its quantity."""
+    """Largest relative error of :func:`rt70.crosscheck.validate.cross_check` and its quantity.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene checked, textbook against Pinocchio.
+    samples : int, optional
+        Random states (:func:`rt70.crosscheck.validate.random_state`: q within ±0.5,
+        q̇ within ±1).
+    seed : int, optional
+        Seed of the random states.
+
+    Returns
+    -------
+    tuple of (float, str, dict of str to float)
+        The largest relative error, its quantity, and each quantity's largest error.
+    """
     records = cross_check(scene, samples=samples, seed=seed, repeat=0)
     worst = max(records, key=lambda r: r.max_rel_err)
     return worst.max_rel_err, worst.quantity, {r.quantity: r.max_rel_err for r in records}
@@ -109,7 +125,23 @@ def rel_error(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def per_body_qdd_error(scene: Scene, samples: int = CROSS_CHECK_SAMPLES, seed: int = 0) -> float:
-    """Largest error of q̈ (textbook against Pinocchio) relative to each body's own |q̈|."""
+    """Largest error of q̈ (textbook against Pinocchio) relative to each body's own |q̈|.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene checked; springs and dampers act, no load.
+    samples : int, optional
+        Random states (q within ±0.5, q̇ within ±1).
+    seed : int, optional
+        Seed of the random states.
+
+    Returns
+    -------
+    float
+        Over the states and the bodies with coordinates, the largest
+        ``max|q̈_tb − q̈_pin| / max|q̈_pin|`` over each body's own coordinates.
+    """
     from rt70 import reference
 
     model, data = scene.textbook, scene.textbook_data
@@ -133,6 +165,21 @@ def momentum_textbook(scene: Scene, q: np.ndarray, qd: np.ndarray):
 
     ``Σ_k [c_k F_k; p_k × c_k F_k + c_k K_k]`` with ``[F_k; K_k] = Θ_k V_k``, ``V = Sᵀ q̇``:
     each body's momentum about its own origin (4.77), moved to the ground frame.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its textbook Data is updated at ``q``.
+    q : ndarray, shape (nv,)
+        Generalised coordinates, rad or m.
+    qd : ndarray, shape (nv,)
+        Generalised velocities, rad/s or m/s.
+
+    Returns
+    -------
+    P, L_O : ndarray, shape (3,)
+        Linear momentum (kg·m/s) and angular momentum about the ground origin
+        (kg·m²/s), ground axes.
     """
     model, data = scene.textbook, scene.textbook_data
     update_structure(model, data, q)
@@ -148,6 +195,21 @@ def momentum_pinocchio(scene: Scene, q: np.ndarray, qd: np.ndarray):
 
     ``pin.computeCentroidalMomentum`` gives ``h_G = [P; L_G]`` at the centre of mass c;
     ``L_O = L_G + c × P``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its Pinocchio data is updated at the state.
+    q : ndarray, shape (nv,)
+        Generalised coordinates in the textbook's order, rad or m.
+    qd : ndarray, shape (nv,)
+        Generalised velocities, rad/s or m/s.
+
+    Returns
+    -------
+    P, L_O : ndarray, shape (3,)
+        Linear momentum (kg·m/s) and angular momentum about the ground origin
+        (kg·m²/s), ground axes.
     """
     import pinocchio as pin
 

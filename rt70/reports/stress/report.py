@@ -11,13 +11,8 @@ import numpy as np
 import scipy
 
 from rt70.guards.atomic import atomic_write_text
-from rt70.reports.stress.rt70_cases import (
-    gimbal_mass_matrix_cases,
-    gimbal_spring_cases,
-    mass_ratio_cases,
-    rigid_mode_cases,
-    stiffness_cases,
-)
+from rt70.reports.stress.gimbal_cases import gimbal_mass_matrix_cases, gimbal_spring_cases
+from rt70.reports.stress.rt70_cases import mass_ratio_cases, rigid_mode_cases, stiffness_cases
 from rt70.reports.stress.runs import Settings
 from rt70.reports.stress.scaling_cases import free_floating_cases, long_chain_cases, unit_cases
 from rt70.reports.stress.tables import Table, worst_value
@@ -114,8 +109,20 @@ def write_report(
 ) -> Path:
     """Run every family and write ``stress.md`` (atomically) into ``directory``.
 
-    ``quick`` runs a reduced set (a few k per family, the smallest chain, 0.02 s
-    simulations): a smoke test of the whole report in seconds.
+    Parameters
+    ----------
+    directory : str or Path
+        Output directory; created if missing.
+    quick : bool, optional
+        Run a reduced set (a few k per family, the smallest chain, 0.02 s simulations):
+        a smoke test of the whole report in seconds.
+    log : callable (str) -> None, optional
+        Receives one line per family, with its run time.
+
+    Returns
+    -------
+    Path
+        The written ``stress.md``.
     """
     start = time.perf_counter()
     tables: dict[str, Table] = {}
