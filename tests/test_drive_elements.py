@@ -19,8 +19,8 @@ from rt70.control.drives import DcDrive, scene_drive, scene_drives
 from rt70.errors import ExtensionError, Rt70Error
 from rt70.model.scene import load_scene
 from rt70.reference import drives as ref_drives
-from rt70.scenes.listing_scenes import lumped_drive
 from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
+from rt70.scenes.rt70_scenes import lumped_drive
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.testing import MIN_REL, assert_close
 from rt70.textbook import drives as tb_drives

@@ -2,7 +2,7 @@
 
 The data live in :mod:`rt70.scenes.rt70_data` (the RT-70 listing of §4.2.3 and the
 chapter-2 tables) and :mod:`rt70.scenes.mechanisms` (small test mechanisms);
-:mod:`rt70.scenes.listing_scenes`, :mod:`rt70.scenes.book_scenes` and
+:mod:`rt70.scenes.rt70_scenes`, :mod:`rt70.scenes.book_scenes` and
 :mod:`rt70.scenes.loop_scenes` write them as scenes with :mod:`rt70.scenes.urdf_writer`,
 and :mod:`rt70.scenes.generate` writes the URDF files under ``urdf/``
 (``python -m rt70.scenes.generate [DIR]``).

@@ -1,7 +1,7 @@
 """Build the rt70 scene URDF files from the book's data.
 
 Every scene is a function returning the URDF text (the RT-70 listing's in
-:mod:`rt70.scenes.listing_scenes`, the chapter-2 models and mechanisms in
+:mod:`rt70.scenes.rt70_scenes`, the chapter-2 models and mechanisms in
 :mod:`rt70.scenes.book_scenes`, the closed chains in :mod:`rt70.scenes.loop_scenes`);
 :data:`SCENES` maps scene names to them and :func:`write_all` writes ``<name>.urdf``
 files. The output is deterministic (:mod:`rt70.scenes.urdf_writer`: fixed element and
@@ -30,8 +30,8 @@ from rt70.scenes.book_scenes import (
     three_masses_scene,
     two_body_gravity_scene,
 )
-from rt70.scenes.listing_scenes import rt70_jack_scene, rt70_scene, rt70_servo_scene
 from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene
+from rt70.scenes.rt70_scenes import rt70_jack_scene, rt70_scene, rt70_servo_scene
 
 #: Default output directory: ``urdf/`` at the repository root.
 DEFAULT_DIRECTORY = Path(__file__).resolve().parents[2] / "urdf"

@@ -5,7 +5,7 @@ the same float; :class:`Writer` writes elements with a fixed attribute order and
 two-space indentation; :func:`begin`, :func:`joint`, :func:`massless_link`,
 :func:`massive_link`, :func:`six_dof_body` (the book's 6-DOF elastic pair),
 :func:`gravity`, :func:`bushing` and :func:`end` write a scene's elements, following
-``docs/urdf-extensions.md``. The scenes themselves are in :mod:`rt70.scenes.listing_scenes`,
+``docs/urdf-extensions.md``. The scenes themselves are in :mod:`rt70.scenes.rt70_scenes`,
 :mod:`rt70.scenes.book_scenes` and :mod:`rt70.scenes.loop_scenes`, gathered by
 :mod:`rt70.scenes.generate`.
 """
