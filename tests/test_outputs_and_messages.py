@@ -350,6 +350,9 @@ def test_option_at_fault_keeps_the_class_and_prefixes_the_option():
     with pytest.raises(LinearModelError) as info, option_at_fault("--reduce 7"):
         raise LinearModelError("order must be between 1 and 6")
     assert str(info.value) == "--reduce 7: order must be between 1 and 6"
+    with pytest.raises(LinearModelError) as info, option_at_fault("--reduce 7"):
+        raise LinearModelError("--reduce 7: order must be between 1 and 6")
+    assert str(info.value) == "--reduce 7: order must be between 1 and 6"  # named once
     with option_at_fault("--x 1"):  # nothing raised: nothing changes
         pass
 

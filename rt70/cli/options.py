@@ -304,6 +304,8 @@ def option_at_fault(option: str) -> Iterator[None]:
     try:
         yield
     except Rt70Error as exc:
+        if str(exc).startswith(f"{option}: "):  # the library named it already
+            raise
         raise type(exc)(f"{option}: {exc}") from None
     except RuntimeWarning as exc:
         raise Rt70Error(f"{option}: {numerical_message(exc)}") from None
