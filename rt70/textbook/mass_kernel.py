@@ -359,6 +359,16 @@ def mass_matrix_batch(model: Model, data: KernelData, Q: np.ndarray) -> np.ndarr
 
     Equal to :func:`rt70.textbook.structured.mass_matrix_batch` to round-off. The
     returned array is ``data.A``, overwritten by the next call with the same ``data``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : KernelData
+        ``KernelData(model, K)``: the kernel's arrays and ``data.A``.
+    Q : numpy.ndarray, shape (K, nv)
+        One configuration per row, in the model's coordinates (``Model.coordinate_names``),
+        rad or m.
     """
     Q = _check_batch("Q", Q, model.nv)
     data = _data_for(model, Q.shape[0], data, KernelData)
@@ -376,7 +386,17 @@ def _compute(model: Model, data: KernelData, Q: np.ndarray) -> None:
 
 
 def mass_matrix(model: Model, data: KernelData, q: np.ndarray) -> np.ndarray:
-    """``A = S Θ Sᵀ`` at one configuration by the kernel, a new array (``KernelData(model, 1)``)."""
+    """``A = S Θ Sᵀ`` at one configuration by the kernel, a new array (``KernelData(model, 1)``).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : KernelData
+        ``KernelData(model, 1)``.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     data = _data_for(model, 1, data, KernelData)
     _compute(model, data, q[None, :])
