@@ -3,13 +3,13 @@
 The kernels of :mod:`rt70.reference.element_kernels` (read its docstring first), on
 the tables of :mod:`rt70.reference.element_tables`: for each pair of frames, the
 joints from their common ancestor down to each frame are composed,
-``frame i = Π_k (placement_k · X_k(q_k)) · P_i`` (:func:`_pair_pose`), recording each
+``frame i = Π_k (placement_k · X_k(q_k)) · P_i`` (``_pair_pose``), recording each
 joint's origin ``o_k`` and axis ``a_k``; frame 2 in frame 1 and the columns of its
 Jacobian follow (:func:`relative_points`), and for the bushings the deformation
 ``δ = [r12; −rpy(c12ᵀ)]``, its Jacobian, and the forces, gains and potential of
 every element (:func:`evaluate`, and :func:`evaluate_packed` on the two arrays of
 :func:`rt70.reference.element_tables.pack`). Explicit 3×3 loops, no BLAS, no
-allocation per call (the scratch is one buffer, :func:`_walk_scratch`); compiled on
+allocation per call (the scratch is one buffer, ``_walk_scratch``); compiled on
 first use and cached on disk.
 """
 
