@@ -175,10 +175,10 @@ def test_compiled_drive_angle_and_force_equal_pinocchios():
 def test_a_new_element_kind_turns_the_kernels_off(monkeypatch):
     """A kind added to the reference side's ELEMENTS but not to the kernels must not be
     left out silently: the backend falls back to the Python path."""
-    from rt70.reference import element_kernels
+    from rt70.reference import element_tables
 
     scene = load_scene("rt70")
-    assert tuple(forces.ELEMENTS) == element_kernels.COVERED
+    assert tuple(forces.ELEMENTS) == element_tables.COVERED
     assert ElementKernels.of(scene.reference) is not None
     monkeypatch.setitem(forces.ELEMENTS, "new_kind", lambda *a: None)
     assert ElementKernels.of(scene.reference) is None

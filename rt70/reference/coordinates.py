@@ -26,6 +26,17 @@ def to_pinocchio(model: ReferenceModel, q: np.ndarray, qd: np.ndarray | None = N
     of the reference side passes its state through here: a wrong shape raises
     :class:`~rt70.errors.ShapeError`, a NaN or infinity
     :class:`~rt70.errors.NonFiniteError` (as on the textbook side).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    qd : numpy.ndarray, shape (nv,), optional
+        Generalised velocities, rad/s or m/s; None: only the configuration is mapped
+        (``v`` is None, ``J̇ q̇`` zero).
     """
     q = check_vector("q", q, model.nv)
     qd = None if qd is None else check_vector("qd", qd, model.nv)

@@ -26,7 +26,20 @@ from rt70.urdf.description import Drive
 
 
 def link_pose(model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: str) -> Pose:
-    """Rotation and origin of ``link``'s frame in ground axes at q (Pinocchio's placements)."""
+    """Rotation and origin of ``link``'s frame in ground axes at q (Pinocchio's placements).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    link : str
+        Name of a URDF link of the scene.
+    """
     m, d = model.pin_model, data.pin_data
     joint, placement = link_point(model, link, np.zeros(3))
     qp = to_pinocchio(model, q)[0]
@@ -36,7 +49,17 @@ def link_pose(model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: s
 
 
 def sector_mesh(model: ReferenceModel, data: ReferenceData, drive: Drive) -> SectorMesh:
-    """The sector's pitch circle in the stator frame, from Pinocchio's poses at q = 0."""
+    """The sector's pitch circle in the stator frame, from Pinocchio's poses at q = 0.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: one with a gear sector.
+    """
     s = drive.sector
     q0 = np.zeros(model.nv)
     link, stator = link_pose(model, data, q0, s.link), link_pose(model, data, q0, s.stator)
@@ -63,7 +86,23 @@ def _joint_torque(
 def drive_angle(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, drive: Drive, mesh=None
 ) -> float:
-    """θ_d at q, rad: the joint's configuration, or the sector's mesh angle."""
+    """θ_d at q, rad: the joint's configuration, or the sector's mesh angle.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: a torque on a joint's coordinate, or a gear sector.
+    mesh : rt70.physics.loads.SectorMesh, optional
+        The sector's pitch circle of :func:`sector_mesh`; computed here when None (pass it to
+        save two placements per call).
+    """
     if drive.sector is None:
         return _joint_torque(model, q, drive.joint, 0.0)[0]
     s = drive.sector
@@ -84,6 +123,23 @@ def drive_force(
 
     ``Q = Jᵀ τ`` of the joint torque (4.143), or ``Jᵀ f`` of the mesh force and its
     reaction (4.150), ``K ∂θ_d/∂q``; with ``torque = 1`` Q is the gradient.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: a torque on a joint's coordinate, or a gear sector.
+    torque : float
+        The reducer torque K, N·m; 1 gives the gradient ``∂θ_d/∂q`` as Q.
+    mesh : rt70.physics.loads.SectorMesh, optional
+        The sector's pitch circle of :func:`sector_mesh`; computed here when None (pass it to
+        save two placements per call).
     """
     if drive.sector is None:
         return _joint_torque(model, q, drive.joint, torque)
@@ -104,6 +160,17 @@ def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Driv
     two placements and two point Jacobians from Pinocchio per evaluation; the same
     numbers (tested). A joint drive, mapped coordinates (mimic joints) or a path the
     kernels do not support keep :func:`drive_force`.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: a torque on a joint's coordinate, or a gear sector.
+    mesh : rt70.physics.loads.SectorMesh, optional
+        The sector's pitch circle of :func:`sector_mesh`; computed once here when None.
     """
     if drive.sector is None or not model.identity_map:
         return lambda q: drive_force(model, data, q, drive, 1.0, mesh)

@@ -22,7 +22,18 @@ def _crba(model: ReferenceModel, data: ReferenceData, qp: np.ndarray) -> np.ndar
 
 
 def mass_matrix(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np.ndarray:
-    """``A = Jᵀ crba J`` (``J`` includes the map to the user's order)."""
+    """``A = Jᵀ crba J`` (``J`` includes the map to the user's order).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, J, _ = to_pinocchio(model, q)
     A = _crba(model, data, qp)
     return A if J is None else J.T @ A @ J
@@ -31,7 +42,18 @@ def mass_matrix(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np
 def bias_force(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
 ) -> np.ndarray:
-    """``B(q, q̇) q̇ = Jᵀ rnea(q, v, J̇ q̇)`` with gravity switched off."""
+    """``B(q, q̇) q̇ = Jᵀ rnea(q, v, J̇ q̇)`` with gravity switched off.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
     pm, pd = model.pin_model_no_gravity, data.pin_data_no_gravity
     if J is None:
@@ -40,7 +62,18 @@ def bias_force(
 
 
 def gravity_force(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np.ndarray:
-    """Generalised gravity force on the right-hand side: ``−Jᵀ g(q)``."""
+    """Generalised gravity force on the right-hand side: ``−Jᵀ g(q)``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, J, _ = to_pinocchio(model, q)
     g = pin.computeGeneralizedGravity(model.pin_model, data.pin_data, qp)
     return -g if J is None else -(J.T @ g)
@@ -56,6 +89,16 @@ def forward_dynamics(
     Pinocchio's velocity space), so that the comparison checks them too. With mimic
     joints (a constraint ABA cannot take) the reduced equations
     ``Jᵀ A J q̈ = Jᵀ (τ − rnea(q, v, J̇ q̇))`` are solved with Pinocchio's CRBA and RNEA.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
     """
     qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
     Qc, Qd = element_torques(model, data, qp, vp)
@@ -74,13 +117,35 @@ def forward_dynamics(
 def kinetic_energy(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
 ) -> float:
-    """``pin.computeKineticEnergy``."""
+    """``pin.computeKineticEnergy``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, vp, _, _ = to_pinocchio(model, q, qd)
     return float(pin.computeKineticEnergy(model.pin_model, data.pin_data, qp, vp))
 
 
 def gravity_potential(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> float:
-    """``pin.computePotentialEnergy`` (gravity only)."""
+    """``pin.computePotentialEnergy`` (gravity only).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, _, _ = to_pinocchio(model, q)
     return float(pin.computePotentialEnergy(model.pin_model, data.pin_data, qp))
 
@@ -92,6 +157,16 @@ def weight_moment(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> 
     ``oMi`` and inertia levers). It is the size of the terms that gravity torques and
     the gravity potential are sums and differences of (the natural scale of
     :func:`rt70.crosscheck.scales.natural_scales`), in N·m = J.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
     """
     qp, _, _, _ = to_pinocchio(model, q)
     pm, pd = model.pin_model, data.pin_data

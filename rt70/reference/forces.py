@@ -134,7 +134,19 @@ Elements = CoordinateElements | GeneralElements
 def joint_spring_elements(
     model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
 ) -> CoordinateElements | None:
-    """Joint springs: δ is the joint's coordinate, read from Pinocchio's ``q``."""
+    """Joint springs: δ is the joint's coordinate, read from Pinocchio's ``q``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
+    jacobian : bool
+        Whether to compute the Jacobians ``∂δ/∂v`` too (unused: a joint spring's is a unit row).
+    """
     if not model.spring_v.size:
         return None
     return CoordinateElements(model, qp, model.spring_v, model.spring_k, model.spring_d)
@@ -143,7 +155,19 @@ def joint_spring_elements(
 def bushing_elements(
     model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
 ) -> GeneralElements | None:
-    """Bushings and struts: :func:`deformations` from Pinocchio's frame kinematics."""
+    """Bushings and struts: :func:`deformations` from Pinocchio's frame kinematics.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
+    jacobian : bool
+        Whether to compute the Jacobians ``∂δ/∂v`` too (the potential needs none).
+    """
     if not model.bushings:
         return None
     delta, jac = deformations(model, data, qp, jacobian=jacobian)
@@ -163,7 +187,19 @@ ELEMENTS: dict[str, Callable[..., Elements | None]] = {
 def elements(
     model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jacobian: bool = True
 ) -> list[Elements]:
-    """The deformations of every element at Pinocchio's ``qp``, kind by kind."""
+    """The deformations of every element at Pinocchio's ``qp``, kind by kind.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
+    jacobian : bool
+        Whether to compute the Jacobians ``∂δ/∂v`` too (the potential needs none).
+    """
     found = [kind(model, data, qp, jacobian) for kind in ELEMENTS.values()]
     return [e for e in found if e is not None]
 
@@ -171,7 +207,18 @@ def elements(
 def spring_damper_force(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Spring force ``Q_c`` and damper force ``Q_d`` in book coordinates: ``Jᵀ τ``."""
+    """Spring force ``Q_c`` and damper force ``Q_d`` in book coordinates: ``Jᵀ τ``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     Qc, Qd = element_torques(model, data, qp, vp)
     return (Qc, Qd) if J is None else (J.T @ Qc, J.T @ Qd)
@@ -186,6 +233,16 @@ def element_torques(
     :func:`~rt70.reference.coordinates.to_pinocchio`), and so are the results (its
     velocity space): the form ``pin.aba`` takes as ``tau``, used by the simulation's
     fast path.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp, vp : numpy.ndarray
+        Pinocchio's configuration (nq,) and velocity (nv_pin,)
+        (:func:`~rt70.reference.coordinates.to_pinocchio`).
     """
     nv = model.pin_model.nv
     Qc, Qd = np.zeros(nv), np.zeros(nv)
@@ -203,6 +260,15 @@ def element_gains(
     ``−∂τ_c/∂v`` without the term of the deformation's second derivative (the
     Gauss–Newton part) and ``−∂τ_d/∂v`` exactly: what an implicit integrator's
     Jacobian needs besides ``pin.computeABADerivatives``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
     """
     n = model.pin_model.nv
     K, D = np.zeros((n, n)), np.zeros((n, n))
@@ -213,7 +279,18 @@ def element_gains(
 
 
 def spring_potential(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> float:
-    """``Σ ½ δᵀ C δ`` with δ from Pinocchio's frame placements."""
+    """``Σ ½ δᵀ C δ`` with δ from Pinocchio's frame placements.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, _, _ = to_pinocchio(model, q)
     U = 0.0
     for e in elements(model, data, qp, jacobian=False):
@@ -230,6 +307,16 @@ def spring_damper_magnitudes(
     value (joint springs ``|k q|``, bushings ``|∂δ/∂q|ᵀ |C δ|`` and
     ``|∂δ/∂q|ᵀ |D δ̇|``): forces of elements that oppose each other cancel in the sum
     but not here. The natural scale of :func:`rt70.crosscheck.scales.natural_scales`.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
     """
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     nv = model.pin_model.nv
@@ -252,6 +339,17 @@ def deformations(model: ReferenceModel, data: ReferenceData, qp: np.ndarray, jac
     ``pin.rpy.matrixToRpy`` / ``computeRpyJacobianInverse``, checked against them in
     the tests). ``c12 = Rx(β) Ry(θ) Rz(α)`` has ``c12ᵀ`` with rpy ``ρ = −[β, θ, α]``;
     the angular velocity of frame 2 relative to frame 1 is ``ω = J_W(ρ) φ̇``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
+    jacobian : bool
+        Whether to compute the Jacobians ``∂δ/∂v`` too (the potential needs none).
     """
     m, d = model.pin_model, data.pin_data
     qp = check_vector("qp", qp, m.nq)

@@ -73,6 +73,19 @@ def pin_rows(
 
     ``qp`` is Pinocchio's configuration: the point's velocity rows of
     :func:`rt70.reference.points.point_jacobian_pinocchio`.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
     """
     return point_jacobian_pinocchio(model, data, qp, link, xyz)[:3]
 
@@ -84,7 +97,23 @@ def constraint_rows(
     brakes: Sequence[str] = (),
     pins: Sequence[tuple[str, np.ndarray]] = (),
 ) -> np.ndarray:
-    """The locks' rows in Pinocchio's velocity space, (m, nv_pin): brakes, then pins."""
+    """The locks' rows in Pinocchio's velocity space, (m, nv_pin): brakes, then pins.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    brakes : sequence of str
+        The braked joints (1-DOF), one row each.
+    pins : sequence of (str, array_like)
+        The stow pins: a link and the point fixed to the ground in the link's frame (m),
+        three rows each.
+    """
     qp, _, _, _ = to_pinocchio(model, q)
     rows = [brake_row(model, j)[None] for j in brakes]
     rows += [pin_rows(model, data, qp, link, xyz) for link, xyz in pins]
@@ -98,7 +127,23 @@ def book_rows(
     brakes: Sequence[str] = (),
     pins: Sequence[tuple[str, np.ndarray]] = (),
 ) -> np.ndarray:
-    """The locks' rows ``B_c = J_c J`` in the book's coordinates, (m, nv)."""
+    """The locks' rows ``B_c = J_c J`` in the book's coordinates, (m, nv).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    brakes : sequence of str
+        The braked joints (1-DOF), one row each.
+    pins : sequence of (str, array_like)
+        The stow pins: a link and the point fixed to the ground in the link's frame (m),
+        three rows each.
+    """
     _, _, J, _ = to_pinocchio(model, q)
     J_c = constraint_rows(model, data, q, brakes, pins)
     return J_c if J is None else J_c @ J

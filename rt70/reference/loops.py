@@ -45,7 +45,18 @@ def _frames(model: ReferenceModel, data: ReferenceData):
 
 
 def loop_residual(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np.ndarray:
-    """Φ(q), shape (m,): ``p₁ − p₂`` (and ``log₃(R₁R₂ᵀ)``) in ground axes."""
+    """Φ(q), shape (m,): ``p₁ − p₂`` (and ``log₃(R₁R₂ᵀ)``) in ground axes.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, _, _ = to_pinocchio(model, q)
     pin.forwardKinematics(model.pin_model, data.pin_data, qp)
     parts = []
@@ -86,7 +97,18 @@ def _rotations(model: ReferenceModel, data: ReferenceData) -> np.ndarray:
 
 
 def loop_jacobian(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> np.ndarray:
-    """``B_c``, shape (m, nv): ``R₁ · getConstraintJacobian · J`` (``B_c q̇ = Φ̇``)."""
+    """``B_c``, shape (m, nv): ``R₁ · getConstraintJacobian · J`` (``B_c q̇ = Φ̇``).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, J, _ = to_pinocchio(model, q)
     m, d = model.pin_model, data.pin_data
     if not model.loops:
@@ -104,7 +126,18 @@ def loop_jacobian(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> 
 def loop_bias(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
 ) -> np.ndarray:
-    """``C = Ḃ_c q̇``, shape (m,): the frames' relative acceleration at ``q̈ = 0``."""
+    """``C = Ḃ_c q̇``, shape (m,): the frames' relative acceleration at ``q̈ = 0``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, vp, _, Jdqd = to_pinocchio(model, q, qd)
     m, d = model.pin_model, data.pin_data
     pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv) if Jdqd is None else Jdqd)
@@ -139,6 +172,21 @@ def constrained_forward_dynamics(
     τ holds the scene's springs and dampers (Pinocchio's own, :func:`element_torques`)
     and ``J⁻ᵀ Q``; ``q̈ = J⁻¹ (a − J̇ q̇)``. Raises :class:`~rt70.errors.Rt70Error` for a
     scene with mimic joints (Pinocchio's constraint dynamics has no mimic constraint).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model, with its loops.
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    Q : numpy.ndarray, shape (nv,), optional
+        Further generalised forces (inputs) in the book's coordinates, N or N·m.
+    stabilization : rt70.physics.baumgarte.Baumgarte, optional
+        Gains of ``Φ̈ + 2ζω Φ̇ + ω² Φ = 0`` (Pinocchio's ``Kp = ω²``, ``Kd = 2ζω``);
+        None: ``Φ̈ = 0``.
     """
     qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
     if J is not None and J.shape[0] != J.shape[1]:

@@ -30,7 +30,20 @@ def _frame(model: ReferenceModel, data: ReferenceData, link: str):
 def constraint_matrix(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, elements: Sequence[NoSlip]
 ) -> np.ndarray:
-    """``A(q)`` (m × nv): one row ``dᵀ (J_v + a [n]× J_ω)`` per element (1.1)."""
+    """``A(q)`` (m × nv): one row ``dᵀ (J_v + a [n]× J_ω)`` per element (1.1).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    elements : sequence of rt70.urdf.description.NoSlip
+        The ``<rt70:no_slip>`` constraints, one row each.
+    """
     A = np.zeros((len(elements), model.nv))
     for i, e in enumerate(elements):
         Jv, Jw = point_jacobian(model, data, q, e.link, e.xyz)  # runs forwardKinematics
@@ -46,7 +59,20 @@ def constraint_bias(
     qd: np.ndarray,
     elements: Sequence[NoSlip],
 ) -> np.ndarray:
-    """``Ȧ q̇`` (m,): ``ċ`` of every row at ``q̈ = 0`` (Pinocchio's bias accelerations)."""
+    """``Ȧ q̇`` (m,): ``ċ`` of every row at ``q̈ = 0`` (Pinocchio's bias accelerations).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    elements : sequence of rt70.urdf.description.NoSlip
+        The ``<rt70:no_slip>`` constraints, one row each.
+    """
     qp, vp, _, Jdqd = to_pinocchio(model, q, qd)
     m, d = model.pin_model, data.pin_data
     pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv) if Jdqd is None else Jdqd)
@@ -79,6 +105,22 @@ def reduced_terms(
 
     ``qd`` is the full ``𝔅 q̇_ind``; both are mapped to Pinocchio's velocities by ``J``
     (``v = J q̇``, ``v̇ = J q̈ + J̇ q̇``) and back by ``Jᵀ``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    qd : numpy.ndarray, shape (nv,)
+        The full velocities ``𝔅 q̇_ind``, rad/s or m/s.
+    basis : numpy.ndarray, shape (nv, n_ind)
+        The velocity map 𝔅 (``q̇ = 𝔅 q̇_ind``, rows in the full order).
+    basis_rate_qd : numpy.ndarray, shape (nv,)
+        ``𝔅̇ q̇_ind``, rad/s² or m/s².
     """
     qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
     pm, pd = model.pin_model_no_gravity, data.pin_data_no_gravity

@@ -28,6 +28,15 @@ from rt70.reference.model import ReferenceData, ReferenceModel
 def link_point(model: ReferenceModel, link: str, xyz) -> tuple[int, pin.SE3]:
     """Pinocchio's parent joint of ``link`` and the placement of the point in it.
 
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
+
     Raises
     ------
     UnknownLinkError
@@ -51,6 +60,18 @@ def point_positions(
 
     One ``pin.forwardKinematics`` for all of them; each is ``(oMi[joint] · placement)``'s
     translation.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    points : sequence of (str, array_like)
+        The points: a link's name and the point in the link's frame (m).
     """
     located = [link_point(model, link, xyz) for link, xyz in points]
     qp, _, _, _ = to_pinocchio(model, q)
@@ -65,7 +86,22 @@ def point_positions(
 def point_position(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, link: str, xyz
 ) -> np.ndarray:
-    """Ground-axis position (3,) of the point ``xyz`` of ``link`` at q, in m."""
+    """Ground-axis position (3,) of the point ``xyz`` of ``link`` at q, in m.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
+    """
     return point_positions(model, data, q, [(link, xyz)])[0]
 
 
@@ -81,6 +117,19 @@ def point_jacobian_pinocchio(
     without passing through the ground origin: that form shifts velocities taken at the
     origin back to the point, which costs ε times the point's distance from the origin
     (1e-12 relative on the RT-70 in millimetres, against 1e-16 here).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    qp : numpy.ndarray, shape (nq,)
+        Pinocchio's configuration (:func:`~rt70.reference.coordinates.to_pinocchio`).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
     """
     joint, placement = link_point(model, link, xyz)
     m, d = model.pin_model, data.pin_data
@@ -97,6 +146,20 @@ def point_jacobian(
     """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
 
     :func:`point_jacobian_pinocchio` times ``J`` (book coordinates → Pinocchio's ``v``).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
     """
     qp, _, J, _ = to_pinocchio(model, q)
     jac = point_jacobian_pinocchio(model, data, qp, link, xyz)
@@ -112,6 +175,18 @@ def generalized_force(
 
     ``J`` is the point's ``LOCAL_WORLD_ALIGNED`` frame Jacobian in book coordinates
     (:func:`point_jacobian`); the result is what the load adds to the right-hand side.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    wrench : rt70.physics.loads.Wrench
+        A force (N) at a point of a link and a torque (N·m) on it, ground axes.
     """
     Jv, Jw = point_jacobian(model, data, q, wrench.link, wrench.xyz)
     return Jv.T @ np.asarray(wrench.force) + Jw.T @ np.asarray(wrench.torque)

@@ -39,6 +39,21 @@ def joint_reactions(
     ``pin.rnea(q, v, a, fext)`` and ``data.f[i]`` per Pinocchio joint (in Pinocchio's
     joint order; URDF ``fixed`` joints are frames, not joints). Arguments as
     :func:`rt70.textbook.reactions.joint_reactions`.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd, qdd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m), velocities (rad/s or m/s) and accelerations
+        (rad/s² or m/s²) in the book's order (:func:`rt70.urdf.coordinate_names`).
+    wrenches : iterable of rt70.physics.loads.Wrench
+        Loads on links (ground axes, at a point of the link); a load on the ground link
+        is carried by no joint and ignored.
+    gravity : bool
+        Include gravity (the base accelerates by −g).
     """
     qdd = check_vector("qdd", qdd, model.nv)
     qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
@@ -61,6 +76,20 @@ def reaction_impulses(
     """Reaction impulses for a velocity jump Δq̇: ``rnea(q, 0, J Δq̇, fext = impulses)``.
 
     Gravity off (source 004 (16), Algorithm 004-D's Pinocchio equivalent).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    dqd : numpy.ndarray, shape (nv,)
+        The velocity jump Δq̇, rad/s or m/s.
+    impulses : iterable of rt70.physics.loads.Wrench
+        Impulses on links (ground axes; N·s and N·m·s in the force and torque fields).
     """
     zero = np.zeros(model.nv)
     return joint_reactions(model, data, q, zero, dqd, impulses, gravity=False)
@@ -74,6 +103,15 @@ def external_forces(
     The force and torque (ground axes) are turned to the point frame's axes by its
     rotation ``(oMi · placement).rotation`` and moved to the joint by the placement's
     action — never through the ground origin. Needs ``oMi`` (a forward pass).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    pin_data : pinocchio.Data
+        Pinocchio's data after a forward pass (its ``oMi``).
+    wrenches : iterable of rt70.physics.loads.Wrench
+        Loads on links, ground axes; those on the ground link are left out.
     """
     fext = [pin.Force.Zero() for _ in range(model.pin_model.njoints)]
     for w in wrenches:
@@ -89,7 +127,18 @@ def external_forces(
 def joint_frames(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray
 ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Ground rotation and origin of every joint frame at q (``oMi``), for ground-axis reports."""
+    """Ground rotation and origin of every joint frame at q (``oMi``), for ground-axis reports.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    """
     qp, _, _, _ = to_pinocchio(model, q)
     pm, pd = model.pin_model, data.pin_data
     pin.forwardKinematics(pm, pd, qp)

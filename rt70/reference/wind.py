@@ -22,7 +22,20 @@ from rt70.reference.points import generalized_force, link_point
 def wind_wrenches(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, condition: WindCondition
 ) -> dict[str, Wrench]:
-    """The wind's Wrench on every exposed body at q, by element name (ground axes)."""
+    """The wind's Wrench on every exposed body at q, by element name (ground axes).
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    condition : rt70.physics.aerodynamics.WindCondition
+        The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
+    """
     return {
         w.name: wind_wrench(w, link_pose(model, data, q, w.link), condition, model.air_density)
         for w in model.winds
@@ -32,7 +45,20 @@ def wind_wrenches(
 def wind_forces(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, condition: WindCondition
 ) -> dict[str, np.ndarray]:
-    """Generalised force (nv,) of each exposed body at q, by element name: ``Jᵀ f_i``."""
+    """Generalised force (nv,) of each exposed body at q, by element name: ``Jᵀ f_i``.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    condition : rt70.physics.aerodynamics.WindCondition
+        The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
+    """
     wrenches = wind_wrenches(model, data, q, condition)
     return {name: generalized_force(model, data, q, w) for name, w in wrenches.items()}
 
@@ -40,7 +66,20 @@ def wind_forces(
 def wind_force(
     model: ReferenceModel, data: ReferenceData, q: np.ndarray, condition: WindCondition
 ) -> np.ndarray:
-    """Generalised wind force (nv,) at q: ``Q_w = Jᵀ f`` summed over the exposed bodies."""
+    """Generalised wind force (nv,) at q: ``Q_w = Jᵀ f`` summed over the exposed bodies.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order
+        (:func:`rt70.urdf.coordinate_names`).
+    condition : rt70.physics.aerodynamics.WindCondition
+        The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
+    """
     Q = np.zeros(model.nv)
     for value in wind_forces(model, data, q, condition).values():
         Q += value

@@ -35,7 +35,19 @@ from rt70.urdf.description import Drive
 
 
 def link_pose(model: Model, data: Data, q: np.ndarray, link: str) -> Pose:
-    """Rotation and origin of ``link``'s frame in ground axes at q (one forward pass)."""
+    """Rotation and origin of ``link``'s frame in ground axes at q (one forward pass).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    link : str
+        Name of a URDF link of the scene.
+    """
     if link not in model.link_frames:
         raise UnknownLinkError(f"{model.name}: no link '{link}' with a frame in the textbook model")
     data.q_full = model.expand(check_vector("q", q, model.nv))
@@ -63,7 +75,17 @@ def _wrench_force(model: Model, data: Data, link: str, xyz, force: np.ndarray) -
 
 
 def sector_mesh(model: Model, data: Data, drive: Drive) -> SectorMesh:
-    """The sector's pitch circle in the stator frame, from this side's poses at q = 0."""
+    """The sector's pitch circle in the stator frame, from this side's poses at q = 0.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: one with a gear sector.
+    """
     s = drive.sector
     q0 = np.zeros(model.nv)
     link, stator = link_pose(model, data, q0, s.link), link_pose(model, data, q0, s.stator)
@@ -75,6 +97,20 @@ def drive_angle(model: Model, data: Data, q: np.ndarray, drive: Drive, mesh=None
     """θ_d at q, rad: the joint's coordinate, or the sector's mesh angle.
 
     ``mesh`` is :func:`sector_mesh`'s circle, computed here when not given.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: a torque on a joint's coordinate, or a gear sector.
+    mesh : rt70.physics.loads.SectorMesh, optional
+        The sector's pitch circle of :func:`sector_mesh`; computed here when None (pass it
+        to save two forward passes per call).
     """
     q = check_vector("q", q, model.nv)
     if drive.sector is None:
@@ -93,6 +129,22 @@ def drive_force(
     ``Q = K e_k`` for a torque drive (4.143); for a sector, ``Q = S U`` of the mesh
     force on the link and its reaction on the stator (4.150), which is
     ``K ∂θ_d/∂q``. With the default ``torque = 1`` Q is the gradient ∂θ_d/∂q.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: a torque on a joint's coordinate, or a gear sector.
+    torque : float
+        The reducer torque K, N·m; 1 gives the gradient ``∂θ_d/∂q`` as Q.
+    mesh : rt70.physics.loads.SectorMesh, optional
+        The sector's pitch circle of :func:`sector_mesh`; computed here when None (pass it
+        to save two forward passes per call).
     """
     q = check_vector("q", q, model.nv)
     if drive.sector is None:

@@ -19,14 +19,35 @@ from rt70.textbook.spatial import check_euler_pairs, crf
 
 
 def mass_matrix(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
-    """Mass matrix ``A = S Θ Sᵀ`` (4.79)."""
+    """Mass matrix ``A = S Θ Sᵀ`` (4.79).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     S = update_structure(model, data, q)
     data.A = S @ data.Theta @ S.T
     return data.A
 
 
 def body_velocities(model: Model, data: Data, qd: np.ndarray) -> np.ndarray:
-    """Absolute body velocities ``V⁰ = Sᵀ q̇`` (4.63), each in its own body frame."""
+    """Absolute body velocities ``V⁰ = Sᵀ q̇`` (4.63), each in its own body frame.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers, with S of the configuration (:func:`update_structure`); ``data.V``
+        is set here.
+    qd : numpy.ndarray, shape (nv,)
+        Generalised velocities, rad/s or m/s.
+    """
     qd = check_vector("qd", qd, model.nv)
     data.V = (data.S.T @ qd).reshape(model.nb, 6)
     return data.V
@@ -38,6 +59,17 @@ def structure_matrix_rate(model: Model, data: Data, q: np.ndarray, qd: np.ndarra
     ``V_j^{k,j} = V_j⁰ − (L_k^j)ᵀ V_k⁰`` is the velocity of body j relative to body k,
     in j's frame. Requires :func:`body_velocities` to have been called for (q, q̇).
     With mimic constraints (constant G) ``Ṡ = Gᵀ Ṡ_full``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers with L, S (:func:`update_structure`) and V
+        (:func:`body_velocities`) of this state.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
     """
     L, V = data.L, data.V
     q_full, qd_full = data.q_full, model.expand(qd, offset=False)
@@ -59,7 +91,18 @@ def structure_matrix_rate(model: Model, data: Data, q: np.ndarray, qd: np.ndarra
 
 
 def bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """Matrix ``B = S Θ Ṡᵀ + S Φ⁰ Θ Sᵀ`` (4.80), ``Φ⁰ = diag(Φ(V_k⁰))``."""
+    """Matrix ``B = S Θ Ṡᵀ + S Φ⁰ Θ Sᵀ`` (4.80), ``Φ⁰ = diag(Φ(V_k⁰))``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
     update_structure(model, data, q)
@@ -78,7 +121,18 @@ def _bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.
 
 
 def bias_force(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """Velocity-product force ``B(q, q̇) q̇`` (4.78)–(4.81)."""
+    """Velocity-product force ``B(q, q̇) q̇`` (4.78)–(4.81).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
     return bias_matrix(model, data, q, qd) @ qd
 
 
@@ -86,6 +140,15 @@ def gravity_force(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
     """Generalised gravity force ``Q_g = S G`` (4.113)–(4.128).
 
     ``G_k = [m_k g_k; <p_cm,k> m_k g_k] = Θ_k [g_k; 0]``, ``g_k = c_{0k}ᵀ g0``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
     """
     update_structure(model, data, q)
     return _gravity_force(model, data)
@@ -108,6 +171,18 @@ def forward_dynamics(
     model); a singular A raises :class:`~rt70.errors.Rt70Error`, and an Euler pair
     within ``DYNAMICS_GIMBAL_COS`` of gimbal lock a
     :class:`~rt70.errors.SingularConfigurationError`.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    Q : numpy.ndarray, shape (nv,)
+        The other generalised forces (springs, dampers, inputs), N or N·m.
     """
     Q = check_vector("Q", Q, model.nv)
     q = check_vector("q", q, model.nv)

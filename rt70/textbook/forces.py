@@ -98,7 +98,17 @@ class CoordinateElements:
         return model.expand(qd, offset=False)[self.coords]
 
     def subtract_jt(self, model: Model, Q: np.ndarray, f: np.ndarray) -> None:
-        """``Q −= Σ_e (∂δ_e/∂q)ᵀ f_e`` in place (``f``: one value per element)."""
+        """``Q −= Σ_e (∂δ_e/∂q)ᵀ f_e`` in place.
+
+        Parameters
+        ----------
+        model : Model
+            The textbook model (its mimic map reduces the pair coordinates to q).
+        Q : numpy.ndarray, shape (nv,)
+            A generalised force, N or N·m; changed in place.
+        f : numpy.ndarray, shape (n_e,)
+            One value per element, e.g. ``C δ``, N or N·m.
+        """
         Q_full = np.zeros(model.n_full)
         np.subtract.at(Q_full, self.coords, f)
         Q += model.reduce(Q_full)
@@ -131,7 +141,15 @@ class GeneralElements:
     def of(
         cls, deformations: list[Deformation], stiffness: np.ndarray, damping: np.ndarray
     ) -> GeneralElements:
-        """The elements of a list of :class:`Deformation` (one per element), stacked."""
+        """The elements of a list of :class:`Deformation` (one per element), stacked.
+
+        Parameters
+        ----------
+        deformations : list of Deformation
+            One per element: δ (k,) and ∂δ/∂q (k, nv).
+        stiffness, damping : numpy.ndarray, shape (n_e, k)
+            Diagonals of each element's C (N/m, N·m/rad) and D (N·s/m, N·m·s/rad).
+        """
         return cls(
             np.array([d.delta for d in deformations]),
             np.array([d.jacobian for d in deformations]),
@@ -144,7 +162,17 @@ class GeneralElements:
         return self.jacobian @ qd
 
     def subtract_jt(self, model: Model, Q: np.ndarray, f: np.ndarray) -> None:
-        """``Q −= Σ_e (∂δ_e/∂q)ᵀ f_e`` in place (``f``: shape (n_e, k))."""
+        """``Q −= Σ_e (∂δ_e/∂q)ᵀ f_e`` in place.
+
+        Parameters
+        ----------
+        model : Model
+            The textbook model (unused: these Jacobians are already on q).
+        Q : numpy.ndarray, shape (nv,)
+            A generalised force, N or N·m; changed in place.
+        f : numpy.ndarray, shape (n_e, k)
+            One k-vector per element, e.g. ``C δ``, N and N·m.
+        """
         Q -= np.einsum("ekn,ek->n", self.jacobian, f)
 
     def squares(self, w: np.ndarray) -> list[float]:
@@ -277,7 +305,17 @@ ELEMENTS: dict[str, Callable[[Model, Data], Elements | None]] = {
 
 
 def elements(model: Model, data: Data, q: np.ndarray) -> list[Elements]:
-    """The deformations of every element at ``q``, kind by kind (:data:`ELEMENTS`)."""
+    """The deformations of every element at ``q``, kind by kind (:data:`ELEMENTS`).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     update_structure(model, data, q)
     found = (kind(model, data) for kind in ELEMENTS.values())
     return [e for e in found if e is not None]
@@ -286,7 +324,18 @@ def elements(model: Model, data: Data, q: np.ndarray) -> list[Elements]:
 def spring_damper_force(
     model: Model, data: Data, q: np.ndarray, qd: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Spring force ``Q_c = −Σ Jᵀ C δ`` and damper force ``Q_d = −Σ Jᵀ D J q̇`` (J = ∂δ/∂q)."""
+    """Spring force ``Q_c = −Σ Jᵀ C δ`` and damper force ``Q_d = −Σ Jᵀ D J q̇`` (J = ∂δ/∂q).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
     Qc = np.zeros(model.nv)
@@ -298,7 +347,17 @@ def spring_damper_force(
 
 
 def spring_potential(model: Model, data: Data, q: np.ndarray) -> float:
-    """Elastic potential ``Σ ½ δᵀ C δ`` of all elements."""
+    """Elastic potential ``Σ ½ δᵀ C δ`` of all elements.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     U = 0.0
     for e in elements(model, data, q):
@@ -312,6 +371,15 @@ def gravity_potential(model: Model, data: Data, q: np.ndarray) -> float:
 
     Bodies welded to the ground through fixed joints only are part of E0: their
     potential is a constant and is left out (Pinocchio's convention too).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
     """
     update_structure(model, data, q)
     com_world = data.p + np.einsum("kij,kj->ki", data.R, model.com)
@@ -320,7 +388,18 @@ def gravity_potential(model: Model, data: Data, q: np.ndarray) -> float:
 
 
 def kinetic_energy(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> float:
-    """Kinetic energy ``½ q̇ᵀ A q̇`` (1.61)."""
+    """Kinetic energy ``½ q̇ᵀ A q̇`` (1.61).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
     from rt70.textbook.dynamics import mass_matrix
 
     qd = check_vector("qd", qd, model.nv)

@@ -22,6 +22,15 @@ def pair_motion(model: Model, j: int, qj: np.ndarray) -> tuple[np.ndarray, np.nd
 
     ``V_j^{jc,j} = M_j f_j q̇_j`` (4.10)/(4.13); for the euler6 pair
     ``M_j = diag(c_jᵀ, ε_j)`` with the Euler matrix ε of (1.38).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    j : int
+        The pair.
+    qj : numpy.ndarray, shape (k_j,)
+        The pair's coordinates (its slice of ``q_full``), rad or m.
     """
     kind = model.kind[j]
     if kind == "euler6":
@@ -48,6 +57,15 @@ def pair_motion_rate(model: Model, j: int, qj: np.ndarray, qdj: np.ndarray) -> n
     """``Ṁ_j f_j`` (6 × k_j): zero except for the euler6 pair (4.82).
 
     For it ``Ṁ_j = diag(ċ_jᵀ, ε̇_j)``, ``ċ = c <ω_rel>``, ``ω_rel = ε φ̇``, so ``ċᵀ = −<ω_rel> cᵀ``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    j : int
+        The pair.
+    qj, qdj : numpy.ndarray, shape (k_j,)
+        The pair's coordinates (rad or m) and velocities (rad/s or m/s).
     """
     if model.kind[j] == "planar":
         out = np.zeros((6, 3))
@@ -71,6 +89,15 @@ def forward_kinematics(model: Model, data: Data, q: np.ndarray) -> None:
     """Forward pass: pair transforms ``L_i^j`` (4.5)–(4.7), ``M_j f_j``, absolute poses.
 
     ``L_i^j = T(r_jc^i)[c_jc^i] · T(r_j^jc)[c_j^jc]``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers: ``L_pair``, ``Mf``, ``R`` and ``p`` are set here.
+    q : numpy.ndarray, shape (n_full,)
+        Pair coordinates ``q_full = G q + q_offset`` (mimic joints included), rad or m.
     """
     for j in range(model.nb):
         r, c, mf = pair_motion(model, j, q[model.coords(j)])
@@ -120,7 +147,17 @@ def structure_matrix(model: Model, data: Data) -> np.ndarray:
 
 
 def update_structure(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
-    """Run forward kinematics and fill L and S for configuration q; return S."""
+    """Run forward kinematics and fill L and S for configuration q; return S.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers: the forward pass, ``q_full``, L and S are set here.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     data.q_full = model.expand(q)
     forward_kinematics(model, data, data.q_full)
@@ -133,6 +170,17 @@ def frame_jacobian(data: Data, body: int, r: np.ndarray, c: np.ndarray) -> np.nd
 
     ``V_F = (T(r)[c])ᵀ V_body`` (formalism §0) and ``V_body = (Sᵀ q̇)_body`` (4.63).
     The ground (``body = −1``) has a zero Jacobian.
+
+    Parameters
+    ----------
+    data : Data
+        Work buffers holding S of the configuration (:func:`update_structure`).
+    body : int
+        The body (pair index) the frame is fixed to; −1 for the ground.
+    r : numpy.ndarray, shape (3,)
+        The frame's origin in the body's frame, m.
+    c : numpy.ndarray, shape (3, 3)
+        The frame's orientation in the body's frame.
     """
     if body < 0:
         return np.zeros((6, data.S.shape[0]))
@@ -142,7 +190,19 @@ def frame_jacobian(data: Data, body: int, r: np.ndarray, c: np.ndarray) -> np.nd
 def frame_pose(
     data: Data, body: int, r: np.ndarray, c: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Absolute orientation and origin of a frame fixed to ``body`` at ``(r, c)``."""
+    """Absolute orientation and origin of a frame fixed to ``body`` at ``(r, c)``.
+
+    Parameters
+    ----------
+    data : Data
+        Work buffers holding the poses of the configuration (:func:`forward_kinematics`).
+    body : int
+        The body (pair index) the frame is fixed to; −1 for the ground.
+    r : numpy.ndarray, shape (3,)
+        The frame's origin in the body's frame, m.
+    c : numpy.ndarray, shape (3, 3)
+        The frame's orientation in the body's frame.
+    """
     if body < 0:
         return c, r
     return data.R[body] @ c, data.p[body] + data.R[body] @ r

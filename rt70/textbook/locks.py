@@ -41,5 +41,19 @@ def brake_row(model: Model, joint: str) -> np.ndarray:
 
 
 def pin_rows(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> np.ndarray:
-    """Rows (3, nv) of a stow pin fixing the point ``xyz`` of ``link``: ``v_p = J_v q̇``."""
+    """Rows (3, nv) of a stow pin fixing the point ``xyz`` of ``link``: ``v_p = J_v q̇``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
+    """
     return point_jacobian(model, data, q, link, xyz)[0]

@@ -69,7 +69,17 @@ def _acceleration(data: Data, body: int, r: np.ndarray, Vdot: np.ndarray, rows: 
 
 
 def loop_residual(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
-    """Φ(q), shape (m,): the loops' point differences (and orientation errors)."""
+    """Φ(q), shape (m,): the loops' point differences (and orientation errors).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     update_structure(model, data, q)
     parts = [_residual(data, loop) for loop in model.loops]
     return np.concatenate(parts) if parts else np.zeros(0)
@@ -85,7 +95,17 @@ def _jacobian_here(model: Model, data: Data) -> np.ndarray:
 
 
 def loop_jacobian(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
-    """``B_c = ∂Φ/∂q``, shape (m, nv), in the sense ``B_c q̇ = Φ̇``."""
+    """``B_c = ∂Φ/∂q``, shape (m, nv), in the sense ``B_c q̇ = Φ̇``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     update_structure(model, data, q)
     return _jacobian_here(model, data)
 
@@ -111,7 +131,18 @@ def _bias_here(
 
 
 def loop_bias(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """``C = Ḃ_c q̇``, shape (m,): the frames' relative acceleration at q̈ = 0."""
+    """``C = Ḃ_c q̇``, shape (m,): the frames' relative acceleration at q̈ = 0.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
     update_structure(model, data, q)
@@ -121,7 +152,18 @@ def loop_bias(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.nda
 def loop_terms(
     model: Model, data: Data, q: np.ndarray, qd: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(Φ, B_c, C)`` from one forward pass (what a simulation step needs)."""
+    """``(Φ, B_c, C)`` from one forward pass (what a simulation step needs).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
     update_structure(model, data, q)

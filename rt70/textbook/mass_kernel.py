@@ -180,14 +180,37 @@ def _mass_matrix_one(
                     acc += T[a, k] * L[b, k]
                 theta_c[j, a, b] = acc
                 theta_c[j, b, a] = acc
-    for j in range(nb - 1, -1, -1):  # step 3: leaves to the root (children follow parents)
+    _composite_inertias(parent, theta_c)
+    _mass_entries(parent, q_start, ndof, theta_c, sigma, F, out)
+
+
+@numba.njit(cache=True)
+def _composite_inertias(parent: np.ndarray, theta_c: np.ndarray) -> None:
+    """Step 3: ``Θᶜ_k = Σ_{j ⪰ k} Θ⁰_j`` in place, from the leaves to the root."""
+    for j in range(parent.shape[0] - 1, -1, -1):  # children follow parents
         i = parent[j]
         if i >= 0:
             for a in range(6):
                 for b in range(6):
                     theta_c[i, a, b] += theta_c[j, a, b]
+
+
+@numba.njit(cache=True)
+def _mass_entries(
+    parent: np.ndarray,
+    q_start: np.ndarray,
+    ndof: np.ndarray,
+    theta_c: np.ndarray,
+    sigma: np.ndarray,
+    F: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """Step 4: ``A_la = σ_lᵀ Θᶜ_k σ_a`` for a of body k, l of k (l ≤ a) or of its ancestors.
+
+    And its mirror ``A_al``; zero across branches. ``F`` is a scratch 6-vector.
+    """
     out[:] = 0.0
-    for k in range(nb):  # step 4
+    for k in range(parent.shape[0]):
         sk = q_start[k]
         for a in range(sk, sk + ndof[k]):
             for m in range(6):  # F = Θᶜ_k σ_a
@@ -336,6 +359,16 @@ def mass_matrix_batch(model: Model, data: KernelData, Q: np.ndarray) -> np.ndarr
 
     Equal to :func:`rt70.textbook.structured.mass_matrix_batch` to round-off. The
     returned array is ``data.A``, overwritten by the next call with the same ``data``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : KernelData
+        ``KernelData(model, K)``: the kernel's arrays and ``data.A``.
+    Q : numpy.ndarray, shape (K, nv)
+        One configuration per row, in the model's coordinates (``Model.coordinate_names``),
+        rad or m.
     """
     Q = _check_batch("Q", Q, model.nv)
     data = _data_for(model, Q.shape[0], data, KernelData)
@@ -353,7 +386,17 @@ def _compute(model: Model, data: KernelData, Q: np.ndarray) -> None:
 
 
 def mass_matrix(model: Model, data: KernelData, q: np.ndarray) -> np.ndarray:
-    """``A = S Θ Sᵀ`` at one configuration by the kernel, a new array (``KernelData(model, 1)``)."""
+    """``A = S Θ Sᵀ`` at one configuration by the kernel, a new array (``KernelData(model, 1)``).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : KernelData
+        ``KernelData(model, 1)``.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
     q = check_vector("q", q, model.nv)
     data = _data_for(model, 1, data, KernelData)
     _compute(model, data, q[None, :])

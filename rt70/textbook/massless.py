@@ -128,6 +128,17 @@ def require_diagonal(
     The check at one given configuration (a simulation's start, a linearisation's
     equilibrium), beside the model-wide :func:`check_moves_mass`: a zero (or NaN)
     ``A_ii`` means no mass moves with coordinate i there.
+
+    Parameters
+    ----------
+    A : numpy.ndarray, shape (n, n)
+        A mass matrix.
+    names : list of str
+        The name of each coordinate, in A's order.
+    where : str
+        The start of the message, e.g. the scene's name and a colon (``"rt70: "``), or empty.
+    error : type
+        The exception raised, a subclass of :class:`~rt70.errors.Rt70Error`.
     """
     massless = [n for n, a in zip(names, np.diag(A), strict=True) if not a > 0.0]
     if massless:

@@ -228,21 +228,138 @@ def _child_joints(desc: RobotDescription) -> dict[str, list[Joint]]:
 
 def build_model(desc: RobotDescription) -> Model:
     """Build the textbook :class:`Model` from a validated URDF description."""
+    pairs = _read_pairs(desc)
+    link_frames = pairs.link_frames
+    masses = [float(t[0, 0]) for t in pairs.thetas]  # Θ = [[m 1, −m<p>], [m<p>, …]] (4.77)
+    coms = [
+        _unskew(t[3:, :3]) / m if m > 0 else np.zeros(3)
+        for t, m in zip(pairs.thetas, masses, strict=True)
+    ]
+    ndof_arr = np.array(pairs.ndof, dtype=int)
+    G, q_offset, independent = _mimic_constraints(pairs.coord_names, desc)
+    return Model(
+        name=desc.name,
+        parent=np.array(pairs.parent, dtype=int),
+        kind=pairs.kind,
+        axis=np.array(pairs.axis, dtype=float).reshape(-1, 3),
+        r_c=np.array(pairs.r_c, dtype=float).reshape(-1, 3),
+        c_c=np.array(pairs.c_c, dtype=float).reshape(-1, 3, 3),
+        Theta=np.array(pairs.thetas, dtype=float).reshape(-1, 6, 6),
+        mass=np.array(masses, dtype=float),
+        com=np.array(coms, dtype=float).reshape(-1, 3),
+        q_start=np.concatenate([[0], np.cumsum(ndof_arr)[:-1]]).astype(int),
+        ndof=ndof_arr,
+        body_names=pairs.body_names,
+        coordinate_names=independent,
+        gravity=np.array(desc.gravity, dtype=float),
+        full_coordinate_names=list(pairs.coord_names),
+        link_frames=link_frames,
+        bushings=_bushings(desc, link_frames),
+        loops=_loops(desc, link_frames),
+        spring_coords=np.array([pairs.joint_coord[s.joint] for s in desc.joint_springs], dtype=int),
+        spring_stiffness=np.array([s.stiffness for s in desc.joint_springs], dtype=float),
+        spring_damping=np.array([s.damping for s in desc.joint_springs], dtype=float),
+        G=G,
+        q_offset=q_offset,
+        winds=desc.winds,
+        air_density=desc.air_density,
+        pair_joints=pairs.pair_joints,
+    )
+
+
+@dataclass
+class _Pairs:
+    """The pairs of a description as lists, in tree order, while :func:`_read_pairs` runs.
+
+    One entry per pair in ``parent`` … ``pair_joints`` (the fields of :class:`Model`
+    of the same names; ``thetas`` is Θ), one per pair coordinate in ``coord_names``;
+    ``joint_coord`` maps a coordinate's name to its index, ``link_frames`` every link
+    read so far to its ``(body, r, c)``.
+    """
+
+    link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]]
+    parent: list[int] = field(default_factory=list)
+    kind: list[str] = field(default_factory=list)
+    axis: list[np.ndarray] = field(default_factory=list)
+    r_c: list[np.ndarray] = field(default_factory=list)
+    c_c: list[np.ndarray] = field(default_factory=list)
+    thetas: list[np.ndarray] = field(default_factory=list)
+    ndof: list[int] = field(default_factory=list)
+    body_names: list[str] = field(default_factory=list)
+    coord_names: list[str] = field(default_factory=list)
+    joint_coord: dict[str, int] = field(default_factory=dict)
+    pair_joints: list[tuple[str, ...]] = field(default_factory=list)
+
+    def weld(
+        self, desc: RobotDescription, joint: Joint, body: int, r: np.ndarray, c: np.ndarray
+    ) -> None:
+        """A fixed ``joint``: its child link merged into ``body`` at ``(r, c)`` (as Pinocchio).
+
+        The link's inertia is added to the body's Θ, moved by ``T(r)[c]`` (4.77); the
+        ground (body −1) takes no inertia.
+        """
+        inertial = desc.links[joint.child].inertial
+        if inertial is not None and body >= 0:
+            theta = body_inertia(inertial.mass, inertial.com, inertial.inertia)
+            X = placement(r, c)
+            self.thetas[body] = self.thetas[body] + X @ theta @ X.T
+        self.link_frames[joint.child] = (body, r, c)
+
+    def add(
+        self,
+        desc: RobotDescription,
+        joint: Joint,
+        chain: list[Joint],
+        body: int,
+        r: np.ndarray,
+        c: np.ndarray,
+    ) -> str:
+        """A new pair on ``body``, construction frame ``(r, c)``; returns its child link.
+
+        The pair is ``joint``, or the six joints of ``chain`` read as one euler6 pair
+        (:func:`_euler6_chain`; empty when it is not one).
+        """
+        if chain:
+            jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
+        else:
+            child, jkind = joint.child, _URDF_KIND[joint.type]
+            suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
+            names = [joint.name + suffix for suffix in suffixes]
+        inertial = desc.links[child].inertial
+        j = len(self.kind)
+        self.pair_joints.append(tuple(step.name for step in chain) if chain else (joint.name,))
+        self.parent.append(body)
+        self.kind.append(jkind)
+        self.axis.append(joint.axis)
+        self.r_c.append(r)
+        self.c_c.append(c)
+        if inertial is None:
+            self.thetas.append(np.zeros((6, 6)))
+        else:
+            self.thetas.append(body_inertia(inertial.mass, inertial.com, inertial.inertia))
+        for name in names:
+            self.joint_coord[name] = len(self.coord_names)
+            self.coord_names.append(name)
+        self.ndof.append(_NDOF[jkind])
+        self.body_names.append(child)
+        self.link_frames[child] = (j, np.zeros(3), np.eye(3))
+        return child
+
+
+def _read_pairs(desc: RobotDescription) -> _Pairs:
+    """The pairs of ``desc``: depth-first, parents before children, siblings in file order.
+
+    An explicit stack of ``(joint, body, r_link, c_link)``, the joint's parent link
+    sitting at ``(r_link, c_link)`` in body (a recursion would overflow Python's stack
+    on chains of ~1000 bodies). A fixed joint welds its child link to the body
+    (:meth:`_Pairs.weld`); any other joint, or a chain of six read as one euler6 pair,
+    is a new pair (:meth:`_Pairs.add`).
+    """
     referenced = {b.frame1.link for b in desc.bushings} | {b.frame2.link for b in desc.bushings}
     referenced |= {p.link for p in desc.optical_points} | {w.link for w in desc.winds}
     referenced |= {f.link for loop in desc.loops for f in (loop.frame1, loop.frame2)}
-    parent, kind, axis, r_c, c_c = [], [], [], [], []
-    thetas, ndof, body_names, coord_names = [], [], [], []
-    pair_joints: list[tuple[str, ...]] = []
-    link_frames: dict[str, tuple[int, np.ndarray, np.ndarray]] = {
-        desc.root: (-1, np.zeros(3), np.eye(3))
-    }
-    joint_coord: dict[str, int] = {}
     children = _child_joints(desc)
-
-    # Depth-first, parents before children, siblings in file order: an explicit stack of
-    # (joint, body, r_link, c_link), the joint's parent link sitting at (r_link, c_link)
-    # in body (a recursion would overflow Python's stack on chains of ~1000 bodies).
+    pairs = _Pairs(link_frames={desc.root: (-1, np.zeros(3), np.eye(3))})
     stack: list[tuple[Joint, int, np.ndarray, np.ndarray]] = []
 
     def visit(link: str, body: int, r_link: np.ndarray, c_link: np.ndarray) -> None:
@@ -254,54 +371,29 @@ def build_model(desc: RobotDescription) -> Model:
         joint, body, r_link, c_link = stack.pop()
         r_joint = r_link + c_link @ joint.xyz
         c_joint = c_link @ rpy_matrix(joint.rpy)
-        inertial = desc.links[joint.child].inertial
-        if joint.type == "fixed":  # merged into the parent body, as Pinocchio does
-            if inertial is not None and body >= 0:
-                theta = body_inertia(inertial.mass, inertial.com, inertial.inertia)
-                X = placement(r_joint, c_joint)
-                thetas[body] = thetas[body] + X @ theta @ X.T
-            link_frames[joint.child] = (body, r_joint, c_joint)
+        if joint.type == "fixed":
+            pairs.weld(desc, joint, body, r_joint, c_joint)
             visit(joint.child, body, r_joint, c_joint)
             continue
         chain = _euler6_chain(desc, joint, referenced, children)
-        if chain:
-            jkind, child, names = "euler6", chain[-1].child, [j.name for j in chain]
-            inertial = desc.links[child].inertial
-        else:
-            child, jkind = joint.child, _URDF_KIND[joint.type]
-            suffixes = _SUFFIXES.get(jkind, ("",) * _NDOF[jkind])
-            names = [joint.name + suffix for suffix in suffixes]
-        j = len(kind)
-        pair_joints.append(tuple(c.name for c in chain) if chain else (joint.name,))
-        parent.append(body)
-        kind.append(jkind)
-        axis.append(joint.axis)
-        r_c.append(r_joint)
-        c_c.append(c_joint)
-        if inertial is None:
-            thetas.append(np.zeros((6, 6)))
-        else:
-            thetas.append(body_inertia(inertial.mass, inertial.com, inertial.inertia))
-        for name in names:
-            joint_coord[name] = len(coord_names)
-            coord_names.append(name)
-        ndof.append(_NDOF[jkind])
-        body_names.append(child)
-        link_frames[child] = (j, np.zeros(3), np.eye(3))
-        visit(child, j, np.zeros(3), np.eye(3))
+        child = pairs.add(desc, joint, chain, body, r_joint, c_joint)
+        visit(child, len(pairs.kind) - 1, np.zeros(3), np.eye(3))
+    return pairs
 
-    masses = [float(t[0, 0]) for t in thetas]  # Θ = [[m 1, −m<p>], [m<p>, …]] (4.77)
-    coms = [
-        _unskew(t[3:, :3]) / m if m > 0 else np.zeros(3)
-        for t, m in zip(thetas, masses, strict=True)
-    ]
-    ndof_arr = np.array(ndof, dtype=int)
+
+def _bushings(desc: RobotDescription, link_frames: dict) -> list[BushingModel]:
+    """The description's bushings and struts with their frames placed on the bodies."""
     bushings = []
     for b in desc.bushings:
         body1, r1, c1 = _frame_on_body(link_frames, b.frame1.link, b.frame1.xyz, b.frame1.rpy)
         body2, r2, c2 = _frame_on_body(link_frames, b.frame2.link, b.frame2.xyz, b.frame2.rpy)
         bushings.append(BushingModel(b.name, body1, r1, c1, body2, r2, c2, b.stiffness, b.damping))
-    loops = [
+    return bushings
+
+
+def _loops(desc: RobotDescription, link_frames: dict) -> list[LoopModel]:
+    """The description's loop closures with their frames placed on the bodies."""
+    return [
         LoopModel(
             loop.name,
             loop.rows,
@@ -310,35 +402,6 @@ def build_model(desc: RobotDescription) -> Model:
         )
         for loop in desc.loops
     ]
-    G, q_offset, independent = _mimic_constraints(coord_names, desc)
-    return Model(
-        name=desc.name,
-        parent=np.array(parent, dtype=int),
-        kind=kind,
-        axis=np.array(axis, dtype=float).reshape(-1, 3),
-        r_c=np.array(r_c, dtype=float).reshape(-1, 3),
-        c_c=np.array(c_c, dtype=float).reshape(-1, 3, 3),
-        Theta=np.array(thetas, dtype=float).reshape(-1, 6, 6),
-        mass=np.array(masses, dtype=float),
-        com=np.array(coms, dtype=float).reshape(-1, 3),
-        q_start=np.concatenate([[0], np.cumsum(ndof_arr)[:-1]]).astype(int),
-        ndof=ndof_arr,
-        body_names=body_names,
-        coordinate_names=independent,
-        gravity=np.array(desc.gravity, dtype=float),
-        full_coordinate_names=list(coord_names),
-        link_frames=link_frames,
-        bushings=bushings,
-        loops=loops,
-        spring_coords=np.array([joint_coord[s.joint] for s in desc.joint_springs], dtype=int),
-        spring_stiffness=np.array([s.stiffness for s in desc.joint_springs], dtype=float),
-        spring_damping=np.array([s.damping for s in desc.joint_springs], dtype=float),
-        G=G,
-        q_offset=q_offset,
-        winds=desc.winds,
-        air_density=desc.air_density,
-        pair_joints=pair_joints,
-    )
 
 
 def _mimic_constraints(
@@ -369,5 +432,6 @@ def _unskew(m: np.ndarray) -> np.ndarray:
 def _frame_on_body(
     link_frames: dict, link: str, xyz: np.ndarray, rpy: np.ndarray
 ) -> tuple[int, np.ndarray, np.ndarray]:
+    """``(body, r, c)`` of the frame ``(xyz, rpy)`` of ``link``, placed on the link's body."""
     body, r_link, c_link = link_frames[link]
     return body, r_link + c_link @ xyz, c_link @ rpy_matrix(rpy)

@@ -38,7 +38,19 @@ def _frame_rotation(model: Model, data: Data, link: str) -> tuple[int, np.ndarra
 def constraint_matrix(
     model: Model, data: Data, q: np.ndarray, elements: Sequence[NoSlip]
 ) -> np.ndarray:
-    """``A(q)`` (m × nv): one row ``dᵀ (J_v + a [n]× J_ω)`` per element (1.1)."""
+    """``A(q)`` (m × nv): one row ``dᵀ (J_v + a [n]× J_ω)`` per element (1.1).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    elements : sequence of rt70.urdf.description.NoSlip
+        The ``<rt70:no_slip>`` constraints, one row each.
+    """
     q = check_vector("q", q, model.nv)
     update_structure(model, data, q)
     A = np.zeros((len(elements), model.nv))
@@ -58,6 +70,18 @@ def constraint_bias(
     (``ω_f`` the frame link's angular velocity), and, in the point body's axes,
     ``a_p = R (v̇ + ω̇ × r + ω × (v + ω × r))``, ``ω̇_ground = R ω̇``: ``[v; ω] = Sᵀ q̇``
     and its rate ``[v̇; ω̇] = Ṡᵀ q̇`` (4.63), (4.81).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    elements : sequence of rt70.urdf.description.NoSlip
+        The ``<rt70:no_slip>`` constraints, one row each.
     """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)

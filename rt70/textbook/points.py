@@ -32,6 +32,15 @@ from rt70.textbook.model import Model
 def link_point(model: Model, link: str, xyz) -> tuple[int, np.ndarray]:
     """Body of ``link`` and the point ``xyz`` (link frame) in that body's frame.
 
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
+
     Raises
     ------
     UnknownLinkError
@@ -56,6 +65,17 @@ def point_positions(
     """Ground-axis positions (n, 3) of the points ``(link, xyz)`` at q, in m.
 
     One forward pass (4.5)–(4.7) for all of them: ``p = p_body + c_0,body r``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    points : sequence of (str, array_like)
+        The points: a link's name and the point in the link's frame (m).
     """
     located = [link_point(model, link, xyz) for link, xyz in points]
     q = check_vector("q", q, model.nv)
@@ -68,7 +88,21 @@ def point_positions(
 
 
 def point_position(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> np.ndarray:
-    """Ground-axis position (3,) of the point ``xyz`` of ``link`` at q, in m."""
+    """Ground-axis position (3,) of the point ``xyz`` of ``link`` at q, in m.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
+    """
     return point_positions(model, data, q, [(link, xyz)])[0]
 
 
@@ -78,6 +112,15 @@ def ground_jacobian(data: Data, body: int, r: np.ndarray) -> tuple[np.ndarray, n
     ``[v_p; ω]`` in the body's axes is the frame Jacobian ``(T(r))ᵀ (Sᵀ)_body`` (4.63);
     both rows are turned to ground axes by the body's rotation ``c_0,body``. For the
     configuration already in ``data`` (:func:`update_structure`); zero for the ground.
+
+    Parameters
+    ----------
+    data : Data
+        Work buffers holding the configuration's poses and S (:func:`update_structure`).
+    body : int
+        The body (pair index) the point is fixed to; −1 for the ground.
+    r : numpy.ndarray, shape (3,)
+        The point in the body's frame, m.
     """
     J = frame_jacobian(data, body, r, np.eye(3))  # [v_p; ω] in body axes (4.63)
     R, _ = frame_pose(data, body, np.zeros(3), np.eye(3))
@@ -92,6 +135,17 @@ def ground_bias_acceleration(
     With the body's twist ``[v; ω] = Sᵀ q̇`` (``data.V``, body axes) and its rate at
     q̈ = 0, ``Vdot = Ṡᵀ q̇`` (4.63), (4.81): ``a_p = c (v̇ + ω̇ × r + ω × (v + ω × r))``
     and ``ω̇ = c ω̇_body``, ``c = c_0,body``. Zero for the ground.
+
+    Parameters
+    ----------
+    data : Data
+        Work buffers holding the poses and the body velocities ``data.V`` of the state.
+    body : int
+        The body (pair index) the point is fixed to; −1 for the ground.
+    r : numpy.ndarray, shape (3,)
+        The point in the body's frame, m.
+    Vdot : numpy.ndarray, shape (nb, 6)
+        ``Ṡᵀ q̇`` of every body in its own axes, ``[v̇; ω̇]`` (m/s², rad/s²).
     """
     if body < 0:
         return np.zeros(3), np.zeros(3)
@@ -107,6 +161,19 @@ def point_jacobian(
     """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
 
     One forward pass at q, then :func:`ground_jacobian`.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    link : str
+        Name of a URDF link of the scene.
+    xyz : array_like, shape (3,)
+        The point in the link's frame, m.
     """
     body, r = link_point(model, link, xyz)
     update_structure(model, data, q)
@@ -119,6 +186,17 @@ def generalized_force(model: Model, data: Data, q: np.ndarray, wrench: Wrench) -
     ``U`` is the wrench moved to the body frame; ``S U`` is the transposed point
     Jacobian times the force and the torque, both in ground axes. Its power is
     ``q̇ᵀ Q = F·v_p + M·ω``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    wrench : rt70.physics.loads.Wrench
+        A force (N) at a point of a link and a torque (N·m) on it, ground axes.
     """
     Jv, Jw = point_jacobian(model, data, q, wrench.link, wrench.xyz)
     return Jv.T @ np.asarray(wrench.force) + Jw.T @ np.asarray(wrench.torque)

@@ -98,6 +98,19 @@ def reaction_impulses(
     products, the impulses of finite forces (gravity) neglected, ``q̈ → Δq̇`` and the
     loads → their impulses ``impulses`` (N·s, N·m·s; e.g. the impact multipliers Λ as
     equal and opposite wrenches). Per URDF joint ``[F; M]`` impulse in the joint's axes.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    dqd : numpy.ndarray, shape (nv,)
+        The velocity jump Δq̇, rad/s or m/s.
+    impulses : iterable of rt70.physics.loads.Wrench
+        Impulses on links (ground axes; N·s and N·m·s in the force and torque fields).
     """
     zero = np.zeros(model.nv)
     return joint_reactions(model, data, q, zero, dqd, impulses, gravity=False)
@@ -116,6 +129,15 @@ def load_wrenches(model: Model, data: Data, wrenches: Iterable[Wrench]) -> np.nd
     Shape (nb, 6), each in its body's frame about its origin (4.129)–(4.131); ``r`` is
     the point in the body frame (:func:`rt70.textbook.points.link_point`). Poses in
     ``data``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Work buffers holding the configuration's poses.
+    wrenches : iterable of rt70.physics.loads.Wrench
+        Loads on links, ground axes; those on the ground link are ignored.
     """
     U = np.zeros((model.nb, 6))
     for w in wrenches:
@@ -137,6 +159,15 @@ def subtree_sums(model: Model, data: Data, W: np.ndarray) -> np.ndarray:
     topological order, which adds each subtree's total to its parent once (errata
     X.3.12). ``L_pair[c] = T(r) [c]`` moves a wrench from the child's frame to the
     parent's (the transpose of the velocity map (4.5)–(4.7)).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Work buffers holding the configuration's pair transforms ``L_pair``.
+    W : numpy.ndarray, shape (nb, 6)
+        Each body's wrench ``[F; M]`` (N, N·m) in its own frame about its origin.
     """
     R = np.array(W, dtype=float, copy=True)
     for c in range(model.nb - 1, -1, -1):
@@ -159,8 +190,23 @@ def pair_reactions(
 
     Source 004 (9)–(10) with the book's matrices: the body wrenches
     ``W = Θ V̇ + Φ(V) Θ V − G − U`` (forward pass) summed over the subtrees,
-    ``R = L W`` (:func:`subtree_sums`). Arguments as :func:`joint_reactions`;
-    :func:`projection` of R is the generalised force ``S W`` (004 (11)).
+    ``R = L W`` (:func:`subtree_sums`); :func:`projection` of R is the generalised force
+    ``S W`` (004 (11)).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd, qdd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m), velocities (rad/s or m/s) and accelerations
+        (rad/s² or m/s²) in the model's order (``Model.coordinate_names``).
+    wrenches : iterable of rt70.physics.loads.Wrench
+        Loads on links (ground axes, at a point of the link); a load on the ground link
+        acts on no pair and is ignored.
+    gravity : bool
+        Include the weights ``G_j = Θ_j [g_j; 0]`` (4.113).
     """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
@@ -186,6 +232,16 @@ def projection(model: Model, data: Data, R: np.ndarray) -> np.ndarray:
 
     Equals ``S W`` (4.66), the right-hand side the reactions balance:
     ``A q̈ + B q̇ − S G − S U``. ``M_k f_k`` from the last forward pass in ``data``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Work buffers holding the configuration's ``M_k f_k`` (the last forward pass).
+    R : numpy.ndarray, shape (nb, 6)
+        The pair reactions ``[F; M]`` (N, N·m), each in its body's frame about its origin
+        (:func:`pair_reactions`).
     """
     Q_full = np.concatenate([data.Mf[k].T @ R[k] for k in range(model.nb)])
     return model.reduce(Q_full)
@@ -197,6 +253,16 @@ def joint_wrenches(model: Model, data: Data, R: np.ndarray) -> dict[str, np.ndar
     A pair of one URDF joint: its body frame is the joint's. An euler6 chain of six
     joints: the same wrench moved to each joint's child frame in the construction
     frame, ``T(r)[c]`` of the body frame seen from it (:func:`chain_frames`).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Work buffers holding the configuration's pair coordinates ``q_full``.
+    R : numpy.ndarray, shape (nb, 6)
+        The pair reactions ``[F; M]`` (N, N·m), each in its body's frame about its origin
+        (:func:`pair_reactions`).
     """
     out: dict[str, np.ndarray] = {}
     for k, names in enumerate(model.pair_joints):

@@ -27,6 +27,15 @@ def check_euler_pairs(model, q_full: np.ndarray, threshold: float = DYNAMICS_GIM
 
     ``θ`` is the pair's fifth coordinate (``q_j = [x, y, z, β, θ, α]``); the Euler
     matrix (1.38) is singular at ``θ = ±π/2``.
+
+    Parameters
+    ----------
+    model : rt70.textbook.model.Model
+        The textbook model.
+    q_full : numpy.ndarray, shape (n_full,)
+        Pair coordinates ``q_full = G q + q_offset``, rad or m.
+    threshold : float
+        Smallest ``|cos θ|`` accepted (:data:`DYNAMICS_GIMBAL_COS` by default).
     """
     for j, kind in enumerate(model.kind):
         if kind == "euler6":
@@ -158,6 +167,15 @@ def body_inertia(mass: float, com: np.ndarray, inertia_com: np.ndarray) -> np.nd
     """Θ about a frame displaced by ``p = com`` from the centre of mass (4.77).
 
     ``Θ = T(p) diag(m 1₃, I_c) T(p)ᵀ = [[m 1₃, −m<p>], [m<p>, I_c − m<p><p>]]``.
+
+    Parameters
+    ----------
+    mass : float
+        The body's mass m, kg.
+    com : numpy.ndarray, shape (3,)
+        Its centre of mass p in the frame, m.
+    inertia_com : numpy.ndarray, shape (3, 3)
+        Its inertia tensor ``I_c`` about the centre of mass in the frame's axes, kg·m².
     """
     p = skew(com)
     out = np.zeros((6, 6))

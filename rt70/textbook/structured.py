@@ -20,140 +20,25 @@ over the depth of the tree. Pairs are grouped by their number of coordinates (1,
 6), so the 6×6 work is done once per pair, not once per coordinate.
 
 Every algorithm is called as ``algorithm(model, data, q, …)``, Pinocchio's convention:
-the Model is constant, the work buffers (and the tree's :class:`Topology`, built once)
-live in :class:`BatchData` — reuse one for repeated calls: fresh multi-megabyte
-temporaries cost more than the arithmetic. ``mass_matrix_batch`` returns ``data.A``,
-overwritten by the next call with the same data (as ``pin.crba`` fills ``data.M``).
+the Model is constant, the work buffers (and the tree's index arrays,
+:class:`~rt70.textbook.topology.Topology`, built once) live in :class:`BatchData` —
+reuse one for repeated calls: fresh multi-megabyte temporaries cost more than the
+arithmetic. ``mass_matrix_batch`` returns ``data.A``, overwritten by the next call with
+the same data (as ``pin.crba`` fills ``data.M``). The batched spatial helpers are in
+:mod:`rt70.textbook.spatial_batch`.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
 from rt70.errors import NonFiniteError, ShapeError
 from rt70.guards.arrays import check_vector
 from rt70.textbook.model import Model
-from rt70.textbook.spatial import placement
+from rt70.textbook.spatial_batch import crm_batch, euler123_batch, skew_batch
+from rt70.textbook.topology import Topology, topology
 
 _E3 = np.eye(3)
-
-
-@dataclass(frozen=True)
-class Group:
-    """Pairs with the same number ``width`` of coordinates (1, 3 or 6)."""
-
-    width: int
-    bodies: np.ndarray | slice  # (n_g,) pair indices, a slice when they are contiguous
-    dofs: np.ndarray | slice  # (n_g, width) coordinates, a slice when contiguous
-    count: int  # n_g
-
-    def rows_of(self, x: np.ndarray) -> np.ndarray:
-        """Per-coordinate rows ``x[:, dofs]`` as (K, n_g, width, 6); a view when contiguous."""
-        if isinstance(self.dofs, slice):
-            return x[:, self.dofs].reshape(x.shape[0], self.count, self.width, x.shape[-1])
-        return x[:, self.dofs]
-
-
-@dataclass(frozen=True)
-class Topology:
-    """Index arrays derived once from a model's parent array (plain data)."""
-
-    jumps: tuple[np.ndarray, ...]  # ancestor 2^k levels up (nb = the ground), k = 0, 1, ...
-    revolute_k: np.ndarray  # <a> of each revolute pair's axis (Rodrigues' formula)
-    revolute_basis: np.ndarray  # rows 1, <a>, <a>² flattened, (n_rev, 3, 9)
-    revolute_bodies: np.ndarray | slice  # revolute pairs (a slice when contiguous)
-    revolute_dofs: np.ndarray | slice  # their coordinates
-    L_construction: np.ndarray  # T(r_c)[c_c] of every pair (nb, 6, 6)
-    translates: bool  # whether any pair has a variable translation
-    anc: np.ndarray  # anc[k, j] = 1.0 if k is j or an ancestor of j
-    dof_body: np.ndarray  # body of each full coordinate
-    weight: np.ndarray  # 1 where body(l) ⊀ body(a) strictly, ½ on a body's own block
-    weight_t: np.ndarray  # its transpose (contiguous)
-    incidence: np.ndarray  # incidence[k, a] = 1.0 if coordinate a belongs to pair k
-    groups: tuple[Group, ...]
-    kinds: dict[str, np.ndarray]  # bodies of each pair kind
-    kind_dofs: dict[str, np.ndarray]  # their coordinates, shape (n_kind, ndof)
-    rows_1dof: np.ndarray  # body-frame axis [a; 0] or [0; a] of each 1-DOF pair (n1, 1, 6)
-
-
-def _build_topology(model: Model) -> Topology:
-    nb, n = model.nb, model.n_full
-    depth = np.zeros(nb, dtype=int)
-    for j in range(nb):
-        depth[j] = 0 if model.parent[j] < 0 else depth[model.parent[j]] + 1
-    # pointer jumping: jumps[k][j] is the ancestor 2^k levels above j, or nb (the ground)
-    jump = np.where(model.parent < 0, nb, model.parent).astype(int)
-    jump = np.append(jump, nb)
-    jumps = []
-    for _ in range(int(np.ceil(np.log2(depth.max() + 1))) if nb else 0):
-        jumps.append(jump[:nb].copy())
-        jump = jump[jump]
-    anc = np.zeros((nb, nb))
-    for j in range(nb):
-        anc[model.ancestors(j), j] = 1.0
-    dof_body = np.repeat(np.arange(nb), model.ndof)
-    same = (dof_body[:, None] == dof_body[None, :]).astype(float)
-    weight = anc[np.ix_(dof_body, dof_body)] - 0.5 * same
-    incidence = np.zeros((nb, n))
-    incidence[dof_body, np.arange(n)] = 1.0
-    groups = []
-    for width in (1, 3, 6):
-        bodies = np.flatnonzero(model.ndof == width)
-        if bodies.size:
-            dofs = (model.q_start[bodies][:, None] + np.arange(width)).astype(int)
-            groups.append(Group(width, _as_slice(bodies), _as_slice(dofs), bodies.size))
-    kinds, kind_dofs = {}, {}
-    for kind, width in (("euler6", 6), ("revolute", 1), ("prismatic", 1), ("planar", 3)):
-        bodies = np.array([j for j in range(nb) if model.kind[j] == kind], dtype=int)
-        kinds[kind] = bodies
-        kind_dofs[kind] = (model.q_start[bodies][:, None] + np.arange(width)).astype(int)
-    one = np.flatnonzero(model.ndof == 1)
-    rows_1dof = np.zeros((one.size, 1, 6))
-    for i, j in enumerate(one):
-        rows_1dof[i, 0, 3:] = model.axis[j] if model.kind[j] == "revolute" else 0.0
-        rows_1dof[i, 0, :3] = model.axis[j] if model.kind[j] == "prismatic" else 0.0
-    rev_k = _skew_batch(model.axis[kinds["revolute"]])
-    return Topology(
-        jumps=tuple(jumps),
-        L_construction=np.array(
-            [placement(r, c) for r, c in zip(model.r_c, model.c_c, strict=True)]
-        ).reshape(-1, 6, 6),
-        translates=any(k in ("prismatic", "euler6", "planar") for k in model.kind),
-        revolute_k=rev_k,
-        revolute_basis=np.stack(
-            [np.broadcast_to(_E3, rev_k.shape), rev_k, rev_k @ rev_k], axis=-3
-        ).reshape(-1, 3, 9),
-        revolute_bodies=_as_slice(kinds["revolute"])
-        if kinds["revolute"].size
-        else kinds["revolute"],
-        revolute_dofs=_as_slice(kind_dofs["revolute"][:, 0])
-        if kinds["revolute"].size
-        else kind_dofs["revolute"][:, 0],
-        anc=anc,
-        dof_body=dof_body,
-        weight=weight,
-        weight_t=np.ascontiguousarray(weight.T),
-        incidence=incidence,
-        groups=tuple(groups),
-        kinds=kinds,
-        kind_dofs=kind_dofs,
-        rows_1dof=rows_1dof,
-    )
-
-
-def _as_slice(index: np.ndarray) -> np.ndarray | slice:
-    """A slice equal to ``index`` (flattened) if it is a contiguous range, else ``index``."""
-    flat = index.ravel()
-    if np.array_equal(flat, np.arange(flat[0], flat[0] + flat.size)):
-        return slice(int(flat[0]), int(flat[0] + flat.size))
-    return index
-
-
-def topology(model: Model) -> Topology:
-    """The :class:`Topology` of ``model`` (kept by :class:`BatchData`, built once there)."""
-    return _build_topology(model)
 
 
 #: Work arrays of one chunk of the batched mass matrix stay below this many bytes, so
@@ -232,48 +117,34 @@ def _data_for(model: Model, K: int, data, kind: type | None = None):
     return data
 
 
-_SKEW_SRC = np.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
-_SKEW_SIGN = np.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])
-
-
-def _skew_batch(x: np.ndarray) -> np.ndarray:
-    """``<x>`` for an array of 3-vectors, shape (..., 3) → (..., 3, 3)."""
-    return (x[..., _SKEW_SRC] * _SKEW_SIGN).reshape(x.shape + (3,))
-
-
-_E123 = np.eye(3)
-
-
-def _euler123_batch(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``c = c1(β) c2(θ) c3(α)`` (1.23) and the transposed Euler matrix εᵀ (1.38), batched.
-
-    The rows of ``εᵀ`` are ``(c2 c3)ᵀ e_x``, ``c3ᵀ e_y`` and ``e_z`` read as rows of
-    ``c2 c3`` and ``c3``.
-    """
-    elementary = _rotations_about_axes(_E123, phi)  # c1(β), c2(θ), c3(α)
-    c23 = elementary[..., 1, :, :] @ elementary[..., 2, :, :]
-    c = elementary[..., 0, :, :] @ c23
-    eps_t = np.empty_like(c)
-    eps_t[..., 0, :] = c23[..., 0, :]
-    eps_t[..., 1, :] = elementary[..., 2, 1, :]
-    eps_t[..., 2, :] = _E123[2]
-    return c, eps_t
-
-
-def _rotations_about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rodrigues' formula for rotations about unit ``axes`` (n, 3) by ``angles`` (K, n)."""
-    k = _skew_batch(axes)
-    k2 = k @ k
-    s, c = np.sin(angles)[..., None, None], np.cos(angles)[..., None, None]
-    return _E3 + s * k + (1.0 - c) * k2
-
-
 def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
     """Fill ``data.L0`` (``L_0^j`` of every body) and ``data.sigma`` for K configurations.
 
     ``L_i^j = T(r_c + c_c r_j)[c_c c_j]`` (4.5)–(4.7); forward pass over the depth of
     the tree with the chain property ``L_0^j = L_0^i L_i^j`` (§4.2), one batched
     product per level; then ``σ = (L_0^j)⁻ᵀ M_j f_j`` per group of equal-width pairs.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Work
+        Work buffers for the K configurations (:meth:`BatchData.work`), filled here.
+    Qf : numpy.ndarray, shape (K, n_full)
+        Pair coordinates of each configuration, ``q_full = G q + q_offset`` (mimic
+        joints included), rad or m.
+    """
+    _pair_motions(model, data, Qf)
+    _ground_placements(data)
+    _mobility_axes(data)
+
+
+def _pair_motions(model: Model, data: Work, Qf: np.ndarray) -> None:
+    """Each pair's own motion ``T(r_j)[c_j]`` into ``data.M_rel`` and its axes ``M_j f_j``.
+
+    Kind by kind (4.8), (1.23), (1.38): ``c_j``, ``r_j`` into the views ``data.c_rel``,
+    ``data.r_rel``, the rows of ``M_j f_j`` of the euler6 and planar pairs into
+    ``data.rows`` (those of 1-DOF pairs are constant, ``Topology.rows_1dof``).
     """
     topo = data.topo
     c_rel, r_rel = data.c_rel, data.r_rel  # views into data.M_rel
@@ -289,7 +160,7 @@ def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
     bodies, dofs = topo.kinds["euler6"], topo.kind_dofs["euler6"]
     if bodies.size:
         q6 = Qf[:, dofs]  # (K, n6, 6)
-        c, eps_t = _euler123_batch(q6[..., 3:])
+        c, eps_t = euler123_batch(q6[..., 3:])
         c_rel[:, bodies] = c
         r_rel[:, bodies] = q6[..., :3]
         rows = data.rows[6]  # row a = column a of M_j = diag(cᵀ, ε)
@@ -306,20 +177,32 @@ def forward_kinematics_batch(model: Model, data: Work, Qf: np.ndarray) -> None:
         rows[..., 0, 0], rows[..., 0, 1] = ca, -sa  # cᵀ e_x
         rows[..., 1, 0], rows[..., 1, 1] = sa, ca  # cᵀ e_y
         rows[..., 2, 5] = 1.0
-    # L_i^j = T(r_c)[c_c] · T(r_j)[c_j] (4.5)–(4.7): the constant part times M_rel
     M_rel = data.M_rel
     M_rel[..., 3:, 3:] = c_rel
     if topo.translates:
-        np.matmul(_skew_batch(r_rel), c_rel, out=M_rel[..., 3:, :3])
-    # L_0^j = L_0^i L_i^j (chain property) for all bodies at once by pointer jumping:
-    # after step k, row j holds the transform from the ancestor 2^(k+1) levels up to j
-    # (row nb is the ground's identity).
+        np.matmul(skew_batch(r_rel), c_rel, out=M_rel[..., 3:, :3])
+
+
+def _ground_placements(data: Work) -> None:
+    """``L_0^j`` of every body into ``data.L0``, from the pairs' motions in ``data.M_rel``.
+
+    ``L_i^j = T(r_c)[c_c] · T(r_j)[c_j]`` (4.5)–(4.7), the constant part times M_rel;
+    then ``L_0^j = L_0^i L_i^j`` (chain property) for all bodies at once by pointer
+    jumping: after step k, row j holds the transform from the ancestor 2^(k+1) levels
+    up to j (row nb is the ground's identity).
+    """
+    topo = data.topo
     cur, other = data.L0_buffers
-    np.matmul(topo.L_construction, M_rel, out=cur[:, :-1])
+    np.matmul(topo.L_construction, data.M_rel, out=cur[:, :-1])
     for jump in topo.jumps:
         np.matmul(cur[:, jump], cur[:, :-1], out=other[:, :-1])
         cur, other = other, cur
-    data.L0 = L0 = cur[:, :-1]
+    data.L0 = cur[:, :-1]
+
+
+def _mobility_axes(data: Work) -> None:
+    """``σ = (L_0^j)⁻ᵀ M_j f_j`` of every coordinate into ``data.sigma``, group by group."""
+    topo, L0 = data.topo, data.L0
     K, nb = L0.shape[:2]
     # (L_0^j)⁻ᵀ = [[c, <p>c], [0, c]]: L_0^j = [[c, 0], [<p>c, c]] with its blocks permuted
     np.take(L0.reshape(K, nb, 36), _INV_T, axis=-1, out=data.X.reshape(K, nb, 36))
@@ -377,6 +260,16 @@ def mass_matrix_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarra
     ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` and its transpose (the
     composite form of (4.79), module docstring). The returned array is ``data.A`` and is
     overwritten by the next call with the same ``data``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : BatchData
+        ``BatchData(model, K)``: the work buffers and ``data.A``.
+    Q : numpy.ndarray, shape (K, nv)
+        One configuration per row, in the model's coordinates
+        (``Model.coordinate_names``), rad or m.
     """
     Q = _check_batch("Q", Q, model.nv)
     data = _data_for(model, Q.shape[0], data)
@@ -416,20 +309,18 @@ def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray
 def mass_matrix(model: Model, data: BatchData, q: np.ndarray) -> np.ndarray:
     """``A = S Θ Sᵀ`` at one configuration (structure-exploiting form), a new array.
 
-    ``data`` is a ``BatchData(model, 1)``.
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : BatchData
+        ``BatchData(model, 1)``.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates in the model's order (``Model.coordinate_names``), rad
+        or m.
     """
     q = check_vector("q", q, model.nv)
     return mass_matrix_batch(model, data, q[None, :])[0].copy()
-
-
-def _crm_batch(v: np.ndarray) -> np.ndarray:
-    """Motion cross product matrices ``V×`` (linear-first), ``−Φ(V)ᵀ`` of (1.55); batched."""
-    out = np.zeros(v.shape[:-1] + (6, 6))
-    w = _skew_batch(v[..., 3:])
-    out[..., :3, :3] = w
-    out[..., 3:, 3:] = w
-    out[..., :3, 3:] = _skew_batch(v[..., :3])
-    return out
 
 
 def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray, data: Work):
@@ -446,7 +337,7 @@ def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray,
         rows = data.rows[6]  # row a = column a of M_j (from forward_kinematics_batch)
         omega = (v6[..., None, 3:] @ rows[..., 3:, 3:])[..., 0, :]  # ε φ̇
         ct_x = (v6[..., None, :3] @ rows[..., :3, :3])[..., 0, :]  # cᵀ ẋ
-        out[:, bodies, :3] = -(_skew_batch(omega) @ ct_x[..., None])[..., 0]
+        out[:, bodies, :3] = -(skew_batch(omega) @ ct_x[..., None])[..., 0]
         st, ct = np.sin(q6[..., 4]), np.cos(q6[..., 4])
         sa, ca = np.sin(q6[..., 5]), np.cos(q6[..., 5])
         db, dt, da = v6[..., 3], v6[..., 4], v6[..., 5]
@@ -464,7 +355,17 @@ def _mobility_rate(model: Model, topo: Topology, Qf: np.ndarray, Vf: np.ndarray,
 
 
 def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarray) -> np.ndarray:
-    """``B(q, q̇) q̇`` (4.80) for K states, shape (K, nv) (composite form, module docstring)."""
+    """``B(q, q̇) q̇`` (4.80) for K states, shape (K, nv) (composite form, module docstring).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : BatchData
+        ``BatchData(model, K)``.
+    Q, Qd : numpy.ndarray, shape (K, nv)
+        Configurations (rad or m) and velocities (rad/s or m/s), one state per row.
+    """
     Q = _check_batch("Q", Q, model.nv)
     Qd = _check_batch("Qd", Qd, model.nv)
     Qf, Vf = _expand_batch(model, Q), _expand_batch(model, Qd, offset=False)
@@ -474,7 +375,7 @@ def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarra
     u = topo.incidence @ (data.sigma * Vf[..., None])  # Σ_a σ_a q̇_a per pair, (K, nb, 6)
     V = topo.anc.T @ u  # V⁰_j = Σ_{k ⪯ j} u_k
     rate = (data.X @ _mobility_rate(model, topo, Qf, Vf, data)[..., None])[..., 0]
-    crm = _crm_batch(V)
+    crm = crm_batch(V)
     a = topo.anc.T @ ((crm @ u[..., None])[..., 0] + rate)  # a⁰ = Ṡᵀ q̇ seen from E0
     theta0 = ground_inertias(model, data)
     h = theta0 @ V[..., None]  # momenta Θ⁰ V⁰
@@ -485,13 +386,39 @@ def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarra
 
 
 def bias_force(model: Model, data: BatchData, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """``B(q, q̇) q̇`` at one state (structure-exploiting form); ``data = BatchData(model, 1)``."""
+    """``B(q, q̇) q̇`` at one state (structure-exploiting form), shape (nv,).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : BatchData
+        ``BatchData(model, 1)``.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order.
+    """
     q, qd = check_vector("q", q, model.nv), check_vector("qd", qd, model.nv)
     return bias_force_batch(model, data, q[None, :], qd[None, :])[0]
 
 
 def gravity_force_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarray:
-    """``Q_g = S G`` (4.113)–(4.128) for K configurations: ``σ_aᵀ Θᶜ_body(a) [g0; 0]``."""
+    """``Q_g = S G`` (4.113)–(4.128) for K configurations: ``σ_aᵀ Θᶜ_body(a) [g0; 0]``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : BatchData
+        ``BatchData(model, K)``.
+    Q : numpy.ndarray, shape (K, nv)
+        One configuration per row, rad or m.
+
+    Returns
+    -------
+    numpy.ndarray, shape (K, nv)
+        The generalised gravity force of each configuration, N or N·m.
+    """
     Q = _check_batch("Q", Q, model.nv)
     data = _data_for(model, Q.shape[0], data).work(Q.shape[0])
     topo = data.topo

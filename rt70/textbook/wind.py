@@ -37,6 +37,17 @@ def wind_wrenches(
     """The wind's Wrench on every exposed body at q, by element name (ground axes).
 
     Runs the forward pass and fills S in ``data`` (:func:`update_structure`).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    condition : rt70.physics.aerodynamics.WindCondition
+        The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
     """
     update_structure(model, data, check_vector("q", q, model.nv))
     out = {}
@@ -51,7 +62,19 @@ def wind_wrenches(
 def wind_forces(
     model: Model, data: Data, q: np.ndarray, condition: WindCondition
 ) -> dict[str, np.ndarray]:
-    """Generalised force (nv,) of each exposed body at q, by element name: ``S W_i``."""
+    """Generalised force (nv,) of each exposed body at q, by element name: ``S W_i``.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    condition : rt70.physics.aerodynamics.WindCondition
+        The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
+    """
     wrenches = wind_wrenches(model, data, q, condition)
     return {name: _force(model, data, w) for name, w in wrenches.items()}
 
@@ -60,6 +83,17 @@ def wind_force(model: Model, data: Data, q: np.ndarray, condition: WindCondition
     """Generalised wind force (nv,) at q: ``Q_w = S W`` summed over the exposed bodies.
 
     Zero for a model without ``<rt70:wind>`` elements.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    condition : rt70.physics.aerodynamics.WindCondition
+        The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
     """
     Q = np.zeros(model.nv)
     for value in wind_forces(model, data, q, condition).values():
