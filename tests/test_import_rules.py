@@ -350,18 +350,6 @@ def test_detector_follows_from_package_imports(tmp_path):
     assert "rt70.scenes.rt70_data" in _loaded_with("rt70.scenes.rt70_chapter2")
 
 
-#: The largest a module of the package may grow (issue 9: one job per module).
-MAX_MODULE_LINES = 700
-
-
-def test_no_module_is_over_the_size_limit():
-    """No module of the package is over MAX_MODULE_LINES lines (split it by its jobs)."""
-    sizes = {m: len(p.read_text(encoding="utf-8").splitlines()) for m, p in MODULES.items()}
-    assert sizes and max(sizes.values()) > 100  # the modules were found and counted
-    over = {m: n for m, n in sizes.items() if n > MAX_MODULE_LINES}
-    assert not over, f"modules over {MAX_MODULE_LINES} lines: {over}"
-
-
 # --- the floors (issue 22) ----------------------------------------------------------------
 
 
