@@ -37,6 +37,7 @@ from rt70.model.scene import Scene
 from rt70.physics.constraints import HolonomicMap, locking
 from rt70.physics.loads import Wrench
 from rt70.textbook import dynamics, forces, points
+from rt70.units import ARCSEC_PER_RAD
 
 #: Newton in :func:`equilibrium` stops when its step is below this (relative, m or rad).
 STEP_TOL = 1e-12
@@ -373,10 +374,6 @@ def _gravity_stiffness(
     return _negative_jacobian(force, np.asarray(q, dtype=float), h)
 
 
-#: Arc seconds per radian (the listing's TURNE0 output unit).
-ARCSEC = 206264.80624709636
-
-
 @dataclass(frozen=True)
 class Sag:
     """Static deflection of one body under gravity, against its rigid (q_elastic = 0) pose."""
@@ -412,7 +409,7 @@ def sag(scene: Scene, q_eq: np.ndarray, held: dict[str, float]) -> list[Sag]:
     for j, name in enumerate(model.body_names):
         rel = R0[j].T @ data.R[j]
         angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-        out.append(Sag(name, (data.p[j] - p0[j]) * 1e3, angle * ARCSEC))
+        out.append(Sag(name, (data.p[j] - p0[j]) * 1e3, angle * ARCSEC_PER_RAD))
     return out
 
 
