@@ -549,7 +549,7 @@ def _textbook_calls(scene):
             m, d, q, qd, np.zeros(m.nv)
         ),
         "forces.spring_damper_force": lambda q, qd: forces.spring_damper_force(m, d, q, qd),
-        "forces.kinetic_energy": lambda q, qd: forces.kinetic_energy(m, d, q, qd),
+        "dynamics.kinetic_energy": lambda q, qd: dynamics.kinetic_energy(m, d, q, qd),
         "forces.spring_potential": lambda q, qd: forces.spring_potential(m, d, q),
         "structured.mass_matrix": lambda q, qd: structured.mass_matrix(
             m, structured.BatchData(m), q

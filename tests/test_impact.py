@@ -251,10 +251,10 @@ def test_cli_impact_bad_input_exits_2_with_one_line(argv, message, capsys):
 
 
 def test_pinocchio_needs_independent_rows_for_the_least_norm_impulse():
-    """Why rt70.reference.impact reduces the rows first (docs/impacts.md)."""
+    """Why rt70.reference.locks reduces the rows first (docs/impacts.md)."""
     import pinocchio as pin
 
-    from rt70.reference.impact import impulse_dynamics, pin_rows
+    from rt70.reference.locks import impulse_dynamics, pin_rows
 
     scene = load_scene("double_pendulum")
     ref, rd = scene.reference, scene.reference_data

@@ -190,11 +190,11 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
         ),
         "forward_dynamics": (tb_forward, lambda: reference.forward_dynamics(ref, rd, q, qd)),
         "kinetic_energy": (
-            lambda: forces.kinetic_energy(tm, td, q, qd),
+            lambda: dynamics.kinetic_energy(tm, td, q, qd),
             lambda: reference.kinetic_energy(ref, rd, q, qd),
         ),
         "potential_energy": (
-            lambda: forces.gravity_potential(tm, td, q) + forces.spring_potential(tm, td, q),
+            lambda: dynamics.gravity_potential(tm, td, q) + forces.spring_potential(tm, td, q),
             lambda: (
                 reference.gravity_potential(ref, rd, q) + reference.spring_potential(ref, rd, q)
             ),

@@ -9,7 +9,7 @@ engaged the same way):
   the ground: three rows, the point's velocity in ground axes.
 
 Each side builds the rows on its own (:mod:`rt70.textbook.locks`,
-:mod:`rt70.reference.impact`); :func:`engage` solves the impact (15) with the textbook's
+:mod:`rt70.reference.locks`); :func:`engage` solves the impact (15) with the textbook's
 A and rows through :func:`rt70.physics.impact.solve_impact`, or with Pinocchio's
 ``impulseDynamics``. The command line is ``rt70 impact`` (:mod:`rt70.cli.impact`);
 docs/impacts.md.
@@ -163,7 +163,7 @@ def constraint_rows(scene: Scene, q: np.ndarray, locks: Sequence[Lock], side: st
     """
     brakes, pins = _split(locks)
     if side == "reference":
-        from rt70.reference.impact import book_rows
+        from rt70.reference.locks import book_rows
 
         rows = book_rows(scene.reference, scene.reference_data, q, brakes, pins)
         order = _order(locks)
@@ -193,7 +193,7 @@ def engage(
 
     ``"textbook"``: the book's A (S Θ Sᵀ) and the textbook's rows through
     :func:`rt70.physics.impact.solve_impact`; ``"reference"``: Pinocchio's ``impulseDynamics``
-    (:func:`rt70.reference.impact.impulse_dynamics`), its energies from Pinocchio's A.
+    (:func:`rt70.reference.locks.impulse_dynamics`), its energies from Pinocchio's A.
     Impulses are in the order of :func:`labels`.
 
     Parameters
@@ -231,7 +231,7 @@ def engage(
         A = mass_matrix(scene.textbook, scene.textbook_data, q)
         return solve_impact(A, B_c, qd, e, gamma)
     from rt70.reference.dynamics import mass_matrix as ref_mass_matrix
-    from rt70.reference.impact import impulse_dynamics
+    from rt70.reference.locks import impulse_dynamics
 
     ref, rd = scene.reference, scene.reference_data
     brakes, pins = _split(locks)

@@ -232,12 +232,12 @@ class TextbookBackend(Backend):
 
     def energies(self, q, qd):
         """``(T, U_g, U_c)``, J, on the textbook's side."""
-        from rt70.textbook import forces
+        from rt70.textbook import dynamics, forces
 
         model, data = self.scene.textbook, self.scene.textbook_data
         return (
-            forces.kinetic_energy(model, data, q, qd),
-            forces.gravity_potential(model, data, q),
+            dynamics.kinetic_energy(model, data, q, qd),
+            dynamics.gravity_potential(model, data, q),
             forces.spring_potential(model, data, q),
         )
 

@@ -252,7 +252,7 @@ def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict,
         model, data = scene.textbook, scene.textbook_data
 
         def frames():
-            return reactions.joint_frames(model, data)
+            return reactions.joint_frames(model, data, q)
     else:
         from rt70.reference import drives as side_drives
         from rt70.reference import reactions

@@ -261,8 +261,8 @@ def _unit_run(
     freq = frequencies_hz(scene)
     model, data = scene.textbook, scene.textbook_data
     e0 = (
-        forces.kinetic_energy(model, data, q0, v0)
-        + forces.gravity_potential(model, data, q0)
+        dynamics.kinetic_energy(model, data, q0, v0)
+        + dynamics.gravity_potential(model, data, q0)
         + forces.spring_potential(model, data, q0)
     ) / (mu * lam**2)
     err, _, _ = cross_check_error(scene, settings.samples)
