@@ -18,6 +18,7 @@ from rt70.errors import Rt70Error, SingularConfigurationError
 from rt70.linear.linearize import equilibrium
 from rt70.model import optics, outputs
 from rt70.model.scene import load_scene
+from rt70.model.sides import SIDES
 from rt70.scenes import rt70_optics, rt70_state
 from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
@@ -123,7 +124,7 @@ def test_construction_is_the_design(rt70):
     system = rt70_optics.rt70_mirror_system(rt70)
     outs = optics.mirror_outputs(system, [0.0, 0.0, 1.0])
     without = [o for o in outs if o.name != "pointing_correction"]
-    for side in outputs.SIDES:
+    for side in SIDES:
         v = outputs.evaluate(rt70, np.zeros(42), without, side)
         assert_close(v["main_mirror_axis"], [0.0, 0.0, 1.0], rel=MIN_REL)
         assert_close(v["counterreflector_axis"], [0.0, 0.0, 1.0], rel=MIN_REL)
@@ -261,7 +262,7 @@ def test_outputs_ride_along_a_simulation(rt70, states):
     outs = rt70_optics.rt70_mirror_outputs(rt70, e, a)
     x0 = rt70_state.listing_initial_state(rt70)
     t = np.linspace(0.0, 0.02, 3)
-    result = simulate(rt70, (0.0, 0.02), x0, backend="textbook", t_eval=t, outputs=outs)
+    result = simulate(rt70, (0.0, 0.02), x0, side="textbook", t_eval=t, outputs=outs)
     assert result.outputs["pointing_correction"].shape == (3, 2)
     expected = outputs.evaluate_trajectory(rt70, result.q, outs, "textbook")
     for o in outs:  # the simulation evaluates the outputs by this very function: bit for bit

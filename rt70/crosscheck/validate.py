@@ -324,7 +324,7 @@ class _Tally:
             values[name] = np.asarray(x_tb, dtype=float), np.asarray(x_ref, dtype=float)
             self.t_tb[name] += dt_tb / samples
             self.t_ref[name] += dt_ref / samples
-            for side, x in zip(("textbook", "pinocchio"), values[name], strict=True):
+            for side, x in zip(("textbook", "reference"), values[name], strict=True):
                 if _nonfinite(x):
                     self.bad[name].add(side)
         return values

@@ -24,7 +24,7 @@ def servo_figure(run) -> Figure:
     ax_a, ax_t, ax_p, ax_e = fig.subplots(4, 1, sharex=True)
     fig.suptitle(
         f"{r.scene}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
-        f"{sc.azimuth_deg:g}° — {r.method} ({r.backend}), rtol {r.rtol:g}",
+        f"{sc.azimuth_deg:g}° — {r.method} ({r.side}), rtol {r.rtol:g}",
         fontsize=11,
     )
     # 1. axis angles vs reference: offsets from the start, arc seconds (elevation upward)

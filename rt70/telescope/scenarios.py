@@ -39,6 +39,7 @@ from rt70.guards.resources import check_time_series
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.model.outputs import evaluate
 from rt70.model.scene import Scene
+from rt70.model.sides import refuses_backend
 from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import (
@@ -94,13 +95,14 @@ from rt70.units import RAD_PER_ARCSEC
 METHOD = "LSODA"
 
 
+@refuses_backend
 def run_scenario(
     scene: Scene,
     sc: Scenario,
     drives: DriveFactory | None = None,
     rtol: float = 1e-6,
     samples_per_s: float = 20.0,
-    backend: str = "pinocchio",
+    side: str = "reference",
     method: str | None = None,
     progress: bool = False,
 ) -> ScenarioRun:
@@ -123,8 +125,8 @@ def run_scenario(
         Relative tolerance of the integration (:func:`rt70.simulation.simulate.simulate`).
     samples_per_s : float
         Output samples per second of simulated time.
-    backend : {"pinocchio", "textbook"}
-        Which side evaluates the mechanics.
+    side : {"reference", "textbook"}
+        Which side evaluates the mechanics (:mod:`rt70.model.sides`).
     method : str, optional
         The integration method; default :data:`METHOD` (LSODA, and why).
     progress : bool
@@ -143,7 +145,7 @@ def run_scenario(
         scene,
         (0.0, sc.t_end),
         (q0, np.zeros(scene.textbook.nv)),
-        backend=backend,
+        side=side,
         method=METHOD if method is None else method,
         rtol=rtol,
         t_eval=t_eval,
