@@ -211,8 +211,10 @@ def test_tip_on_a_line_with_its_bias_is_exact(tip_models):
 
 def test_bad_side_and_method_are_refused():
     scene = load_scene("double_pendulum")
-    with pytest.raises(Rt70Error, match="unknown side"):
+    with pytest.raises(Rt70Error, match="'pinocchio' is now 'reference'"):
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, side="pinocchio")
+    with pytest.raises(Rt70Error, match="unknown side"):
+        cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, side="ref")
     with pytest.raises(Rt70Error, match="unknown method"):
         cs.constrained_linearize(scene, _no_loop, _no_loop_jacobian, method="qr")
     with pytest.raises(Rt70Error, match="q_start has shape"):

@@ -79,11 +79,11 @@ def test_energies_match_pinocchio(name):
     ref, rd = scene.reference, scene.reference_data
     rng = np.random.default_rng(9)
     q, qd = rng.uniform(-0.5, 0.5, tm.nv), rng.uniform(-1, 1, tm.nv)
-    T = forces.kinetic_energy(tm, td, q, qd)
+    T = dynamics.kinetic_energy(tm, td, q, qd)
     assert T > 0.0
     assert_close(T, reference.kinetic_energy(ref, rd, q, qd), rel=1e-12)
     # U_g sums the weights' moments m g·c, which cancel: their size is G₀ = Σ m |g| |c|
-    Ug = forces.gravity_potential(tm, td, q)
+    Ug = dynamics.gravity_potential(tm, td, q)
     G0 = reference.weight_moment(ref, rd, q)
     assert_close(Ug, reference.gravity_potential(ref, rd, q), rel=1e-12, scale=G0)
     Us = forces.spring_potential(tm, td, q)  # a sum of positive terms (0 without springs)
@@ -99,8 +99,8 @@ def test_power_balance_of_equations_of_motion():
 
     def energy(q, qd):
         return (
-            forces.kinetic_energy(tm, td, q, qd)
-            + forces.gravity_potential(tm, td, q)
+            dynamics.kinetic_energy(tm, td, q, qd)
+            + dynamics.gravity_potential(tm, td, q)
             + forces.spring_potential(tm, td, q)
         )
 

@@ -35,26 +35,26 @@ def turret():
     return load_scene(TURRET)
 
 
-def _run(scene, backend, components, t_end=T_END, rtol=RTOL, method="DOP853"):
+def _run(scene, side, components, t_end=T_END, rtol=RTOL, method="DOP853"):
     return simulate(
-        scene, (0.0, t_end), backend=backend, components=components, method=method,
+        scene, (0.0, t_end), side=side, components=components, method=method,
         rtol=rtol, t_eval=np.linspace(0.0, t_end, 7),
     )  # fmt: skip
 
 
 @pytest.fixture(scope="module")
 def runs(turret):
-    """A voltage step on both drives of the turret, on each backend, audited."""
+    """A voltage step on both drives of the turret, on each side, audited."""
     out = {}
-    for backend in ("pinocchio", "textbook"):
-        audited = [AuditedDrive(d) for d in scene_drives(turret, backend, voltage=VOLTS)]
-        out[backend] = (_run(turret, backend, audited), audited)
+    for side in ("reference", "textbook"):
+        audited = [AuditedDrive(d) for d in scene_drives(turret, side, voltage=VOLTS)]
+        out[side] = (_run(turret, side, audited), audited)
     return out
 
 
 @pytest.mark.slow
-def test_backends_agree_on_the_driven_trajectory(runs):
-    (a, _), (b, _) = runs["pinocchio"], runs["textbook"]
+def test_sides_agree_on_the_driven_trajectory(runs):
+    (a, _), (b, _) = runs["reference"], runs["textbook"]
     assert a.success and b.success
     moved = np.max(np.abs(a.q))
     assert moved > 0.1  # the step turned the axes
@@ -63,13 +63,13 @@ def test_backends_agree_on_the_driven_trajectory(runs):
         assert_close(b.states[name], a.states[name], rel=10 * RTOL, what=name)
 
 
-@pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
-def test_energy_balance_closes_with_drives(runs, backend):
-    run, audited = runs[backend]
+@pytest.mark.parametrize("side", ["reference", "textbook"])
+def test_energy_balance_closes_with_drives(runs, side):
+    run, audited = runs[side]
     residual, scale = energy_balance(run, audited)
     assert scale > 1.0  # joules exchanged: electrical work, losses, the structure's energy
     assert residual[0] == 0.0  # the balance starts from the same numbers on both sides
-    print(f"{backend}: residual {np.max(np.abs(residual)) / scale:.2e} of {scale:.3g} J")
+    print(f"{side}: residual {np.max(np.abs(residual)) / scale:.2e} of {scale:.3g} J")
     assert_close(residual, np.zeros_like(residual), rel=RTOL, scale=scale)
     # every flow took part
     for flow in ("armature_loss", "motor_loss", "reducer_loss"):
@@ -80,7 +80,7 @@ def test_energy_balance_closes_on_the_rt70(tmp_path):
     """Both drives of rt70_servo under a voltage step, from the undeformed zenith pointing."""
     scene = load_scene("rt70_servo")
     audited = [AuditedDrive(d) for d in scene_drives(scene, "reference", voltage=20.0)]
-    run = _run(scene, "pinocchio", audited, t_end=0.01, rtol=1e-8, method="Radau")
+    run = _run(scene, "reference", audited, t_end=0.01, rtol=1e-8, method="Radau")
     residual, scale = energy_balance(run, audited)
     print(f"rt70_servo: residual {np.max(np.abs(residual)) / scale:.2e} of {scale:.3g} J")
     assert run.states["azimuth:electrical_work"][-1] > 1.0
@@ -106,7 +106,7 @@ def test_twist_on_the_coordinate_with_the_sector_force_breaks_the_balance(turret
         coupling=_BookCoupling(turret, el, "reference"),
     )  # fmt: skip
     audited = [AuditedDrive(drive)]
-    run = _run(turret, "pinocchio", audited)
+    run = _run(turret, "reference", audited)
     residual, scale = energy_balance(run, audited)
     print(f"book's twist: residual {np.max(np.abs(residual)) / scale:.2e} of {scale:.3g} J")
     assert np.max(np.abs(residual)) > 1e4 * RTOL * scale
@@ -130,7 +130,7 @@ def test_servo_reads_the_drive_angle_and_its_energy_balances(turret):
     errors, _, _ = servo._loops(0.0, q, np.zeros(6))
     assert_close(errors[0], 0.1 - theta, rel=MIN_REL, scale=0.1 + abs(theta))
     audited = [AuditedDrive(servo)]
-    run = _run(turret, "pinocchio", audited, t_end=0.6)
+    run = _run(turret, "reference", audited, t_end=0.6)
     residual, scale = energy_balance(run, audited)
     assert_close(residual, np.zeros_like(residual), rel=RTOL, scale=scale)
     assert 0.02 < servo.coupling.angle(run.q[-1]) < 0.1  # on its way to the 0.1 rad step

@@ -49,13 +49,13 @@ def _linear_response(t: np.ndarray, voltage: float) -> np.ndarray:
     return np.column_stack([sol.y[3], sol.y[1], sol.y[4], sol.y[2]])
 
 
-@pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
-def test_drive_on_a_rotor_follows_its_lagrange_form(backend):
+@pytest.mark.parametrize("side", ["reference", "textbook"])
+def test_drive_on_a_rotor_follows_its_lagrange_form(side):
     scene = scene_from_text(ROTOR, "rotor")
     drive = DcDrive("az", scene.coordinate_names, "axis", PARAMS, voltage=12.0)
     t = np.linspace(0.0, 0.5, 101)
     run = simulate(
-        scene, (0.0, 0.5), backend=backend, components=[drive], t_eval=t,
+        scene, (0.0, 0.5), side=side, components=[drive], t_eval=t,
         method="DOP853", rtol=1e-11, atol=1e-13,
     )  # fmt: skip
     ref = _linear_response(t, 12.0)

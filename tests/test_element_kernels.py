@@ -108,8 +108,8 @@ def test_a_mimic_model_keeps_the_python_path():
 
     scene = load_scene("gear_reducer")
     assert not scene.reference.identity_map
-    assert BACKENDS["pinocchio"](scene).kernels is None
-    assert BACKENDS["pinocchio"](load_scene("rt70")).kernels is not None
+    assert BACKENDS["reference"](scene).kernels is None
+    assert BACKENDS["reference"](load_scene("rt70")).kernels is not None
 
 
 def test_a_model_with_a_free_flyer_on_the_path_is_not_supported():
@@ -142,9 +142,9 @@ def test_simulation_with_kernels_equals_the_python_path(monkeypatch):
     x0 = listing_initial_state(scene)
     t = np.linspace(0.0, 0.3, 31)
     runs = []
-    backend = BACKENDS["pinocchio"]
+    backend = BACKENDS["reference"]
     for kernels in (True, False):
-        monkeypatch.setitem(BACKENDS, "pinocchio", functools.partial(backend, kernels=kernels))
+        monkeypatch.setitem(BACKENDS, "reference", functools.partial(backend, kernels=kernels))
         runs.append(simulate(scene, (0.0, 0.3), x0, rtol=1e-8, t_eval=t))
     fast, slow = runs
     assert_close(fast.q, slow.q, rel=1e-6)

@@ -71,7 +71,7 @@ def test_plant_is_unchanged(servo, monkeypatch):
 
 def test_unknown_side_is_refused(servo):
     scene, held, q0 = servo
-    with pytest.raises(Rt70Error, match="unknown side"):
+    with pytest.raises(Rt70Error, match="'pinocchio' is now 'reference'"):
         lin.stiffness_matrix(scene, q0, side="pinocchio")
     with pytest.raises(Rt70Error, match="unknown side"):
         lin.equilibrium(scene, held, side="")

@@ -221,7 +221,7 @@ def test_cli_impact_json_and_text(capsys):
     assert_close(out["energy_lost"], out["carnot"], rel=1e-12)
     assert_close(out["impulses"], [-7.0 / 48.0], rel=1e-12)  # (A Δq̇)₂
     # a relative error: its own scale is 1
-    assert_close(out["pinocchio"]["max_rel_err_impulses"], 0.0, rel=1e-12, scale=1.0)
+    assert_close(out["reference"]["max_rel_err_impulses"], 0.0, rel=1e-12, scale=1.0)
     assert main([*argv, "--after", "0.1"]) == 0
     text = capsys.readouterr().out
     assert "brake:joint2" in text and "energy audit at t = 0.1 s" in text
@@ -251,10 +251,10 @@ def test_cli_impact_bad_input_exits_2_with_one_line(argv, message, capsys):
 
 
 def test_pinocchio_needs_independent_rows_for_the_least_norm_impulse():
-    """Why rt70.reference.impact reduces the rows first (docs/impacts.md)."""
+    """Why rt70.reference.locks reduces the rows first (docs/impacts.md)."""
     import pinocchio as pin
 
-    from rt70.reference.impact import impulse_dynamics, pin_rows
+    from rt70.reference.locks import impulse_dynamics, pin_rows
 
     scene = load_scene("double_pendulum")
     ref, rd = scene.reference, scene.reference_data

@@ -22,6 +22,7 @@ from rt70.errors import ExtensionError, Rt70Error
 from rt70.mechanics import chaplygin_cart as cart
 from rt70.mechanics import nonholonomic_scene as ns
 from rt70.model.scene import load_scene, scene_from_text
+from rt70.model.sides import SIDES
 from rt70.physics import nonholonomic as nh
 from rt70.testing import MIN_REL, assert_close, close
 
@@ -111,7 +112,7 @@ def test_cli_refuses_a_bad_element_in_one_line(tmp_path: Path, capsys):
 
 
 # --- A(q) and Ȧ q̇ -------------------------------------------------------------------------
-@pytest.mark.parametrize("side", ns.SIDES)
+@pytest.mark.parametrize("side", SIDES)
 def test_rows_are_the_rolling_constraints(cart_scene, side):
     for q, _ in _states(4):
         th = q[2]
@@ -121,7 +122,7 @@ def test_rows_are_the_rolling_constraints(cart_scene, side):
         assert_close(A, expected, rel=1e-14)
 
 
-@pytest.mark.parametrize("side", ns.SIDES)
+@pytest.mark.parametrize("side", SIDES)
 def test_constraint_rate_is_the_derivative_of_the_rows(cart_scene, side):
     rng = np.random.default_rng(3)
     q, qd, h = rng.uniform(-2, 2, 5), rng.uniform(-2, 2, 5), 1e-6
@@ -170,7 +171,7 @@ def a_412(th: float, qd: np.ndarray, printed: bool = False) -> np.ndarray:
     return np.array([a1, a2 - M0 * L * thd**2 * s, 0.0])
 
 
-@pytest.mark.parametrize("side", ns.SIDES)
+@pytest.mark.parametrize("side", SIDES)
 def test_reduced_cart_is_48_and_the_corrected_412(cart_scene, side):
     for q, qd in _states(5):
         _, red = ns.reduced_system(cart_scene, side, q, qd, cart.INDEPENDENT, names=cart.ROLLING)

@@ -18,14 +18,15 @@ from rt70.errors import Rt70Error, SingularConfigurationError
 from rt70.linear.linearize import equilibrium
 from rt70.model import optics, outputs
 from rt70.model.scene import load_scene
+from rt70.model.sides import SIDES
 from rt70.scenes import rt70_optics, rt70_state
 from rt70.simulation.simulate import simulate
 from rt70.testing import MIN_REL, assert_close
+from rt70.units import ARCSEC_PER_RAD, MM_PER_M
 
-ARCSEC = optics.ARCSEC
 #: The scale of the quantities each output is formed from (unit vectors, positions of
 #: order metres): 1 in its unit, 1 rad in arcsec, 1 m in mm.
-NATURAL = {"1": 1.0, "arcsec": ARCSEC, "mm": 1e3}
+NATURAL = {"1": 1.0, "arcsec": ARCSEC_PER_RAD, "mm": MM_PER_M}
 #: An output known exactly (zero by geometry, or a known small angle) holds to this
 #: fraction of its natural scale: the rounding of unit vectors and of positions some tens
 #: of metres from the origin (up to 140 ulps measured).
@@ -41,7 +42,7 @@ def assert_zero(values, unit: str, what: str = "") -> None:
 def assert_angle(actual, expected, what: str = "") -> None:
     """A misalignment (arcsec) of known size: formed from unit vectors, so it rounds on
     the scale of 1 rad, not of its own (small) value."""
-    assert_close(actual, expected, rel=ROUNDING_REL, scale=ARCSEC, what=what)
+    assert_close(actual, expected, rel=ROUNDING_REL, scale=ARCSEC_PER_RAD, what=what)
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +124,7 @@ def test_construction_is_the_design(rt70):
     system = rt70_optics.rt70_mirror_system(rt70)
     outs = optics.mirror_outputs(system, [0.0, 0.0, 1.0])
     without = [o for o in outs if o.name != "pointing_correction"]
-    for side in outputs.SIDES:
+    for side in SIDES:
         v = outputs.evaluate(rt70, np.zeros(42), without, side)
         assert_close(v["main_mirror_axis"], [0.0, 0.0, 1.0], rel=MIN_REL)
         assert_close(v["counterreflector_axis"], [0.0, 0.0, 1.0], rel=MIN_REL)
@@ -150,12 +151,12 @@ def test_turning_the_dish_asks_for_the_opposite_correction(rt70, coordinate):
     outs = rt70_optics.rt70_mirror_outputs(rt70, elevation, azimuth)
     k = 0 if coordinate == "platform_rz" else 1
     for delta_arcsec in (10.0, 1.0):
-        q = _pointing(rt70, elevation, azimuth, **{coordinate: delta_arcsec / ARCSEC})
+        q = _pointing(rt70, elevation, azimuth, **{coordinate: delta_arcsec / ARCSEC_PER_RAD})
         v = outputs.evaluate(rt70, q, outs, "textbook")
         expected = np.zeros(2)
         expected[k] = -delta_arcsec
         # within the second-order bound δ² (in rad, shown in arcsec), at both sizes
-        second_order = (delta_arcsec / ARCSEC) ** 2 * ARCSEC
+        second_order = (delta_arcsec / ARCSEC_PER_RAD) ** 2 * ARCSEC_PER_RAD
         assert_close(v["pointing_correction"], expected, rel=1.0, scale=second_order)
         if coordinate == "base_rx":  # a turn in the source's vertical plane: the angle itself
             assert_angle(v["main_mirror_misalignment"][0], delta_arcsec)
@@ -187,18 +188,18 @@ def test_tilting_the_counterreflector_asks_for_the_opposite_turn(rt70, coordinat
     no translation to first order (the turn back also brings the focus back)."""
     outs = rt70_optics.rt70_mirror_outputs(rt70, 50.0, 10.0)
     delta = 5.0  # arcsec
-    q = _pointing(rt70, 50.0, 10.0, **{coordinate: delta / ARCSEC})
+    q = _pointing(rt70, 50.0, 10.0, **{coordinate: delta / ARCSEC_PER_RAD})
     v = outputs.evaluate(rt70, q, outs, "reference")
     assert_angle(v["counterreflector_misalignment"][0], delta)
     assert_close(np.linalg.norm(v["counterreflector_error"]), delta, rel=1e-6)
     expected = np.zeros(3)
     expected[k] = -delta
     assert_close(v["counterreflector_rotation"], expected, rel=2e-7)  # on δ
-    lever = 1.2e3 * delta / ARCSEC  # mm the focus moved, 1.2 m from the pivot
+    lever = 1.2e3 * delta / ARCSEC_PER_RAD  # mm the focus moved, 1.2 m from the pivot
     assert_close(abs(v["focal_offset"][1 - k]), lever, rel=1e-6)
     # second order only: the chord of the turn back, lever · δ/2
     translation = v["counterreflector_translation"]
-    assert_close(translation, np.zeros(3), rel=1.0, scale=lever * delta / ARCSEC)
+    assert_close(translation, np.zeros(3), rel=1.0, scale=lever * delta / ARCSEC_PER_RAD)
 
 
 def test_counterreflector_system_is_rank_two(rt70, states):
@@ -237,8 +238,8 @@ def test_output_matrix_is_the_derivative(rt70, states):
     # the pointing correction needs the azimuth and elevation coordinates
     names = rt70.textbook.coordinate_names
     row = sum(o.size for o in outs[: [o.name for o in outs].index("pointing_correction")])
-    assert_close(C_tb[row, names.index("platform_rz")], -ARCSEC, rel=1e-3)
-    assert_close(C_tb[row + 1, names.index("base_rx")], -ARCSEC, rel=1e-3)
+    assert_close(C_tb[row, names.index("platform_rz")], -ARCSEC_PER_RAD, rel=1e-3)
+    assert_close(C_tb[row + 1, names.index("base_rx")], -ARCSEC_PER_RAD, rel=1e-3)
 
 
 def test_output_matrix_refuses_what_has_no_derivative(rt70):
@@ -261,7 +262,7 @@ def test_outputs_ride_along_a_simulation(rt70, states):
     outs = rt70_optics.rt70_mirror_outputs(rt70, e, a)
     x0 = rt70_state.listing_initial_state(rt70)
     t = np.linspace(0.0, 0.02, 3)
-    result = simulate(rt70, (0.0, 0.02), x0, backend="textbook", t_eval=t, outputs=outs)
+    result = simulate(rt70, (0.0, 0.02), x0, side="textbook", t_eval=t, outputs=outs)
     assert result.outputs["pointing_correction"].shape == (3, 2)
     expected = outputs.evaluate_trajectory(rt70, result.q, outs, "textbook")
     for o in outs:  # the simulation evaluates the outputs by this very function: bit for bit
@@ -288,11 +289,11 @@ def test_tilting_the_mirror_or_its_ring(rt70, coordinate):
     ask for Δβ = −δ (the bearing's x is the ring's x here) within δ²."""
     outs = rt70_optics.rt70_mirror_outputs(rt70, 60.0, -30.0)
     delta = 20.0  # arcsec
-    q = _pointing(rt70, 60.0, -30.0, **{coordinate: delta / ARCSEC})
+    q = _pointing(rt70, 60.0, -30.0, **{coordinate: delta / ARCSEC_PER_RAD})
     v = outputs.evaluate(rt70, q, outs, "textbook")
     on_ring = coordinate == "main_mirror_rx"
-    axis_turned = abs(v["main_mirror_axis"][1]) * ARCSEC
+    axis_turned = abs(v["main_mirror_axis"][1]) * ARCSEC_PER_RAD
     assert_close(axis_turned, delta if on_ring else 0.0, rel=5e-8, scale=delta)  # on the tilt
     assert_angle(v["main_mirror_misalignment"][0], delta)
-    bound = (delta / ARCSEC) ** 2 * ARCSEC
+    bound = (delta / ARCSEC_PER_RAD) ** 2 * ARCSEC_PER_RAD
     assert_close(v["pointing_correction"], [0.0, -delta], rel=1.0, scale=bound)

@@ -39,7 +39,7 @@ def _fit(t: np.ndarray, y: np.ndarray, w: float) -> tuple[complex, float]:
 def test_python_control_model_matches_the_nonlinear_small_signal_response(servo, amplitude):
     """The azimuth torque → azimuth angle of rt70_servo at elevation 45°, 0.75 Hz.
 
-    The nonlinear model (Pinocchio backend, BDF, rtol 1e-8) starts at the static
+    The nonlinear model (reference side, BDF, rtol 1e-8) starts at the static
     equilibrium with the drives' holding torques, and a torque ``a·w(t)·sin ωt`` on the
     azimuth axis (a = 1e4 or 2e4 N·m: about 1″ of azimuth, so the nonlinearity is
     negligible; w a 3 s ramp-in). Over 12–20 s the angle is fitted by

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rt70.errors import NonFiniteError, ShapeError, UnknownLinkError
+from rt70.errors import NonFiniteError, Rt70Error, ShapeError, UnknownLinkError
 from rt70.linear import linearize as lin
 from rt70.model import outputs
 from rt70.model.scene import load_scene, scene_from_text
@@ -313,8 +313,10 @@ def test_output_errors(rt70):
     q = np.zeros(rt70.textbook.nv)
     with pytest.raises(Exception, match="named more than once: main_mirror_focus"):
         outputs.evaluate(rt70, q, [focus, focus])
-    with pytest.raises(Exception, match="unknown side 'pinocchio'"):
+    with pytest.raises(Rt70Error, match="side 'pinocchio' is now 'reference'"):
         outputs.evaluate(rt70, q, [focus], "pinocchio")
+    with pytest.raises(Rt70Error, match="unknown side 'ref'"):
+        outputs.evaluate(rt70, q, [focus], "ref")
     bad = outputs.Output("two", "m", 2, focus.points)  # the formula gives 3 components
     with pytest.raises(ShapeError, match="output 'two': expected shape"):
         outputs.evaluate(rt70, q, [bad])
@@ -322,15 +324,14 @@ def test_output_errors(rt70):
         outputs.evaluate(rt70, q, [outputs.position_output("x", "nowhere", [0, 0, 0])])
 
 
-@pytest.mark.parametrize("backend", ["pinocchio", "textbook"])
-def test_simulation_carries_outputs(tmp_path, backend):
+@pytest.mark.parametrize("side", ["reference", "textbook"])
+def test_simulation_carries_outputs(tmp_path, side):
     scene = load_scene("double_pendulum")
     tip = outputs.position_output("tip", "link2", [0.0, 0.0, -1.0])
     t = np.linspace(0.0, 0.05, 6)
     x0 = (np.array([0.3, -0.2]), np.zeros(2))
-    result = simulate(scene, (0.0, 0.05), x0, backend=backend, t_eval=t, outputs=[tip])
+    result = simulate(scene, (0.0, 0.05), x0, side=side, t_eval=t, outputs=[tip])
     assert result.outputs["tip"].shape == (6, 3)
-    side = "reference" if backend == "pinocchio" else "textbook"
     expected = outputs.evaluate_trajectory(scene, result.q, [tip], side)["tip"]
     assert np.array_equal(result.outputs["tip"], expected)  # the same function: bit for bit
     assert not close(result.outputs["tip"][0], result.outputs["tip"][-1], rel=1e-5)  # it moved

@@ -231,7 +231,7 @@ def test_euler6_chain_carries_one_wrench_in_six_frames(scenes):
     tm, td = scene.textbook, scene.textbook_data
     q, qd, qdd = _state(tm.nv, 12)
     tb = tb_reactions.joint_reactions(tm, td, q, qd, qdd)
-    frames = tb_reactions.joint_frames(tm, td)
+    frames = tb_reactions.joint_frames(tm, td, q)
     ref_frames = ref_reactions.joint_frames(scene.reference, scene.reference_data, q)
     size = max(np.max(np.abs(p)) for _, p in ref_frames.values())  # of the mechanism, m
     for names in tm.pair_joints:

@@ -16,6 +16,7 @@ from rt70.errors import Rt70Error
 from rt70.scenes import rt70_data as data
 from rt70.scenes import rt70_drives as drv
 from rt70.testing import MIN_REL, close
+from rt70.units import RAD_PER_ARCSEC
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "drives.md"
 AXES = {"az": drv.AZIMUTH_DRIVE, "el": drv.ELEVATION_DRIVE}
@@ -72,7 +73,7 @@ FIELDS |= {
     f"motor.{f.name}": ((lambda d, n=f.name: getattr(d.motor, n)), ROUNDING)
     for f in dataclasses.fields(drv.DcMotor)
 }
-CONSTANTS = {"*.kgf_m": drv.KGF_M, "*.arcsec": drv.ARCSEC}
+CONSTANTS = {"*.kgf_m": drv.KGF_M, "*.arcsec": RAD_PER_ARCSEC}
 
 
 def _close(a: float, b: float, rel: float) -> bool:
@@ -143,8 +144,8 @@ def test_book_torques_are_converted_from_kgf_m():
 
 
 def test_angle_and_speed_units():
-    assert _close(drv.ARCSEC, math.radians(1 / 3600), 1e-14)
-    assert _close(drv.AZIMUTH_DRIVE.trains.backlash_half_width, drv.ARCSEC, PRINTED)
+    assert _close(RAD_PER_ARCSEC, math.radians(1 / 3600), 1e-14)
+    assert _close(drv.AZIMUTH_DRIVE.trains.backlash_half_width, RAD_PER_ARCSEC, PRINTED)
     motor = drv.MOTOR
     assert _close(motor.rated_speed, 2 * math.pi * 3000 / 60, PRINTED)
     top = drv.AZIMUTH_DRIVE.friction.top_speed

@@ -12,7 +12,7 @@ from rt70.cli.main import main
 from rt70.errors import Rt70Error
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.model.scene import load_scene
-from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.telescope import scenarios as S
 from rt70.telescope.scene_servo import (
@@ -22,6 +22,7 @@ from rt70.telescope.scene_servo import (
     scene_equilibrium,
 )
 from rt70.testing import assert_close
+from rt70.units import RAD_PER_ARCSEC
 
 #: The sector's force has these components besides base_rx (rt70_servo at 45°).
 SECTOR_COORDINATES = ("base_y", "base_z", "counterweight_y")
@@ -55,7 +56,7 @@ def test_elevation_drive_pushes_through_the_sector(servo_scene, started):
     assert_close(Q[names.index("base_rx")], K, rel=1e-3)
     k = names.index("base_rx")
     assert el.encoder(q0) == q0[k]  # the coordinate itself, read
-    assert abs(el.coupling.angle(q0) - q0[k]) > 10 * ARCSEC  # the sag between them (45″)
+    assert abs(el.coupling.angle(q0) - q0[k]) > 10 * RAD_PER_ARCSEC  # the sag between them (45″)
     az = next(c for c in components if c.names[0].startswith("azimuth:"))
     Qa = az.force(0.0, q0, np.zeros_like(q0), az.initial[:3])
     assert np.count_nonzero(Qa) == 1 and Qa[names.index("platform_rz")] != 0.0
@@ -108,7 +109,7 @@ def test_hold_from_the_start_does_not_move(servo_scene, started):
     _, q0, _, components = started
     el = next(c for c in components if c.names[0].startswith("elevation:"))
     k = servo_scene.coordinate_names.index("base_rx")
-    sag = abs(el.coupling.angle(q0) - q0[k]) / ARCSEC  # the deflection the weights cause, ″
+    sag = abs(el.coupling.angle(q0) - q0[k]) / RAD_PER_ARCSEC  # the deflection the weights cause, ″
     run = S.run_scenario(servo_scene, S.scenario("hold", 45.0, 0.0, 2.0), SceneServoFactory())
     for axis in ("azimuth", "elevation"):
         error = run.axis_error[axis]

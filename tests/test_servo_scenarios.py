@@ -20,6 +20,7 @@ from rt70.model.scene import load_scene, scene_from_text
 from rt70.simulation.states import MechanicsForces
 from rt70.telescope import scenarios as S
 from rt70.testing import assert_close
+from rt70.units import RAD_PER_ARCSEC
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +39,7 @@ def test_hold_has_no_start_up_transient(servo_scene):
     run = S.run_scenario(servo_scene, S.scenario("hold", 30.0, 0.0, 1.0))
     m = run.metrics
     # within the solver's absolute tolerance on angles, in arc seconds
-    assert_close(m["pointing_drift_arcsec"], 0.0, rel=1.0, scale=run.result.atol / S.ARCSEC)
+    assert_close(m["pointing_drift_arcsec"], 0.0, rel=1.0, scale=run.result.atol / RAD_PER_ARCSEC)
     hold = m["holding_torque_elevation_Nm"]
     assert 1.0e7 < hold < S.ELEVATION_DRIVE.nominal_torque  # gravity torque, within the drive
     torque = run.axis_torque["elevation"]
@@ -94,7 +95,7 @@ def test_predicted_settling_slews_at_the_rate_limit():
     """Past the linear range, one more degree of step costs exactly 1°/Ω of slewing."""
     g = S.axis_gains(S.AZIMUTH_DRIVE, *S.AXIS_TUNING["azimuth"])
     t1, t2 = S.predicted_settling(3600.0, g), S.predicted_settling(7200.0, g)
-    assert_close(t2 - t1, 3600.0 * S.ARCSEC / g.rate_limit, rel=1e-9)
+    assert_close(t2 - t1, 3600.0 * RAD_PER_ARCSEC / g.rate_limit, rel=1e-9)
     assert S.predicted_settling(0.5, g) == 0.0  # already inside the band: the branch's 0
 
 

@@ -1,4 +1,4 @@
-"""Time simulation: backend agreement, energy audit, outputs, bad input."""
+"""Time simulation: the two sides agree, energy audit, outputs, bad input."""
 
 import numpy as np
 import pytest
@@ -18,10 +18,10 @@ def test_backends_agree_on_trajectories():
     x0 = (rng.uniform(-0.05, 0.05, n), rng.uniform(-0.1, 0.1, n))
     t = np.linspace(0.0, 0.5, 51)
     runs = {
-        b: simulate(scene, (0.0, 0.5), x0, backend=b, method="DOP853", rtol=1e-10, t_eval=t)
-        for b in ("pinocchio", "textbook")
+        s: simulate(scene, (0.0, 0.5), x0, side=s, method="DOP853", rtol=1e-10, t_eval=t)
+        for s in ("reference", "textbook")
     }
-    a, b = runs["pinocchio"], runs["textbook"]
+    a, b = runs["reference"], runs["textbook"]
     assert a.success and b.success
     scale = np.abs(a.q).max() + np.abs(a.qd).max()  # the state's size
     assert_close(b.q, a.q, rel=1e-8, scale=scale)
@@ -33,8 +33,8 @@ def test_rt70_backends_agree_from_the_listing_state():
     scene = load_scene("rt70")
     t = np.linspace(0.0, 0.05, 11)
     x0 = listing_initial_state(scene)
-    a = simulate(scene, (0.0, 0.05), x0, backend="pinocchio", method="BDF", rtol=1e-8, t_eval=t)
-    b = simulate(scene, (0.0, 0.05), x0, backend="textbook", method="BDF", rtol=1e-8, t_eval=t)
+    a = simulate(scene, (0.0, 0.05), x0, side="reference", method="BDF", rtol=1e-8, t_eval=t)
+    b = simulate(scene, (0.0, 0.05), x0, side="textbook", method="BDF", rtol=1e-8, t_eval=t)
     assert a.success and b.success
     assert_close(b.q, a.q, rel=1e-6)
 
@@ -130,7 +130,7 @@ def test_rhs_jacobian_for_implicit_methods_is_checked():
 
     scene = load_scene("two_body_gravity")
     n = scene.textbook.nv
-    analytic = BACKENDS["pinocchio"](scene)
+    analytic = BACKENDS["reference"](scene)
     textbook = BACKENDS["textbook"](scene)
 
     def rhs(x):

@@ -62,8 +62,8 @@ def test_timing_splits_the_wall_time_for_every_family():
         # the parts add up to the wall time: (wall − rhs − jacobian) + rhs + jacobian
         assert_close(sum(r.timing.values()), r.wall_time_s, rel=MIN_REL)
         assert (r.timing["jacobian"] > 0.0) == (method != "DOP853")  # analytic Jacobian
-    # the textbook backend has none: CVODE differences the right-hand side itself
-    r = simulate(scene, (0.0, 0.2), x0, backend="textbook", method="CVODE")
+    # the textbook side has none: CVODE differences the right-hand side itself
+    r = simulate(scene, (0.0, 0.2), x0, side="textbook", method="CVODE")
     assert r.success and r.timing["jacobian"] == 0.0 and r.njev > 0
     assert r.n_steps == len(r.t) - 1 > 0
 
@@ -125,7 +125,7 @@ def test_closed_chain_runs_with_cvode():
     scene = load_scene("crank_slider")
     x0 = assemble(scene, np.zeros(3), np.array([10.0, 0.0, 0.0]), keep=["crank_joint"])
     t = np.linspace(0.0, 0.2, 5)
-    kw = dict(backend="pinocchio", t_eval=t)
+    kw = dict(side="reference", t_eval=t)
     ref = simulate(scene, (0.0, 0.2), x0, method="DOP853", rtol=1e-10, atol=1e-12, **kw)
     r = simulate(scene, (0.0, 0.2), x0, method="CVODE", rtol=1e-8, atol=1e-10, **kw)
     assert r.success and r.timing["jacobian"] == 0.0  # constrained: difference quotients

@@ -59,7 +59,7 @@ def two_body():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
-@pytest.mark.parametrize("side", [0, 1], ids=["textbook", "pinocchio"])
+@pytest.mark.parametrize("side", [0, 1], ids=["textbook", "reference"])
 @pytest.mark.parametrize("quantity", QUANTITIES)
 def test_nonfinite_value_fails_its_row(two_body, monkeypatch, quantity, side, value):
     _corrupt(monkeypatch, quantity, side, value)
@@ -67,7 +67,7 @@ def test_nonfinite_value_fails_its_row(two_body, monkeypatch, quantity, side, va
     bad = records[quantity]
     assert not bad.passed(TOL) and not bad.passed(math.inf)
     assert bad.max_rel_err == math.inf and bad.max_abs_err == math.inf
-    assert bad.nonfinite == ("textbook" if side == 0 else "pinocchio")
+    assert bad.nonfinite == ("textbook" if side == 0 else "reference")
     for name, r in records.items():
         if name != quantity:
             assert r.passed(TOL) and not r.nonfinite, (name, r)

@@ -496,7 +496,7 @@ def test_simulated_wind_power_is_its_input_work(servo):
 
 
 @pytest.mark.slow
-def test_gusty_wind_on_the_textbook_backend(turret):
+def test_gusty_wind_on_the_textbook_side(turret):
     from rt70.simulation.simulate import simulate
     from rt70.wind.load import WindLoad
 
@@ -504,7 +504,7 @@ def test_gusty_wind_on_the_textbook_backend(turret):
     gust = lambda t: 5.0 * math.sin(7.0 * t)  # noqa: E731
     load = WindLoad(turret, mean, gust=gust, side="textbook")
     t = np.linspace(0.0, 0.5, 1001)
-    result = simulate(turret, (0.0, 0.5), backend="textbook", t_eval=t, components=[load])
+    result = simulate(turret, (0.0, 0.5), side="textbook", t_eval=t, components=[load])
     assert result.success
     assert_close(result.relative_drift, 0.0, rel=1e-5, scale=1.0)  # a relative drift
     work = _trapezoid_work(result, lambda t, q: load.force(t, q, None, np.zeros(0)))

@@ -8,7 +8,7 @@ rounds:
 - ``simulate(rt70, 10 s)`` from the listing's state, axes free, BDF at rtol 1e-6 (the
   default of ``rt70 simulate rt70 --t-end 10`` on both): integration wall time, steps,
   evaluations; and the same with ``--method`` (after only, e.g. LSODA);
-- the right-hand side (the Pinocchio backend's ``accelerations``) and its Jacobian per
+- the right-hand side (the reference side's backend's ``accelerations``) and its Jacobian per
   call, against ``pin.aba`` / ``pin.computeABADerivatives`` in the same process;
 - the servo closed: ``rt70_servo``'s step-elevation scenario, 10 s, LSODA rtol 1e-6;
 - the whole command ``python -m rt70 simulate rt70 --t-end 10 --no-plot`` (wall).
@@ -49,7 +49,7 @@ with single_threaded():
     if method != "BDF":
         r = sim.simulate(scene, (0.0, 10.0), (q, qd), method=method, rtol=rtol)
         out["method"] = [r.wall_time_s, r.n_steps, r.nfev, r.njev]
-    side = BACKENDS["pinocchio"](scene)
+    side = BACKENDS["reference"](scene)
     ref, rd = scene.reference, scene.reference_data
     tau = np.zeros(ref.pin_model.nv)
     calls = {

@@ -70,7 +70,7 @@ def timings(name: str, rounds: int) -> list[dict]:
         return ref_loops.constrained_forward_dynamics(ref, rd, q, qd, stabilization=gains)
 
     rows = []
-    sides = (("textbook", tb_closed, tb_free), ("pinocchio", ref_closed, ref_free))
+    sides = (("textbook", tb_closed, tb_free), ("reference", ref_closed, ref_free))
     for side, closed, free in sides:
         t_closed, t_free, ratio = compare(closed, free, rounds=rounds, budget_s=0.05)
         rows.append(

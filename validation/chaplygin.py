@@ -464,7 +464,7 @@ def sleigh_check(sleigh, lines: list[str]) -> None:
         "| side | t (s) | v | ω | θ | (x, y) | max error vs analytic (v, ω, θ) | energy − J_M ω0² |"
     )
     say("|---|---|---|---|---|---|---|---|")
-    for side in ns.SIDES:
+    for side in ("textbook", "reference"):
         sol = ns.simulate_constrained(sleigh, side, np.zeros(3), np.array([0, 0, 1.0]), times, 10.0)
         q, qd = sol.y[:3], sol.y[3:]
         v = qd[0] * np.cos(q[2]) + qd[1] * np.sin(q[2])

@@ -69,8 +69,8 @@ else:
     dynamics.gravity_force(m, d, q)
     Qc, Qd = forces.spring_damper_force(m, d, q, qd)
     dynamics.forward_dynamics(m, d, q, qd, Qc + Qd)
-    forces.kinetic_energy(m, d, q, qd)
-    forces.gravity_potential(m, d, q)
+    dynamics.kinetic_energy(m, d, q, qd)
+    dynamics.gravity_potential(m, d, q)
     forces.spring_potential(m, d, q)
     nv, nb = m.n_full, m.nb
 end = status()

@@ -21,8 +21,7 @@ from rt70.model.scene import load_scene
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.simulation.simulate import simulate
 from rt70.telescope import scenarios as S
-
-ARCSEC = S.ARCSEC
+from rt70.units import RAD_PER_ARCSEC
 
 
 def run(scene, q0, Q, axis, hz, ratio, step, t_end):
@@ -45,14 +44,14 @@ def run(scene, q0, Q, axis, hz, ratio, step, t_end):
     if not r.success:
         return f"FAIL at {r.t[-1]}"
     k = names.index("platform_rz" if axis == "azimuth" else "base_rx")
-    err = (q0[k] + step - r.q[:, k]) / ARCSEC
+    err = (q0[k] + step - r.q[:, k]) / RAD_PER_ARCSEC
     ts = S.settling_time(r.t, err)
     last = np.abs(err[r.t > t_end - 5]).max()
     return f'settle1 {ts:.2f} overshoot {(-err).max():.2f}" last5 max {last:.3f}"'
 
 
 def main(argv):
-    axis, t_end, step = argv[0], float(argv[1]), float(argv[2]) * ARCSEC
+    axis, t_end, step = argv[0], float(argv[1]), float(argv[2]) * RAD_PER_ARCSEC
     scene = load_scene("rt70_servo")
     q0 = equilibrium(scene, rt70_pointing(45.0, 0.0), tol=S.EQUILIBRIUM_TOL)
     Q = static_force(scene, q0)

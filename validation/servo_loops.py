@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from rt70.control import loop_measures, loops, lqg
-from rt70.control import servo_compare as sc
 from rt70.guards.atomic import atomic_write, atomic_write_text
 from rt70.model.scene import load_scene
 from rt70.plotting.servo_loops import plot_closed_loops, plot_open_loops
 from rt70.reports import servo_loops as rs
+from rt70.units import ARCSEC_PER_RAD
 
 OUT = Path(__file__).resolve().parent / "results"
 ELEVATIONS = (10.0, 45.0, 80.0)
@@ -56,8 +56,8 @@ def _figures(scene, axis: str) -> dict[str, object]:
     curves = {
         "cascade: reference → axis angle": cascade["axis_angle", "reference"],
         "LQG: reference → axis angle": closed["axis_angle", "reference"],
-        f"cascade: reference → −{sym} (pointing)": -cascade[name, "reference"] / sc.ARCSEC_PER_RAD,
-        f"LQG: reference → −{sym} (pointing)": -closed[name, "reference"] / sc.ARCSEC_PER_RAD,
+        f"cascade: reference → −{sym} (pointing)": -cascade[name, "reference"] / ARCSEC_PER_RAD,
+        f"LQG: reference → −{sym} (pointing)": -closed[name, "reference"] / ARCSEC_PER_RAD,
     }
     curves = {k: loop_measures.frequency_response(T) for k, T in curves.items()}
     fig_closed = plot_closed_loops(

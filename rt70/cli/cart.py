@@ -70,12 +70,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     car.add_argument(
         "--step", type=options.positive_float, default=1.0, help="print step, s (default 1)"
     )
-    car.add_argument(
-        "--side",
-        choices=("textbook", "reference"),
-        default="reference",
-        help="whose dynamics (default reference)",
-    )
+    options.add_side_argument(car)
     car.add_argument("--json", action="store_true", help="print JSON")
     car.set_defaults(func=run)
     return car

@@ -171,14 +171,14 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _report(scene, q: np.ndarray, locks: list, textbook: tuple, pinocchio: tuple) -> dict:
-    """The JSON-ready result: the textbook's impact, Pinocchio's and their differences.
+def _report(scene, q: np.ndarray, locks: list, textbook: tuple, reference: tuple) -> dict:
+    """The JSON-ready result: the textbook's impact, the reference side's and their differences.
 
-    ``textbook`` and ``pinocchio`` are each side's ``(Impact, joint impulses)``.
+    ``textbook`` and ``reference`` are each side's ``(Impact, joint impulses)``.
     """
     from rt70.mechanics.locks import labels
 
-    (impact, shock), (ref, shock_ref) = textbook, pinocchio
+    (impact, shock), (ref, shock_ref) = textbook, reference
     err_j = _relative(
         np.concatenate(list(shock.values())), np.concatenate(list(shock_ref.values()))
     )
@@ -197,7 +197,7 @@ def _report(scene, q: np.ndarray, locks: list, textbook: tuple, pinocchio: tuple
         "energy_lost": impact.energy_lost,
         "carnot": impact.carnot,
         "balance": impact.balance,
-        "pinocchio": {
+        "reference": {
             "qd_after": ref.qd_after.tolist(),
             "impulses": ref.impulses.tolist(),
             "max_rel_err_qd_after": _relative(impact.qd_after, ref.qd_after),
@@ -223,7 +223,7 @@ def _print_text(args: argparse.Namespace, out: dict, impacts: tuple, shock: dict
     )
     print("  impulses (N·s, N·m·s; pins in ground axes):")
     for name, a, b in zip(locks, impact.impulses, ref.impulses, strict=True):
-        print(f"    {name:<28} {a:>16.9g}   (pinocchio {b:.9g})")
+        print(f"    {name:<28} {a:>16.9g}   (reference {b:.9g})")
     change = np.abs(impact.qd_after - impact.qd_before)
     shown = sorted(np.argsort(-change, kind="stable")[:SHOWN])
     which = "all" if len(names) <= SHOWN else f"the {SHOWN} largest changes"
@@ -240,7 +240,7 @@ def _print_text(args: argparse.Namespace, out: dict, impacts: tuple, shock: dict
     for k in sorted(size, key=size.get, reverse=True)[:SHOWN_JOINTS]:
         F, M = shock[k][:3], shock[k][3:]
         print(f"    {k:<28} |F| {np.linalg.norm(F):>12.6g}   |M| {np.linalg.norm(M):>12.6g}")
-    err = out["pinocchio"]
+    err = out["reference"]
     print(
         "  against Pinocchio (impulseDynamics; rnea for the joints): "
         f"q̇⁺ {err['max_rel_err_qd_after']:.2e}, Λ {err['max_rel_err_impulses']:.2e}, "

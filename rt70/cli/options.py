@@ -23,6 +23,7 @@ from typing import NoReturn
 
 from rt70.cli.session import numerical_message
 from rt70.errors import OutputError, Rt70Error
+from rt70.model.sides import SIDES, check_side
 from rt70.scenes.rt70_state import ELEVATION_RANGE
 
 #: Largest magnitude of an azimuth or a wind direction on the command line, degrees: one
@@ -221,6 +222,59 @@ def angle_deg(text: str) -> float:
             f"holds every direction), got {text}"
         )
     return value
+
+
+# --- the side of the cross-check ---------------------------------------------------------
+def side(text: str) -> str:
+    """A side of the cross-check, ``reference`` (Pinocchio) or ``textbook``."""
+    try:
+        return check_side(text)
+    except Rt70Error as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+class RenamedBackend(argparse.Action):
+    """``--backend``, now ``--side``: refused with the new spelling (one line, exit 2)."""
+
+    def __init__(self, option_strings: list[str], dest: str, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs="?", help=argparse.SUPPRESS)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: object,
+        option_string: str | None = None,
+    ) -> NoReturn:
+        """Refuse the option, naming ``--side`` and the value it takes now."""
+        new = {"pinocchio": "reference", "textbook": "textbook"}.get(str(values).lower())
+        use = f"'--side {new}'" if new else "'--side reference' or '--side textbook'"
+        parser.error(f"--backend is now --side (reference = Pinocchio, textbook): use {use}")
+
+
+def add_side_argument(
+    parser: argparse.ArgumentParser, default: str = "reference", what: str = "the dynamics"
+) -> None:
+    """``--side {reference,textbook}``, and ``--backend`` refused with its new name.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    default : str
+        The side when the option is not given.
+    what : str
+        What the side computes, for the help text.
+    """
+    parser.add_argument(
+        "--side",
+        type=side,
+        choices=SIDES,
+        default=default,
+        help=f"the side that computes {what}: reference (Pinocchio) or textbook (the "
+        f"book's matrix algorithm); default {default}",
+    )
+    parser.add_argument("--backend", action=RenamedBackend)
 
 
 # --- the RT-70's pointing ----------------------------------------------------------------

@@ -49,17 +49,17 @@ def _simulate(args: argparse.Namespace) -> int:
             scene,
             (0.0, 10.0 if args.t_end is None else args.t_end),
             start_state(scene),
-            backend=args.backend,
+            side=args.side,
             method=args.method or "BDF",
             rtol=args.rtol,
             progress=args.progress or sys.stderr.isatty(),
         )
     except ResourceError as exc:  # Pinocchio's Data too large: the textbook side may do
-        if args.backend != "pinocchio":
+        if args.side != "reference":
             raise
-        raise ResourceError(f"{exc}; '--backend textbook' does without Pinocchio") from None
+        raise ResourceError(f"{exc}; '--side textbook' does without Pinocchio") from None
     print(
-        f"{scene.name}: {result.method} ({args.backend}), rtol {args.rtol:g}, "
+        f"{scene.name}: {result.method} ({args.side}), rtol {args.rtol:g}, "
         f"0 … {result.t[-1]:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"
     )
     _print_solver(result)
@@ -99,13 +99,13 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
     from rt70.telescope import scenarios
     from rt70.telescope.scene_servo import choose_drives
 
-    drives, label = choose_drives(scene, args.drives, args.friction, args.backend)
+    drives, label = choose_drives(scene, args.drives, args.friction, args.side)
     run = scenarios.run_scenario(
         scene,
         sc,
         drives=drives,
         rtol=args.rtol,
-        backend=args.backend,
+        side=args.side,
         method=args.method,
         progress=args.progress or sys.stderr.isatty(),
     )
@@ -113,7 +113,7 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
     print(
         f"{scene.name}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
         f"{sc.azimuth_deg:g}°, {label} and servo holding ({scenarios.tuning_text()}); "
-        f"{result.method} ({args.backend}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
+        f"{result.method} ({args.side}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
     )
     _print_solver(result)
     for line in scenarios.summary_lines(run):
@@ -213,7 +213,7 @@ def add_parser(
         help="integrator: a solve_ivp method, or CVODE / CVODE_ADAMS (SUNDIALS) "
         "(default BDF; LSODA for the servo scenarios)",
     )
-    sim.add_argument("--backend", default="pinocchio", choices=("pinocchio", "textbook"))
+    options.add_side_argument(sim, what="q̈ and its Jacobian")
     sim.add_argument(
         "--rtol", type=options.rtol, default=1e-6, help="relative tolerance, 0 < rtol < 1"
     )

@@ -236,8 +236,8 @@ def scene_drives(
     ----------
     scene : rt70.model.scene.Scene
         The scene.
-    side : {"textbook", "reference", "pinocchio"}
-        The side whose kinematics computes θ_d (use the simulation's backend).
+    side : {"reference", "textbook"}
+        The side whose kinematics computes θ_d (use the simulation's side).
     voltage : float, callable or dict
         Armature voltage of every drive, or a dict by drive name (missing: 0 V).
     load_inertia : float

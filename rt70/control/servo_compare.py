@@ -16,9 +16,8 @@ import numpy as np
 
 from rt70.control import loop_measures
 from rt70.control.axis_plant import POINTING
+from rt70.units import ARCSEC_PER_RAD
 
-#: Arc seconds per radian.
-ARCSEC_PER_RAD = 180.0 * 3600.0 / np.pi
 #: Time grid of the step and wind responses, s.
 TIMES = np.linspace(0.0, 40.0, 4001)
 

@@ -190,11 +190,11 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
         ),
         "forward_dynamics": (tb_forward, lambda: reference.forward_dynamics(ref, rd, q, qd)),
         "kinetic_energy": (
-            lambda: forces.kinetic_energy(tm, td, q, qd),
+            lambda: dynamics.kinetic_energy(tm, td, q, qd),
             lambda: reference.kinetic_energy(ref, rd, q, qd),
         ),
         "potential_energy": (
-            lambda: forces.gravity_potential(tm, td, q) + forces.spring_potential(tm, td, q),
+            lambda: dynamics.gravity_potential(tm, td, q) + forces.spring_potential(tm, td, q),
             lambda: (
                 reference.gravity_potential(ref, rd, q) + reference.spring_potential(ref, rd, q)
             ),
@@ -324,7 +324,7 @@ class _Tally:
             values[name] = np.asarray(x_tb, dtype=float), np.asarray(x_ref, dtype=float)
             self.t_tb[name] += dt_tb / samples
             self.t_ref[name] += dt_ref / samples
-            for side, x in zip(("textbook", "pinocchio"), values[name], strict=True):
+            for side, x in zip(("textbook", "reference"), values[name], strict=True):
                 if _nonfinite(x):
                     self.bad[name].add(side)
         return values

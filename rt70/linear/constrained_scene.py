@@ -36,7 +36,7 @@ from rt70.linear import constrained as cm
 from rt70.linear import constrained_equilibrium, manifold, modal, mode_table
 from rt70.linear import linearize as lin
 from rt70.model.scene import Scene
-from rt70.textbook import dynamics
+from rt70.model.sides import side_of
 
 #: A side's loop function: ``(model, data, q) → Φ`` or ``→ B_c``.
 LoopFunction = Callable[[Any, Any, np.ndarray], np.ndarray]
@@ -46,14 +46,6 @@ BiasFunction = Callable[[Any, Any, np.ndarray, np.ndarray], np.ndarray]
 #: How the reduced model is formed (:func:`rt70.linear.constrained.linearize` or
 #: :func:`~rt70.linear.constrained.partition_linearize`).
 METHODS = ("null-space", "partition")
-
-
-def _side(scene: Scene, side: str) -> tuple[Any, Any]:
-    if side not in lin.SIDES:
-        raise Rt70Error(f"unknown side {side!r} (choose from {', '.join(lin.SIDES)})")
-    if side == "textbook":
-        return scene.textbook, scene.textbook_data
-    return scene.reference, scene.reference_data
 
 
 def scene_constraints(
@@ -79,7 +71,8 @@ def scene_constraints(
     loop_bias : callable, optional
         ``(model, data, q, q̇) → C``, shape (m,), of ``side``.
     """
-    model, data = _side(scene, side)
+    s = side_of(scene, side)
+    model, data = s.model, s.data
     bias = None if loop_bias is None else (lambda q, qd: loop_bias(model, data, q, qd))
     return manifold.Constraints(
         residual=lambda q: loop_residual(model, data, q),
@@ -89,17 +82,12 @@ def scene_constraints(
 
 
 def _static_force(scene: Scene, side: str) -> manifold.Vector:
-    if side == "textbook":
-        return lambda q: lin.static_force(scene, q)
-    return lambda q: lin.reference_static_force(scene, q)
+    return lambda q: lin.static_force(scene, q, side)
 
 
 def _mass_matrix(scene: Scene, side: str, q: np.ndarray) -> np.ndarray:
-    if side == "textbook":
-        return dynamics.mass_matrix(scene.textbook, scene.textbook_data, q)
-    from rt70.reference import dynamics as ref_dynamics
-
-    return ref_dynamics.mass_matrix(scene.reference, scene.reference_data, q)
+    s = side_of(scene, side)
+    return s.dynamics.mass_matrix(s.model, s.data, q)
 
 
 @dataclass(frozen=True)

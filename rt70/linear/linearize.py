@@ -34,9 +34,11 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.model.scene import Scene
+from rt70.model.sides import Side, check_side, side_of
 from rt70.physics.constraints import HolonomicMap, locking
 from rt70.physics.loads import Wrench
 from rt70.textbook import dynamics, forces, points
+from rt70.units import ARCSEC_PER_RAD
 
 #: Newton in :func:`equilibrium` stops when its step is below this (relative, m or rad).
 STEP_TOL = 1e-12
@@ -48,36 +50,25 @@ FD_STEP = 1e-6
 REUSE_RATIO = 0.1
 
 
-def static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
-    """Generalised static force ``Q_g + Q_c`` at rest (q̇ = 0)."""
-    model, data = scene.textbook, scene.textbook_data
-    Qc, _ = forces.spring_damper_force(model, data, q, np.zeros(model.nv))
-    return dynamics.gravity_force(model, data, q) + Qc
+def static_force(scene: Scene, q: np.ndarray, side: str = "textbook") -> np.ndarray:
+    """Generalised static force ``Q_g + Q_c`` at rest (q̇ = 0), in book coordinates.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates in the book's order, m or rad.
+    side : {"textbook", "reference"}
+        Whose forces: the book's (the residual of :func:`equilibrium`) or Pinocchio's.
+    """
+    return _static_force(side_of(scene, side), q)
 
 
-def reference_static_force(scene: Scene, q: np.ndarray) -> np.ndarray:
-    """``Q_g + Q_c`` at rest from the reference side (Pinocchio), in book coordinates."""
-    from rt70.reference import dynamics as ref_dynamics
-    from rt70.reference import forces as ref_forces
-
-    model, data = scene.reference, scene.reference_data
-    Qc, _ = ref_forces.spring_damper_force(model, data, q, np.zeros(q.size))
-    return ref_dynamics.gravity_force(model, data, q) + Qc
-
-
-def _reference_gravity(scene: Scene, q: np.ndarray) -> np.ndarray:
-    from rt70.reference import dynamics as ref_dynamics
-
-    return ref_dynamics.gravity_force(scene.reference, scene.reference_data, q)
-
-
-#: The sides whose static forces :func:`stiffness_matrix` can difference.
-SIDES = ("reference", "textbook")
-
-
-def _check_side(side: str) -> None:
-    if side not in SIDES:
-        raise Rt70Error(f"unknown side {side!r} (choose from {', '.join(SIDES)})")
+def _static_force(s: Side, q: np.ndarray) -> np.ndarray:
+    """``Q_g + Q_c`` at rest on the side ``s``."""
+    Qc, _ = s.forces.spring_damper_force(s.model, s.data, q, np.zeros(s.model.nv))
+    return s.dynamics.gravity_force(s.model, s.data, q) + Qc
 
 
 def negative_jacobian(force, q: np.ndarray, h: float = FD_STEP) -> np.ndarray:
@@ -126,9 +117,8 @@ def stiffness_matrix(
     side : {"reference", "textbook"}
         Whose static forces are differenced: Pinocchio's (fast) or the book's.
     """
-    _check_side(side)
-    force = reference_static_force if side == "reference" else static_force
-    return _negative_jacobian(lambda x: force(scene, x), np.asarray(q, dtype=float), h)
+    s = side_of(scene, side)
+    return _negative_jacobian(lambda x: _static_force(s, x), np.asarray(q, dtype=float), h)
 
 
 def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
@@ -221,7 +211,7 @@ def equilibrium(
         If the free coordinates have no stiffness against some direction (singular K),
         or Newton does not converge.
     """
-    _check_side(side)
+    check_side(side)
     hold = locking_map(scene, held or {})
     nv = scene.textbook.nv
     q = np.zeros(nv) if q_start is None else np.array(q_start, dtype=float)
@@ -311,7 +301,7 @@ def linearize(
     side : {"reference", "textbook"}
         Whose static forces K is differenced from (:func:`stiffness_matrix`).
     """
-    _check_side(side)
+    check_side(side)
     model, data = scene.textbook, scene.textbook_data
     lock = locking_map(scene, list(locked))
     M = dynamics.mass_matrix(model, data, q0)
@@ -364,17 +354,9 @@ def _gravity_stiffness(
     scene: Scene, q: np.ndarray, h: float = FD_STEP, side: str = "reference"
 ) -> np.ndarray:
     """``−∂Q_g/∂q`` by central differences (the geometric stiffness of gravity)."""
-    _check_side(side)
-    model, data = scene.textbook, scene.textbook_data
-    if side == "reference":
-        force = lambda x: _reference_gravity(scene, x)  # noqa: E731
-    else:
-        force = lambda x: dynamics.gravity_force(model, data, x)  # noqa: E731
+    s = side_of(scene, side)
+    force = lambda x: s.dynamics.gravity_force(s.model, s.data, x)  # noqa: E731
     return _negative_jacobian(force, np.asarray(q, dtype=float), h)
-
-
-#: Arc seconds per radian (the listing's TURNE0 output unit).
-ARCSEC = 206264.80624709636
 
 
 @dataclass(frozen=True)
@@ -412,7 +394,7 @@ def sag(scene: Scene, q_eq: np.ndarray, held: dict[str, float]) -> list[Sag]:
     for j, name in enumerate(model.body_names):
         rel = R0[j].T @ data.R[j]
         angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-        out.append(Sag(name, (data.p[j] - p0[j]) * 1e3, angle * ARCSEC))
+        out.append(Sag(name, (data.p[j] - p0[j]) * 1e3, angle * ARCSEC_PER_RAD))
     return out
 
 

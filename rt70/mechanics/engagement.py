@@ -132,7 +132,7 @@ def engage_after(
     restitution : float
         e (0: plastic).
     side : {"textbook", "reference"}
-        Who solves the impact. The simulation runs on Pinocchio's backend (BDF).
+        Who solves the impact. The simulation runs on the reference side (BDF).
     rtol : float
         The simulation's relative tolerance.
     inputs : callable (t, q, q̇) -> Q_u, optional

@@ -9,7 +9,7 @@ engaged the same way):
   the ground: three rows, the point's velocity in ground axes.
 
 Each side builds the rows on its own (:mod:`rt70.textbook.locks`,
-:mod:`rt70.reference.impact`); :func:`engage` solves the impact (15) with the textbook's
+:mod:`rt70.reference.locks`); :func:`engage` solves the impact (15) with the textbook's
 A and rows through :func:`rt70.physics.impact.solve_impact`, or with Pinocchio's
 ``impulseDynamics``. The command line is ``rt70 impact`` (:mod:`rt70.cli.impact`);
 docs/impacts.md.
@@ -25,10 +25,8 @@ import numpy as np
 
 from rt70.errors import Rt70Error, UnknownLinkError
 from rt70.model.scene import Scene, require_coordinates
+from rt70.model.sides import check_side, side_of
 from rt70.physics.impact import Impact, check_restitution, impact_energies, solve_impact
-
-#: The sides :func:`engage` can solve on.
-SIDES = ("textbook", "reference")
 
 #: Largest coordinate of a stow pin's point, m: the bound of every number rt70 reads
 #: from a model (``rt70.urdf.elements.MAX_MAGNITUDE``).
@@ -161,23 +159,9 @@ def constraint_rows(scene: Scene, q: np.ndarray, locks: Sequence[Lock], side: st
     side : {"textbook", "reference"}
         Whose kinematics (and, for :func:`engage`, whose impact solve).
     """
+    s = side_of(scene, side)
     brakes, pins = _split(locks)
-    if side == "reference":
-        from rt70.reference.impact import book_rows
-
-        rows = book_rows(scene.reference, scene.reference_data, q, brakes, pins)
-        order = _order(locks)
-        return rows[order]
-    from rt70.textbook import locks as tb
-
-    tm, td = scene.textbook, scene.textbook_data
-    out = []
-    for lock in locks:
-        if isinstance(lock, Brake):
-            out.append(tb.brake_row(tm, lock.joint)[None])
-        else:
-            out.append(tb.pin_rows(tm, td, q, lock.link, lock.xyz))
-    return np.vstack(out)
+    return s.locks.book_rows(s.model, s.data, q, brakes, pins)[_order(locks)]
 
 
 def engage(
@@ -193,7 +177,7 @@ def engage(
 
     ``"textbook"``: the book's A (S Θ Sᵀ) and the textbook's rows through
     :func:`rt70.physics.impact.solve_impact`; ``"reference"``: Pinocchio's ``impulseDynamics``
-    (:func:`rt70.reference.impact.impulse_dynamics`), its energies from Pinocchio's A.
+    (:func:`rt70.reference.locks.impulse_dynamics`), its energies from Pinocchio's A.
     Impulses are in the order of :func:`labels`.
 
     Parameters
@@ -220,24 +204,18 @@ def engage(
         On an unknown side, a lock the scene cannot take (:func:`check_locks`) or a
         restitution outside [0, 1].
     """
-    if side not in SIDES:
-        raise Rt70Error(f"unknown side '{side}' (choose from {', '.join(SIDES)})")
+    check_side(side)
     check_locks(scene, locks)
     e = check_restitution(restitution)
     B_c = constraint_rows(scene, q, locks, side)
-    if side == "textbook":
-        from rt70.textbook.dynamics import mass_matrix
-
-        A = mass_matrix(scene.textbook, scene.textbook_data, q)
+    s = side_of(scene, side)
+    if s.name == "textbook":  # the book's A and rows through the shared solve of (15)
+        A = s.dynamics.mass_matrix(s.model, s.data, q)
         return solve_impact(A, B_c, qd, e, gamma)
-    from rt70.reference.dynamics import mass_matrix as ref_mass_matrix
-    from rt70.reference.impact import impulse_dynamics
-
-    ref, rd = scene.reference, scene.reference_data
-    brakes, pins = _split(locks)
-    qd1, lam = impulse_dynamics(ref, rd, q, qd, brakes, pins, e, gamma)
+    brakes, pins = _split(locks)  # Pinocchio solves (15) itself
+    qd1, lam = s.locks.impulse_dynamics(s.model, s.data, q, qd, brakes, pins, e, gamma)
     lam = lam[_order(locks)]
-    A = ref_mass_matrix(ref, rd, q)
+    A = s.dynamics.mass_matrix(s.model, s.data, q)
     rank = int(np.linalg.matrix_rank(B_c)) if B_c.size else 0
     return impact_energies(A, B_c, np.asarray(qd, dtype=float), qd1, lam, rank, e, gamma)
 
@@ -291,8 +269,7 @@ def joint_impulses(
     """
     from rt70.physics.loads import Wrench
 
-    if side not in SIDES:
-        raise Rt70Error(f"unknown side '{side}' (choose from {', '.join(SIDES)})")
+    s = side_of(scene, side)
     dqd = impact.qd_after - impact.qd_before
     pins, at = [], 0
     for lock in locks:
@@ -301,10 +278,4 @@ def joint_impulses(
             at += 3
         else:
             at += 1
-    if side == "textbook":
-        from rt70.textbook.reactions import reaction_impulses
-
-        return reaction_impulses(scene.textbook, scene.textbook_data, q, dqd, pins)
-    from rt70.reference.reactions import reaction_impulses as ref_reaction_impulses
-
-    return ref_reaction_impulses(scene.reference, scene.reference_data, q, dqd, pins)
+    return s.reactions.reaction_impulses(s.model, s.data, q, dqd, pins)

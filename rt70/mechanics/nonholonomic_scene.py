@@ -21,17 +21,15 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.model.scene import Scene
+from rt70.model.sides import side_of
 from rt70.physics.kkt import KKTSolution
 from rt70.physics.nonholonomic import (
     Projection,
     ReducedSystem,
     constrained_dynamics,
     partition,
-    reduce,
 )
 from rt70.urdf.description import NoSlip
-
-SIDES = ("textbook", "reference")
 
 
 def elements(scene: Scene, names: Sequence[str] | None = None) -> list[NoSlip]:
@@ -54,11 +52,6 @@ def elements(scene: Scene, names: Sequence[str] | None = None) -> list[NoSlip]:
             f"(there are: {', '.join(found)})"
         )
     return [found[n] for n in names]
-
-
-def _side(side: str) -> None:
-    if side not in SIDES:
-        raise Rt70Error(f"side must be one of {', '.join(SIDES)}, got '{side}'")
 
 
 def constraint_rows(
@@ -85,16 +78,9 @@ def constraint_rows(
     tuple of numpy.ndarray
         A, shape (m, n), and ``Ȧ q̇``, shape (m,) in m/s² (rad/s² for an angular row).
     """
-    _side(side)
+    s = side_of(scene, side)
     els = elements(scene, names)
-    if side == "textbook":
-        from rt70.textbook import no_slip
-
-        m, d = scene.textbook, scene.textbook_data
-    else:
-        from rt70.reference import no_slip
-
-        m, d = scene.reference, scene.reference_data
+    m, d, no_slip = s.model, s.data, s.no_slip
     return no_slip.constraint_matrix(m, d, q, els), no_slip.constraint_bias(m, d, q, qd, els)
 
 
@@ -121,15 +107,8 @@ def side_dynamics(scene: Scene, side: str, q: np.ndarray, qd: np.ndarray) -> Sid
     qd : numpy.ndarray, shape (n,)
         Generalised velocities, m/s or rad/s.
     """
-    _side(side)
-    if side == "textbook":
-        from rt70.textbook import dynamics
-
-        m, d = scene.textbook, scene.textbook_data
-    else:
-        from rt70 import reference as dynamics
-
-        m, d = scene.reference, scene.reference_data
+    s = side_of(scene, side)
+    m, d, dynamics = s.model, s.data, s.dynamics
     return SideDynamics(
         dynamics.mass_matrix(m, d, q),
         dynamics.bias_force(m, d, q, qd),
@@ -170,7 +149,7 @@ def reduced_system(
         The ``<rt70:no_slip>`` elements used, rows in this order (default: all, in the
         file's order).
     """
-    _side(side)
+    s = side_of(scene, side)
     q = np.asarray(q, dtype=float)
     A, _ = constraint_rows(scene, side, q, np.zeros(q.size), names)
     proj = partition(A, independent)
@@ -178,16 +157,8 @@ def reduced_system(
     _, A_dot_qd = constraint_rows(scene, side, q, qd, names)
     rate = proj.rate(A, A_dot_qd)
     Q = np.zeros(q.size) if Q is None else np.asarray(Q, dtype=float)
-    if side == "textbook":
-        dyn = side_dynamics(scene, side, q, qd)
-        return proj, reduce(dyn.M, dyn.h, Q + dyn.gravity, proj.basis, rate)
-    from rt70 import reference
-    from rt70.reference import no_slip
-
-    A_star, a = no_slip.reduced_terms(
-        scene.reference, scene.reference_data, q, qd, proj.basis, rate
-    )
-    g = reference.gravity_force(scene.reference, scene.reference_data, q)
+    A_star, a = s.no_slip.reduced_terms(s.model, s.data, q, qd, proj.basis, rate)
+    g = s.dynamics.gravity_force(s.model, s.data, q)
     return proj, ReducedSystem(A_star, a, proj.basis.T @ (Q + g))
 
 

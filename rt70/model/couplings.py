@@ -20,11 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.model.sides import check_side, side_of
 from rt70.urdf.description import Drive
-
-#: Names of the two sides a scene coupling can compute on (``"pinocchio"`` is the
-#: simulation backend's name for ``"reference"``).
-SIDES = ("textbook", "reference", "pinocchio")
 
 
 class CoordinateCoupling:
@@ -79,31 +76,29 @@ class SceneCoupling:
         The scene.
     drive : rt70.urdf.Drive
         One of ``scene.description.drives``.
-    side : {"textbook", "reference", "pinocchio"}
-        Which side's kinematics computes θ_d (``"pinocchio"`` = ``"reference"``).
+    side : {"reference", "textbook"}
+        Which side's kinematics computes θ_d (:mod:`rt70.model.sides`).
+
+    Raises
+    ------
+    Rt70Error
+        If ``side`` is not a side.
     """
 
     def __init__(self, scene, drive: Drive, side: str) -> None:
-        if side not in SIDES:
-            raise Rt70Error(f"drive '{drive.name}': unknown side '{side}' (one of {SIDES})")
+        try:
+            check_side(side)
+        except Rt70Error as exc:
+            raise Rt70Error(f"drive '{drive.name}': {exc}") from None
+        s = side_of(scene, side)
         self.drive = drive
-        self.side = "textbook" if side == "textbook" else "reference"
+        self.side = s.name
         self.n = len(scene.coordinate_names)
         #: The driven joint's coordinate (the axis angle an encoder reads).
         self.index = scene.coordinate_names.index(drive.joint)
-        if self.side == "textbook":
-            from rt70.textbook import drives as kin
-
-            model, data = scene.textbook, scene.textbook_data
-        else:
-            from rt70.reference import drives as kin
-
-            model, data = scene.reference, scene.reference_data
-        mesh = None if drive.sector is None else kin.sector_mesh(model, data, drive)
-        if self.side == "reference":  # compiled where it can (the same numbers)
-            self._gradient = kin.drive_force_function(model, data, drive, mesh)
-        else:
-            self._gradient = lambda q: kin.drive_force(model, data, q, drive, 1.0, mesh)
+        mesh = None if drive.sector is None else s.drives.sector_mesh(s.model, s.data, drive)
+        # the reference side compiles it where it can (the same numbers)
+        self._gradient = s.drives.drive_force_function(s.model, s.data, drive, mesh)
         self._key: bytes | None = None
         self._value: tuple[float, np.ndarray] = (0.0, np.zeros(self.n))
 

@@ -45,11 +45,8 @@ import numpy as np
 
 from rt70.errors import Rt70Error, SingularConfigurationError
 from rt70.model.outputs import Output, Point
+from rt70.units import ARCSEC_PER_RAD, MM_PER_M
 
-#: Arc seconds per radian (the listing's TURNE0: KANGLE = 206264.806).
-ARCSEC = 180.0 * 3600.0 / np.pi
-#: Millimetres per metre (TURNE0: KRI0 = 1e3).
-MM = 1e3
 #: Smallest |det| (relative) of the pointing system (4.163) and smallest σ₂/σ₁ of the
 #: counterreflector system (4.172) before the correction is refused as undefined.
 SINGULAR = 1e-9
@@ -276,29 +273,34 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
             "main_mirror_misalignment",
             "arcsec",
             1,
-            lambda g: ARCSEC * np.atleast_1d(_angle(s, g.n5)),
+            lambda g: ARCSEC_PER_RAD * np.atleast_1d(_angle(s, g.n5)),
         ),
-        out("main_mirror_error", "arcsec", 3, lambda g: ARCSEC * g.in_ok(s - g.n5)),
+        out("main_mirror_error", "arcsec", 3, lambda g: ARCSEC_PER_RAD * g.in_ok(s - g.n5)),
         out(
             "counterreflector_misalignment",
             "arcsec",
             1,
-            lambda g: ARCSEC * np.atleast_1d(_angle(g.n7, g.n5)),
+            lambda g: ARCSEC_PER_RAD * np.atleast_1d(_angle(g.n7, g.n5)),
         ),
-        out("counterreflector_error", "arcsec", 3, lambda g: ARCSEC * g.in_ok(g.n7 - g.n5)),
+        out("counterreflector_error", "arcsec", 3, lambda g: ARCSEC_PER_RAD * g.in_ok(g.n7 - g.n5)),
         out(
             "counterreflector_source_misalignment",
             "arcsec",
             1,
-            lambda g: ARCSEC * np.atleast_1d(_angle(s, g.n7)),
+            lambda g: ARCSEC_PER_RAD * np.atleast_1d(_angle(s, g.n7)),
         ),
-        out("focal_offset", "mm", 3, lambda g: MM * (g.in_ok(g.p7f - g.p5f) - g.design)),
-        out("pointing_correction", "arcsec", 2, lambda g: ARCSEC * _pointing_correction(g, s)),
-        out("counterreflector_rotation", "arcsec", 3, lambda g: ARCSEC * _cr_rotation(g)),
+        out("focal_offset", "mm", 3, lambda g: MM_PER_M * (g.in_ok(g.p7f - g.p5f) - g.design)),
+        out(
+            "pointing_correction",
+            "arcsec",
+            2,
+            lambda g: ARCSEC_PER_RAD * _pointing_correction(g, s),
+        ),
+        out("counterreflector_rotation", "arcsec", 3, lambda g: ARCSEC_PER_RAD * _cr_rotation(g)),
         out(
             "counterreflector_translation",
             "mm",
             3,
-            lambda g: MM * _cr_translation(g, _cr_rotation(g)),
+            lambda g: MM_PER_M * _cr_translation(g, _cr_rotation(g)),
         ),
     ]

@@ -25,12 +25,10 @@ import numpy as np
 
 from rt70.errors import Rt70Error, ShapeError
 from rt70.model.scene import Scene
+from rt70.model.sides import check_side, side_of
 
 #: A point of a body: link name and position in the link's frame (m).
 Point = tuple[str, tuple[float, float, float]]
-
-#: The sides an output is evaluated on: the book's matrices or Pinocchio.
-SIDES = ("textbook", "reference")
 
 
 def _first_point(positions: np.ndarray) -> np.ndarray:
@@ -94,21 +92,14 @@ def optical_point_outputs(scene: Scene) -> list[Output]:
 
 def _positions(scene: Scene, side: str) -> Callable[[np.ndarray, list[Point]], np.ndarray]:
     """``positions(q, points)`` on the chosen side."""
-    if side == "textbook":
-        from rt70.textbook.points import point_positions
-
-        model, data = scene.textbook, scene.textbook_data
-    else:
-        from rt70.reference.points import point_positions
-
-        model, data = scene.reference, scene.reference_data
-    return lambda q, points: point_positions(model, data, q, points)
+    s = side_of(scene, side)
+    point_positions = s.points.point_positions
+    return lambda q, points: point_positions(s.model, s.data, q, points)
 
 
 def _check(outputs: Sequence[Output], side: str) -> None:
-    """Refuse an unknown side or two outputs of one name."""
-    if side not in SIDES:
-        raise Rt70Error(f"unknown side '{side}' (choose from {', '.join(SIDES)})")
+    """Refuse an unknown side (:func:`rt70.model.sides.check_side`) or two outputs of one name."""
+    check_side(side)
     counts = Counter(o.name for o in outputs)
     repeated = sorted(n for n, k in counts.items() if k > 1)
     if repeated:
@@ -130,7 +121,7 @@ def _apply(outputs: Sequence[Output], positions: np.ndarray) -> dict[str, np.nda
 def evaluate(
     scene: Scene, q: np.ndarray, outputs: Sequence[Output], side: str = "textbook"
 ) -> dict[str, np.ndarray]:
-    """Every output at the configuration q, by name, computed on ``side`` (:data:`SIDES`).
+    """Every output at the configuration q, by name, computed on ``side``.
 
     One kinematics pass for all the outputs' points.
 
@@ -252,14 +243,9 @@ def output_matrix(
         If a formula has no derivative at q0 (e.g. an angle magnitude at zero).
     """
     evaluate(scene, q0, outputs, side)  # checks the side, the names, the links, the shapes
-    if side == "textbook":
-        from rt70.textbook.points import point_jacobian, point_positions
-
-        model, data = scene.textbook, scene.textbook_data
-    else:
-        from rt70.reference.points import point_jacobian, point_positions
-
-        model, data = scene.reference, scene.reference_data
+    s = side_of(scene, side)
+    model, data = s.model, s.data
+    point_jacobian, point_positions = s.points.point_jacobian, s.points.point_positions
     q0 = np.asarray(q0, dtype=float)
     jacobians: dict[tuple, np.ndarray] = {}  # J_v of each distinct point, computed once
     rows = []

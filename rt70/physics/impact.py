@@ -33,7 +33,7 @@ The system is the KKT system of :func:`rt70.physics.kkt.solve_kkt` for the jump
 ε·cond(A) and leave q̇ changed by rounding where no row holds): redundant constraint
 rows give the unique q̇⁺ and the least-norm Λ. Plain linear algebra, no side imported:
 the textbook side's A and B_c go in here; the reference side solves the same impact with
-Pinocchio's ``impulseDynamics`` (:mod:`rt70.reference.impact`).
+Pinocchio's ``impulseDynamics`` (:mod:`rt70.reference.locks`).
 """
 
 from __future__ import annotations

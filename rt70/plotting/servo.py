@@ -13,8 +13,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-#: Arc seconds per radian.
-_ARCSEC = 180.0 * 3600.0 / np.pi
+from rt70.units import ARCSEC_PER_RAD
 
 
 def servo_figure(run) -> Figure:
@@ -25,18 +24,20 @@ def servo_figure(run) -> Figure:
     ax_a, ax_t, ax_p, ax_e = fig.subplots(4, 1, sharex=True)
     fig.suptitle(
         f"{r.scene}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
-        f"{sc.azimuth_deg:g}° — {r.method} ({r.backend}), rtol {r.rtol:g}",
+        f"{sc.azimuth_deg:g}° — {r.method} ({r.side}), rtol {r.rtol:g}",
         fontsize=11,
     )
     # 1. axis angles vs reference: offsets from the start, arc seconds (elevation upward)
     signs = {"azimuth": 1.0, "elevation": -1.0}  # base_rx = π/2 − elevation
     colors = {"azimuth": "C0", "elevation": "C1"}
     for axis, ref in run.axis_reference.items():
-        angle = ref - run.axis_error[axis] * signs[axis] / _ARCSEC
+        angle = ref - run.axis_error[axis] * signs[axis] / ARCSEC_PER_RAD
         start = angle[0]
         s, c = signs[axis], colors[axis]
-        ax_a.plot(t, s * (ref - start) * _ARCSEC, "--", color=c, lw=1.0, label=f"{axis} reference")
-        ax_a.plot(t, s * (angle - start) * _ARCSEC, color=c, lw=1.4, label=f"{axis} axis")
+        ax_a.plot(
+            t, s * (ref - start) * ARCSEC_PER_RAD, "--", color=c, lw=1.0, label=f"{axis} reference"
+        )
+        ax_a.plot(t, s * (angle - start) * ARCSEC_PER_RAD, color=c, lw=1.4, label=f"{axis} axis")
     ax_a.set_ylabel("offset from start, ″")
     ax_a.set_title("axis angles (encoders) against their references", fontsize=9)
     ax_a.legend(fontsize=8, ncol=2)

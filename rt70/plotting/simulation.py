@@ -16,7 +16,7 @@ def simulation_figure(result):
     ax_q, ax_e, ax_b = fig.subplots(3, 1, sharex=True)
     ax_q.plot(result.t, result.q, lw=0.8)
     ax_q.set_ylabel("q (m, rad)")
-    ax_q.set_title(f"{result.scene}: {result.method} ({result.backend}), rtol {result.rtol:g}")
+    ax_q.set_title(f"{result.scene}: {result.method} ({result.side}), rtol {result.rtol:g}")
     for name, values in (
         ("kinetic T", result.kinetic),
         ("gravity U_g − U_g(0)", result.gravity - result.gravity[0]),

@@ -149,6 +149,31 @@ def loop_bias(
     return np.concatenate(parts) if parts else np.zeros(0)
 
 
+def loop_terms(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Φ, B_c, C)``: :func:`loop_residual`, :func:`loop_jacobian` and :func:`loop_bias`.
+
+    The twin of :func:`rt70.textbook.loops.loop_terms` (which shares one forward pass);
+    here each of the three is computed on its own.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the book's
+        order (:func:`rt70.urdf.coordinate_names`).
+    """
+    return (
+        loop_residual(model, data, q),
+        loop_jacobian(model, data, q),
+        loop_bias(model, data, q, qd),
+    )
+
+
 def _classical(d: pin.Data, joint: int, placement: pin.SE3) -> np.ndarray:
     """Ground-axis ``[a_p; ω̇]`` of a frame on a joint: classical acceleration of its origin."""
     if joint == 0:

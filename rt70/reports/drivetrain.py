@@ -30,9 +30,10 @@ from rt70.bondgraph.parameters import DriveParameters
 from rt70.control.friction import AxisFriction, switched_rigid_axis
 from rt70.control.geartrains import TwoTrainServo, train_gains
 from rt70.model.scene import Scene, scene_from_text
-from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, FRICTION, MOTOR, TRAINS, WIND_TORQUE
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, FRICTION, MOTOR, TRAINS, WIND_TORQUE
 from rt70.simulation.result import SimulationResult
 from rt70.simulation.simulate import simulate
+from rt70.units import RAD_PER_ARCSEC
 
 #: Sidereal rate, rad/s (15.04″/s).
 SIDEREAL = 7.2921e-5
@@ -136,7 +137,7 @@ def run_case(case: Case, t_end: float, rtol: float = 1e-6, width: float = WIDTH)
         p, p.J_l, position_hz=POSITION_HZ, current_limit=MOTOR.peak_torque / MOTOR.torque_constant,
         rate_limit=AZIMUTH_DRIVE.servo.rate_limit, voltage_limit=2 * MOTOR.rated_voltage,
     )  # fmt: skip
-    step = case.step_arcsec * ARCSEC
+    step = case.step_arcsec * RAD_PER_ARCSEC
 
     def reference(t: float) -> float:
         return step + case.rate * t
@@ -160,7 +161,7 @@ def run_case(case: Case, t_end: float, rtol: float = 1e-6, width: float = WIDTH)
         scene, (0.0, t_end), components=components, inputs=gust if case.gust else None,
         t_eval=t, method="BDF", rtol=rtol, atol=AXIS_ATOL,
     )  # fmt: skip
-    error = (step + case.rate * t - run.q[:, 0]) / ARCSEC
+    error = (step + case.rate * t - run.q[:, 0]) / RAD_PER_ARCSEC
     late = t >= 0.5 * t_end
     s = np.array([run.states[n] for n in drive.names]).T
     taus = np.array(
@@ -259,7 +260,7 @@ def regularisation_run(
         scene, (0.0, t_end), components=[friction], t_eval=t, method=method, rtol=1e-6,
         atol=AXIS_ATOL, inputs=lambda t, q, qd: np.array([stick_slip_torque(t)]),
     )  # fmt: skip
-    return run, float(np.abs(run.q[:, 0] - exact.angle).max() / ARCSEC)
+    return run, float(np.abs(run.q[:, 0] - exact.angle).max() / RAD_PER_ARCSEC)
 
 
 def regularisation_table(

@@ -19,9 +19,9 @@ from rt70.linear import reduce as rd
 from rt70.linear.responses import StateSpace
 from rt70.model.scene import load_scene
 from rt70.physics.loads import Wrench
-from rt70.scenes.rt70_drives import ARCSEC
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import rt70_pointing
+from rt70.units import RAD_PER_ARCSEC
 
 
 def reduction_plants(elevation: float = 45.0, azimuth: float = 0.0) -> dict[str, StateSpace]:
@@ -42,6 +42,6 @@ def reduction_plants(elevation: float = 45.0, azimuth: float = 0.0) -> dict[str,
     torques = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
     angles = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
     free = pl.plant(scene, q0, torques, angles + mirror)
-    per_rad = 1.0 / ARCSEC  # rad → arcsec
+    per_rad = 1.0 / RAD_PER_ARCSEC  # rad → arcsec
     free = rd.rescaled(free, [per_rad, per_rad] + [1.0] * (free.n_outputs - 2), 1e6)
     return {"locked": locked, "free": free}

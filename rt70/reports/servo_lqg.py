@@ -28,10 +28,11 @@ import numpy as np
 from rt70.control import lqg
 from rt70.control.lqg_drive import LqgDrive
 from rt70.reports import servo_loops as rs
-from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE
 from rt70.telescope.scenarios import DriveFactory, Scenario, servo_drives, servo_tolerances
 from rt70.telescope.servo_metrics import settling_time
+from rt70.units import ARCSEC_PER_DEG, RAD_PER_ARCSEC
 
 #: Tracking time of the integral state's back-calculation, s: the LQR's integral time
 #: (:data:`rt70.reports.servo_loops.LQG_WEIGHTS`).
@@ -140,7 +141,7 @@ def step_scenario(step_arcsec: float, elevation_deg: float = 45.0, t_end: float 
     t_end : float, optional
         Length of the run, s.
     """
-    deg = step_arcsec / 3600.0
+    deg = step_arcsec / ARCSEC_PER_DEG
     return Scenario(
         name="step-azimuth",
         elevation_deg=elevation_deg,
@@ -178,8 +179,8 @@ def linear_step(
     closed = lqg.lqg_system(ap, lqg.design(ap, weights=rs.LQG_WEIGHTS))
     keys = ["axis_angle", "voltage", "current"]
     y = np.asarray(control.step_response(closed[keys, "reference"], T=t).outputs).reshape(3, -1)
-    y = y * step_arcsec * ARCSEC
-    return {"axis_arcsec": y[0] / ARCSEC, "voltage": y[1], "current": y[2]}
+    y = y * step_arcsec * RAD_PER_ARCSEC
+    return {"axis_arcsec": y[0] / RAD_PER_ARCSEC, "voltage": y[1], "current": y[2]}
 
 
 def step_numbers(t: np.ndarray, axis_arcsec: np.ndarray, step_arcsec: float) -> dict[str, float]:

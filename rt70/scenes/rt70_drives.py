@@ -29,9 +29,6 @@ from rt70.errors import Rt70Error
 #: One kilogram-force metre in newton metres (standard gravity). Row ``*.kgf_m``.
 KGF_M = 9.80665
 
-#: One arc second in radians. Row ``*.arcsec``.
-ARCSEC = math.pi / (180.0 * 3600.0)
-
 
 def _check_positive(obj: object, allow_zero: tuple[str, ...] = ()) -> None:
     """Raise :class:`Rt70Error` naming the field if a number is not finite and positive."""

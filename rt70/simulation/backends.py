@@ -1,27 +1,32 @@
 """The two sides as the simulation sees them: q̈, the Jacobian and the energies of a state.
 
 :func:`rt70.simulation.simulate.simulate` integrates ``A q̈ + B q̇ = Q_g + Q_c + Q_d + Q_u``
-through one :class:`Backend` per side (:data:`BACKENDS`): the Pinocchio backend by ABA
-with the spring and damper forces as ``tau`` and the analytic Jacobian of
-``computeABADerivatives``, the textbook backend by the structured ``S Θ Sᵀ`` algorithm
-and a Cholesky solve, its Jacobian left to the solver's difference quotients. Both take
-and return vectors in the file's coordinate order; both report the energies of the
-energy audit, T, U_g and U_c (formalism §1, (1.73)).
+through one :class:`Backend` per side (:data:`BACKENDS`, by the side's name): the
+reference side by Pinocchio's ABA with the spring and damper forces as ``tau`` and the
+analytic Jacobian of ``computeABADerivatives``, the textbook side by the structured
+``S Θ Sᵀ`` algorithm and a Cholesky solve, its Jacobian left to the solver's difference
+quotients. Both take and return vectors in the file's coordinate order; both report the
+energies of the energy audit, T, U_g and U_c (formalism §1, (1.73)); each closes the
+scene's loops its own way (:meth:`Backend.constrained_accelerations`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rt70.errors import Rt70Error
+from rt70.errors import Rt70Error, SimulationError
 from rt70.model.scene import Scene
+from rt70.physics.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
+from rt70.physics.kkt import solve_kkt
+from rt70.simulation.loop_constraints import Constraint, stacked
 from rt70.textbook.spatial import DYNAMICS_GIMBAL_COS, check_euler_pairs, euler_theta_indices
 
 
 class Backend:
     """Right-hand side, Jacobian and energies of one side of the cross-check."""
 
-    name = ""
+    #: The side (:data:`rt70.model.sides.SIDES`).
+    side = ""
 
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
@@ -61,6 +66,29 @@ class Backend:
         """``(T, U_g, U_c)``, J: kinetic, gravity and elastic energy at ``(q, q̇)``."""
         raise NotImplementedError
 
+    def constrained_accelerations(
+        self,
+        q: np.ndarray,
+        qd: np.ndarray,
+        Q_u: np.ndarray | None,
+        constraints: list[Constraint],
+        stabilization: Baumgarte | None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``(q̈, Q_d)`` of the constrained equations (14) with Baumgarte's (2.2).
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            The state: coordinates (rad or m) and velocities (rad/s or m/s).
+        Q_u : numpy.ndarray, shape (nv,), or None
+            Generalised input force, N·m or N; None for none.
+        constraints : list of rt70.simulation.loop_constraints.Constraint
+            The scene's loop closures on this side.
+        stabilization : rt70.physics.baumgarte.Baumgarte or None
+            Baumgarte's gains; None lets Φ drift.
+        """
+        raise NotImplementedError
+
 
 class PinocchioBackend(Backend):
     """Pinocchio's ABA with springs as tau; analytic Jacobian from computeABADerivatives.
@@ -70,7 +98,7 @@ class PinocchioBackend(Backend):
     :mod:`rt70.reference.forces`, tested); ``kernels=False`` keeps the Python path.
     """
 
-    name = "pinocchio"
+    side = "reference"
 
     def __init__(self, scene: Scene, kernels: bool = True) -> None:
         super().__init__(scene)
@@ -171,11 +199,35 @@ class PinocchioBackend(Backend):
             U_c,
         )
 
+    def constrained_accelerations(self, q, qd, Q_u, constraints, stabilization):
+        """``(q̈, Q_d)``: Pinocchio's ``constraintDynamics`` on the loops it holds itself.
+
+        The loops are those of the scene's Pinocchio model
+        (:func:`rt70.reference.loops.constrained_forward_dynamics`); the dampers' force
+        is for the energy audit.
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            The state: coordinates (rad or m) and velocities (rad/s or m/s).
+        Q_u : numpy.ndarray, shape (nv,), or None
+            Generalised input force, N·m or N; None for none.
+        constraints : list of rt70.simulation.loop_constraints.Constraint
+            The scene's loop closures (Pinocchio's model holds the same).
+        stabilization : rt70.physics.baumgarte.Baumgarte or None
+            Baumgarte's gains; None lets Φ drift.
+        """
+        from rt70.reference import loops
+
+        qdd, _ = loops.constrained_forward_dynamics(self.ref, self.rd, q, qd, Q_u, stabilization)
+        _, Qd = self.reference.spring_damper_force(self.ref, self.rd, q, qd)
+        return qdd, Qd
+
 
 class TextbookBackend(Backend):
     """The structured S Θ Sᵀ algorithm; the Jacobian by finite differences (scipy's)."""
 
-    name = "textbook"
+    side = "textbook"
 
     def __init__(self, scene: Scene) -> None:
         super().__init__(scene)
@@ -232,15 +284,41 @@ class TextbookBackend(Backend):
 
     def energies(self, q, qd):
         """``(T, U_g, U_c)``, J, on the textbook's side."""
-        from rt70.textbook import forces
+        from rt70.textbook import dynamics, forces
 
         model, data = self.scene.textbook, self.scene.textbook_data
         return (
-            forces.kinetic_energy(model, data, q, qd),
-            forces.gravity_potential(model, data, q),
+            dynamics.kinetic_energy(model, data, q, qd),
+            dynamics.gravity_potential(model, data, q),
             forces.spring_potential(model, data, q),
         )
 
+    def constrained_accelerations(self, q, qd, Q_u, constraints, stabilization):
+        """``(q̈, Q_d)``: the tree's ``A q̈ = f`` and the constraints by the KKT system.
 
-#: The backends by the name :func:`rt70.simulation.simulate.simulate` takes.
-BACKENDS = {"pinocchio": PinocchioBackend, "textbook": TextbookBackend}
+        The range-space method of :func:`rt70.physics.kkt.solve_kkt` on :meth:`system`
+        and the stacked rows of ``constraints``.
+
+        Parameters
+        ----------
+        q, qd : numpy.ndarray, shape (nv,)
+            The state: coordinates (rad or m) and velocities (rad/s or m/s).
+        Q_u : numpy.ndarray, shape (nv,), or None
+            Generalised input force, N·m or N; None for none.
+        constraints : list of rt70.simulation.loop_constraints.Constraint
+            The scene's loop closures on the textbook side.
+        stabilization : rt70.physics.baumgarte.Baumgarte or None
+            Baumgarte's gains; None lets Φ drift.
+        """
+        A, f, Qd = self.system(q, qd, Q_u)  # the tree's A q̈ = f
+        phi, B, C = stacked(constraints, q, qd)
+        g = consistent_rhs(B, constraint_rhs(C, B @ qd, phi, stabilization))
+        try:
+            sol = solve_kkt(A, B, f, g)
+        except Rt70Error as exc:
+            raise SimulationError(str(exc)) from None
+        return sol.x, Qd
+
+
+#: The backends by side, the ``side`` :func:`rt70.simulation.simulate.simulate` takes.
+BACKENDS = {"reference": PinocchioBackend, "textbook": TextbookBackend}

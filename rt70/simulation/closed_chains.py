@@ -11,11 +11,11 @@ dynamics, written once for both sides:
   (:func:`rt70.simulation.closure.require_closable`).
 * :class:`ConstrainedBackend` — wraps a backend of :mod:`rt70.simulation.backends`: q̈
   and λ of the constrained equations (14) with the Baumgarte stabilisation of source
-  002 (2.2) (:mod:`rt70.physics.baumgarte`): on the textbook side the KKT system by the
-  range-space method (:func:`rt70.physics.kkt.solve_kkt`); on Pinocchio's
-  ``pin.constraintDynamics`` for the loops
-  (:func:`rt70.reference.loops.constrained_forward_dynamics`) — any further constraint
-  on that side goes through the same KKT solve with Pinocchio's A and forces.
+  002 (2.2) (:mod:`rt70.physics.baumgarte`), each side its own way
+  (:meth:`rt70.simulation.backends.Backend.constrained_accelerations`): on the textbook
+  side the KKT system by the range-space method (:func:`rt70.physics.kkt.solve_kkt`); on
+  the reference side Pinocchio's ``pin.constraintDynamics`` for the loops
+  (:func:`rt70.reference.loops.constrained_forward_dynamics`).
 
 Ideal constraints do no work (``q̇ᵀ B_cᵀ λ = (B_c q̇)ᵀ λ = 0``), so the energy audit of
 the tree still closes; the residual ``max |Φ|`` is reported with the result.
@@ -30,8 +30,7 @@ import numpy as np
 from rt70.errors import LoopClosureError, Rt70Error, SimulationError
 from rt70.guards.arrays import check_vector
 from rt70.model.scene import Scene
-from rt70.physics.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
-from rt70.physics.kkt import solve_kkt
+from rt70.physics.baumgarte import Baumgarte
 from rt70.simulation.closure import closure_search, require_closable
 from rt70.simulation.loop_constraints import (
     CLOSURE_TOL,
@@ -161,22 +160,21 @@ class ConstrainedBackend:
     the mass matrix and the energies are the tree's.
     """
 
-    def __init__(self, side, stabilization: Baumgarte | None) -> None:
-        self.side = side
-        self.name = side.name
-        self.nv = side.nv
-        self.scene = side.scene
+    def __init__(self, tree, stabilization: Baumgarte | None) -> None:
+        self.tree = tree
+        self.side = tree.side
+        self.nv = tree.nv
+        self.scene = tree.scene
         self.stabilization = stabilization
-        self.side_name = "reference" if side.name == "pinocchio" else "textbook"
-        self.constraints = scene_constraints(side.scene, self.side_name)
+        self.constraints = scene_constraints(tree.scene, tree.side)
 
     def mass_matrix(self, q):
         """The tree's A(q)."""
-        return self.side.mass_matrix(q)
+        return self.tree.mass_matrix(q)
 
     def energies(self, q, qd):
         """The tree's T, U_g, U_c (the constraints store no energy)."""
-        return self.side.energies(q, qd)
+        return self.tree.energies(q, qd)
 
     def jacobian(self, q, qd, Q_u):
         """None: the solver differences the constrained right-hand side.
@@ -204,29 +202,7 @@ class ConstrainedBackend:
         Q_u : numpy.ndarray, shape (nv,), or None
             Generalised input force, N·m or N; None for none.
         """
-        if self.side_name == "reference":
-            from rt70.reference import loops
-
-            scene = self.scene
-            qdd, _ = loops.constrained_forward_dynamics(
-                scene.reference, scene.reference_data, q, qd, Q_u, self.stabilization
-            )
-            _, Qd = self._damper(q, qd)
-            return qdd, Qd
-        A, f, Qd = self.side.system(q, qd, Q_u)  # the tree's A q̈ = f
-        phi, B, C = stacked(self.constraints, q, qd)
-        g = consistent_rhs(B, constraint_rhs(C, B @ qd, phi, self.stabilization))
-        try:
-            sol = solve_kkt(A, B, f, g)
-        except Rt70Error as exc:
-            raise SimulationError(str(exc)) from None
-        return sol.x, Qd
-
-    def _damper(self, q, qd):
-        from rt70 import reference
-
-        scene = self.scene
-        return reference.spring_damper_force(scene.reference, scene.reference_data, q, qd)
+        return self.tree.constrained_accelerations(q, qd, Q_u, self.constraints, self.stabilization)
 
 
 def constrained_start(
@@ -263,7 +239,7 @@ def constrained_start(
     wrapped = ConstrainedBackend(backend, stabilization)
     n = scene.textbook.nv
     if x0 is None:
-        q0, qd0 = closed_rest(scene, side=wrapped.side_name)
+        q0, qd0 = closed_rest(scene, side=wrapped.side)
         return wrapped, q0, qd0
     q0, qd0 = (
         check_vector("initial state q0", x0[0], n),

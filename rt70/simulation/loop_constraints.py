@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rt70.errors import Rt70Error
 from rt70.model.scene import Scene
+from rt70.model.sides import check_side, side_of
 
 #: Newton iterations of :func:`newton` (:func:`rt70.simulation.closed_chains.assemble`)
 #: before it gives up.
@@ -67,19 +67,12 @@ def scene_constraints(scene: Scene, side: str = "textbook") -> list[Constraint]:
     side : {"textbook", "reference"}
         Whose kinematics compute Φ, B_c and C.
     """
+    check_side(side)
     loops = scene.description.loops
     if not loops:
         return []
-    if side == "textbook":
-        from rt70.textbook import loops as tl
-
-        model, data = scene.textbook, scene.textbook_data
-    elif side == "reference":
-        from rt70.reference import loops as tl
-
-        model, data = scene.reference, scene.reference_data
-    else:
-        raise Rt70Error(f"unknown side '{side}' (textbook or reference)")
+    s = side_of(scene, side)
+    tl, model, data = s.loops, s.model, s.data
     return [
         Constraint(
             ", ".join(f"loop '{loop.name}'" for loop in loops),
@@ -87,7 +80,7 @@ def scene_constraints(scene: Scene, side: str = "textbook") -> list[Constraint]:
             lambda q: tl.loop_residual(model, data, q),
             lambda q: tl.loop_jacobian(model, data, q),
             lambda q, qd: tl.loop_bias(model, data, q, qd),
-            (lambda q, qd: tl.loop_terms(model, data, q, qd)) if side == "textbook" else None,
+            lambda q, qd: tl.loop_terms(model, data, q, qd),
         )
     ]
 
@@ -148,14 +141,8 @@ def closed_test(scene: Scene, side: str, tol: float) -> Callable[[np.ndarray, np
     tol : float
         The closure tolerance, relative to ``1 + reach`` (:data:`CLOSURE_TOL`).
     """
-    if side == "textbook":
-        from rt70.textbook import points
-
-        model, data = scene.textbook, scene.textbook_data
-    else:
-        from rt70.reference import points
-
-        model, data = scene.reference, scene.reference_data
+    s = side_of(scene, side)
+    points, model, data = s.points, s.model, s.data
     located = [
         (f.link, f.xyz) for loop in scene.description.loops for f in (loop.frame1, loop.frame2)
     ]

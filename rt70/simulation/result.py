@@ -26,6 +26,7 @@ OUTPUT_SUFFIXES = (".csv", ".npz")
 class SimulationResult:
     """Trajectory, energies and solver statistics of one run.
 
+    ``side`` is the side that ran (``"reference"``, Pinocchio's, or ``"textbook"``).
     Energies in J: ``kinetic`` T, ``gravity`` U_g, ``elastic`` U_c, ``dissipated`` E_ψ,
     ``input_work`` W_u; ``balance = T + U_g + U_c + E_ψ − W_u − (its value at t0)`` and
     ``balance_scale`` the energy exchanged in the run (what ``relative_drift`` is
@@ -45,7 +46,7 @@ class SimulationResult:
     """
 
     scene: str
-    backend: str
+    side: str
     method: str
     rtol: float
     atol: float

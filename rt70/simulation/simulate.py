@@ -1,9 +1,10 @@
 """Time simulation of a scene with an energy audit (formalism §1, (1.73)).
 
-Both backends (:mod:`rt70.simulation.backends`) integrate the same equations
-``A q̈ + B q̇ = Q_g + Q_c + Q_d + Q_u``: the Pinocchio backend by ABA with the spring and
-damper forces as ``tau``, the textbook backend by the structured ``S Θ Sᵀ`` algorithm
-and a Cholesky solve. The state is ``[q, q̇]`` followed by the states of every
+Both sides (``side``, :mod:`rt70.model.sides`; their backends:
+:mod:`rt70.simulation.backends`) integrate the same equations
+``A q̈ + B q̇ = Q_g + Q_c + Q_d + Q_u``: the reference side by Pinocchio's ABA with the
+spring and damper forces as ``tau``, the textbook side by the structured ``S Θ Sᵀ``
+algorithm and a Cholesky solve. The state is ``[q, q̇]`` followed by the states of every
 :class:`rt70.simulation.states.StateComponent`, integrated with it (not by quadrature of
 samples). The first component is always the energy audit
 (:class:`rt70.simulation.states.EnergyAudit`): the dissipated energy
@@ -29,6 +30,7 @@ from rt70.guards.arrays import check_vector
 from rt70.guards.resources import check_time_series, time_series_samples
 from rt70.model.outputs import Output, evaluate, evaluate_trajectory
 from rt70.model.scene import Scene
+from rt70.model.sides import check_side, refuses_backend
 from rt70.physics.baumgarte import DEFAULT_STABILIZATION, Baumgarte
 from rt70.simulation.backends import BACKENDS, Backend
 from rt70.simulation.closed_chains import constrained_start, residual_trajectory
@@ -59,11 +61,12 @@ Inputs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 Event = Callable[[float, np.ndarray, np.ndarray], float]
 
 
+@refuses_backend
 def simulate(
     scene: Scene,
     t_span: tuple[float, float],
     x0: tuple[np.ndarray, np.ndarray] | None = None,
-    backend: str = "pinocchio",
+    side: str = "reference",
     method: str = "BDF",
     rtol: float = 1e-6,
     atol: float | None = None,
@@ -87,9 +90,10 @@ def simulate(
         Initial state, each shape (nv,) in the file's coordinate order (rad or m, rad/s
         or m/s); default rest (the RT-70 listing's:
         :func:`rt70.scenes.rt70_state.listing_initial_state`).
-    backend : {"pinocchio", "textbook"}
-        Which side evaluates q̈ and whether the Jacobian is analytic (Pinocchio's) or
-        differenced by the solver (:mod:`rt70.simulation.backends`).
+    side : {"reference", "textbook"}
+        Which side evaluates q̈ (:mod:`rt70.model.sides`) and whether the Jacobian is
+        analytic (Pinocchio's) or differenced by the solver
+        (:mod:`rt70.simulation.backends`).
     method : str
         A ``scipy.integrate.solve_ivp`` method or "CVODE" / "CVODE_ADAMS" (SUNDIALS;
         :data:`METHODS`, :mod:`rt70.simulation.integrators`).
@@ -103,7 +107,7 @@ def simulate(
     progress : bool
         Show a progress bar (tqdm) on stderr.
     outputs : sequence of rt70.model.outputs.Output
-        Quantities evaluated on the trajectory by the backend's side, in
+        Quantities evaluated on the trajectory by ``side``, in
         ``result.outputs`` by name, arrays (n_t, size); checked at the start first.
     components : sequence of StateComponent
         Extra states integrated with the mechanics after the energy audit's
@@ -115,28 +119,27 @@ def simulate(
         Zero crossings located, with the optional solve_ivp attributes ``terminal`` and
         ``direction``, for every method; their times in ``result.t_events``.
     """
-    t0, t1, t_eval = _checked_request(backend, method, rtol, atol, t_span, t_eval, events)
-    side, q0, qd0 = _initial_state(scene, backend, x0, stabilization)
-    output_side = "reference" if backend == "pinocchio" else "textbook"
-    evaluate(scene, q0, outputs, output_side)  # refuses an unknown link before the run
-    energy_scale = _energy_scale(scene, side, q0, qd0)
+    t0, t1, t_eval = _checked_request(side, method, rtol, atol, t_span, t_eval, events)
+    backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
+    evaluate(scene, q0, outputs, side)  # refuses an unknown link before the run
+    energy_scale = _energy_scale(scene, backend, q0, qd0)
     atol_q = 1e-3 * rtol if atol is None else atol
-    layout = StateLayout([EnergyAudit(rtol * energy_scale), *components], side.nv)
+    layout = StateLayout([EnergyAudit(rtol * energy_scale), *components], backend.nv)
     _check_stiffness(scene, components, t1 - t0)
-    atol_vec = np.concatenate([np.full(2 * side.nv, atol_q), *layout.atol()])
+    atol_vec = np.concatenate([np.full(2 * backend.nv, atol_q), *layout.atol()])
     limit = _most_samples(scene, layout, outputs, t_eval)
-    rhs = _RightHandSide(side, layout, inputs, (t0, t1), progress)
+    rhs = _RightHandSide(backend, layout, inputs, (t0, t1), progress)
     x_start = np.concatenate([q0, qd0, *layout.initial()])
     sol, clock = _integrate(scene, method, rhs, x_start, (rtol, atol_vec), t_eval, events, limit)
     result = _result(scene, method, (rtol, atol_q), sol, clock, rhs, energy_scale)
     passive = inputs is None and not rhs.pushed
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
-    result.outputs = evaluate_trajectory(scene, result.q, outputs, output_side)
+    result.outputs = evaluate_trajectory(scene, result.q, outputs, side)
     return result
 
 
 def _checked_request(
-    backend: str,
+    side: str,
     method: str,
     rtol: float,
     atol: float | None,
@@ -145,8 +148,7 @@ def _checked_request(
     events: Sequence[Event],
 ) -> tuple[float, float, np.ndarray | None]:
     """``(t0, t1, t_eval)`` of :func:`simulate`'s arguments, each checked, or an Rt70Error."""
-    if backend not in BACKENDS:
-        raise Rt70Error(f"unknown backend '{backend}' (choose from {', '.join(BACKENDS)})")
+    check_side(side)
     if method not in METHODS:
         raise Rt70Error(f"unknown method '{method}' (choose from {', '.join(METHODS)})")
     if not all(callable(g) for g in events):
@@ -169,11 +171,11 @@ def _checked_request(
 
 def _initial_state(
     scene: Scene,
-    backend: str,
+    side: str,
     x0: tuple[np.ndarray, np.ndarray] | None,
     stabilization: Baumgarte | None,
 ) -> tuple[Backend, np.ndarray, np.ndarray]:
-    """``(side, q0, q̇0)``: the backend (with the scene's constraints) and the checked start.
+    """``(backend, q0, q̇0)``: the side's backend (with the scene's constraints), the start.
 
     Rest when ``x0`` is None; for a scene with loops the start is closed or checked
     (:func:`rt70.simulation.closed_chains.constrained_start`).
@@ -181,15 +183,15 @@ def _initial_state(
     n = scene.textbook.nv
     if n == 0:
         raise SimulationError(f"{scene.name}: the model has no degree of freedom: nothing moves")
-    side, *closed = constrained_start(scene, BACKENDS[backend](scene), x0, stabilization)
+    backend, *closed = constrained_start(scene, BACKENDS[side](scene), x0, stabilization)
     q0, qd0 = (np.zeros(n), np.zeros(n)) if x0 is None else x0
     q0, qd0 = (q0, qd0) if closed[0] is None else closed
     q0 = check_vector("initial state q0", q0, n)
     qd0 = check_vector("initial state qd0", qd0, n)
-    return side, q0, qd0
+    return backend, q0, qd0
 
 
-def _energy_scale(scene: Scene, side: Backend, q0: np.ndarray, qd0: np.ndarray) -> float:
+def _energy_scale(scene: Scene, backend: Backend, q0: np.ndarray, qd0: np.ndarray) -> float:
     """The initial state's energy scale, J, after checking the start can be integrated.
 
     ``max(T + U_c, 10⁻¹² max(|U_g|, 1), 10⁻³⁰⁰)``: the energy audit's tolerances are
@@ -198,9 +200,9 @@ def _energy_scale(scene: Scene, side: Backend, q0: np.ndarray, qd0: np.ndarray) 
     """
     try:
         check_euler_pairs(scene.textbook, scene.textbook.expand(q0))
-        _check_mass_matrix(scene, side, q0)
+        _check_mass_matrix(scene, backend, q0)
         with np.errstate(over="ignore", invalid="ignore"):  # checked just below
-            T0, Ug0, Uc0 = side.energies(q0, qd0)
+            T0, Ug0, Uc0 = backend.energies(q0, qd0)
     except SingularConfigurationError as exc:  # same class, with the scene's name
         raise SingularConfigurationError(f"{scene.name}: at the initial state: {exc}") from None
     if not np.isfinite([T0, Ug0, Uc0]).all():
@@ -238,14 +240,15 @@ class _RightHandSide:
 
     def __init__(
         self,
-        side: Backend,
+        backend: Backend,
         layout: StateLayout,
         inputs: Inputs | None,
         t_span: tuple[float, float],
         progress: bool,
     ) -> None:
-        self.side, self.layout, self.inputs, self.progress = side, layout, inputs, progress
-        self.n = side.nv
+        self.backend, self.layout, self.inputs = backend, layout, inputs
+        self.progress = progress
+        self.n = backend.nv
         self.t0, self.t1 = t_span
         self.reached = self.t0
         self.pushed = False
@@ -271,7 +274,7 @@ class _RightHandSide:
         n = self.n
         q, qd = x[:n], x[n : 2 * n]
         Q_u = self.input_force(t, x)
-        qdd, Qd = self.side.accelerations(q, qd, Q_u)
+        qdd, Qd = self.backend.accelerations(q, qd, Q_u)
         bar = self.bar
         if self.progress and t - self.t0 > bar.n:
             bar.update(t - self.t0 - bar.n)
@@ -286,7 +289,7 @@ class _RightHandSide:
         n, size = self.n, self.layout.size
         q, qd = x[:n], x[n : 2 * n]
         J = np.zeros((2 * n + size, 2 * n + size))  # zero for extra states
-        J[: 2 * n, : 2 * n] = self.side.jacobian(q, qd, self.input_force(t, x))
+        J[: 2 * n, : 2 * n] = self.backend.jacobian(q, qd, self.input_force(t, x))
         if not np.isfinite(J).all():
             raise SimulationError("the Jacobian of the right-hand side is not finite")
         return J
@@ -313,7 +316,9 @@ def _integrate(
     n = rhs.n
     implicit = method in IMPLICIT or method in CVODE_METHODS
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked in jac
-        analytic = implicit and rhs.side.jacobian(x_start[:n], x_start[n : 2 * n], None) is not None
+        analytic = (
+            implicit and rhs.backend.jacobian(x_start[:n], x_start[n : 2 * n], None) is not None
+        )
     rhs.bar = tqdm(  # on stderr; simulated time since t0
         total=rhs.t1 - rhs.t0,
         disable=not rhs.progress,
@@ -368,9 +373,9 @@ def _result(
     largest energy exchanged in the run (mechanical energy, dissipated energy, input
     work), at least the initial energy scale.
     """
-    n, side = rhs.n, rhs.side
+    n, backend = rhs.n, rhs.backend
     q, qd = sol.y[:n].T, sol.y[n : 2 * n].T
-    energies = np.array([side.energies(a, b) for a, b in zip(q, qd, strict=True)])
+    energies = np.array([backend.energies(a, b) for a, b in zip(q, qd, strict=True)])
     states = rhs.layout.read(sol.y)
     E_psi, W_u = states["dissipated"], states["input_work"]
     total = energies.sum(axis=1) + E_psi - W_u
@@ -380,7 +385,7 @@ def _result(
     wall, timing = clock
     return SimulationResult(
         scene=scene.name,
-        backend=side.name,
+        side=backend.side,
         method=method,
         rtol=rtol,
         atol=atol,
@@ -403,7 +408,7 @@ def _result(
         message=sol.message,
         coordinates=list(scene.textbook.coordinate_names),
         states=states,
-        constraint_residual=residual_trajectory(side, q),
+        constraint_residual=residual_trajectory(backend, q),
         t_events=sol.t_events,
         timing=timing,
     )
@@ -460,13 +465,13 @@ def _state_event(g: Event, n: int) -> Callable[[float, np.ndarray], float]:
     return event
 
 
-def _check_mass_matrix(scene: Scene, side: Backend, q0: np.ndarray) -> None:
+def _check_mass_matrix(scene: Scene, backend: Backend, q0: np.ndarray) -> None:
     """Refuse a model whose mass matrix is singular at the initial state.
 
     A coordinate that moves no mass has a zero diagonal entry; it is named. (Euler pairs
     at gimbal lock are refused before, by ``check_euler_pairs``.)
     """
-    A = side.mass_matrix(q0)
+    A = backend.mass_matrix(q0)
     if not np.isfinite(A).all():
         raise SimulationError(f"{scene.name}: the mass matrix is not finite at the initial state")
     require_diagonal(A, scene.textbook.coordinate_names, f"{scene.name}: ", SimulationError)

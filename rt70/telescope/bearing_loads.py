@@ -42,6 +42,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.model.scene import Scene
+from rt70.model.sides import side_of
 from rt70.physics.loads import Wrench
 
 #: The joints whose reactions are the RT-70's bearing loads (rt70_state's pointing axes).
@@ -244,25 +245,9 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
 def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict, torques: dict):
     """One side's (azimuth, elevation, elevation total, mesh force, vertical forces) at q."""
     zero = np.zeros(q.size)
-    if side == "textbook":
-        from rt70.textbook import drives as side_drives
-        from rt70.textbook import reactions
-        from rt70.textbook import wind as side_wind
-
-        model, data = scene.textbook, scene.textbook_data
-
-        def frames():
-            return reactions.joint_frames(model, data)
-    else:
-        from rt70.reference import drives as side_drives
-        from rt70.reference import reactions
-        from rt70.reference import wind as side_wind
-
-        model, data = scene.reference, scene.reference_data
-
-        def frames():
-            return reactions.joint_frames(model, data, q)
-
+    s = side_of(scene, side)
+    model, data = s.model, s.data
+    side_drives, reactions, side_wind = s.drives, s.reactions, s.wind
     loads: list[Wrench] = []
     if condition is not None:
         loads += list(side_wind.wind_wrenches(model, data, q, condition).values())
@@ -280,7 +265,7 @@ def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict,
         mesh_force += np.asarray(on_link.force)
     total = reactions.joint_reactions(model, data, q, zero, zero, loads)
     bearing = reactions.joint_reactions(model, data, q, zero, zero, loads + mesh)
-    poses = frames()
+    poses = reactions.joint_frames(model, data, q)
     c_az, c_el = poses[AZIMUTH_JOINT][0], poses[ELEVATION_JOINT][0]
     up = -np.asarray(scene.description.gravity, dtype=float)
     up /= np.linalg.norm(up)

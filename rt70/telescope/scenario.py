@@ -17,7 +17,6 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.model.outputs import Output
 from rt70.model.scene import Scene
-from rt70.scenes.rt70_drives import ARCSEC
 from rt70.scenes.rt70_optics import rt70_mirror_system
 from rt70.scenes.rt70_state import (
     POINTING_AXES,
@@ -26,6 +25,7 @@ from rt70.scenes.rt70_state import (
 from rt70.simulation.result import SimulationResult
 from rt70.simulation.states import StateComponent
 from rt70.telescope.servo_tuning import holding_excess
+from rt70.units import ARCSEC_PER_DEG, RAD_PER_ARCSEC
 
 #: The scenarios by name (``rt70 simulate --scenario``).
 SCENARIOS = ("hold", "step-azimuth", "step-elevation", "track")
@@ -128,7 +128,7 @@ def scenario(
         )
     rate = SIDEREAL_ARCSEC_PER_S
     return Scenario(
-        **common, azimuth=lambda t: rate * t / 3600.0, elevation=zero, rate_arcsec_s=rate
+        **common, azimuth=lambda t: rate * t / ARCSEC_PER_DEG, elevation=zero, rate_arcsec_s=rate
     )
 
 
@@ -216,7 +216,7 @@ def sky_error(axis: np.ndarray, target: np.ndarray) -> np.ndarray:
     e, a = elevation_azimuth(axis)
     e_t, a_t = elevation_azimuth(target)
     da = (a - a_t + np.pi) % (2 * np.pi) - np.pi
-    return np.column_stack([da * np.cos(e_t), e - e_t]) / ARCSEC
+    return np.column_stack([da * np.cos(e_t), e - e_t]) / RAD_PER_ARCSEC
 
 
 @dataclass

@@ -39,7 +39,8 @@ from rt70.guards.resources import check_time_series
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.model.outputs import evaluate
 from rt70.model.scene import Scene
-from rt70.scenes.rt70_drives import ARCSEC, AZIMUTH_DRIVE, ELEVATION_DRIVE
+from rt70.model.sides import refuses_backend
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
 from rt70.scenes.rt70_state import (
     AZIMUTH_COORDINATE,
@@ -84,6 +85,7 @@ from rt70.telescope.servo_tuning import (  # noqa: F401  (re-exported: the scena
     servo_tolerances,
     tuning_text,
 )
+from rt70.units import RAD_PER_ARCSEC
 
 #: Integration method of the scenarios. scipy's BDF and Radau stop at random on a hold
 #: ("Required step size is less than spacing between numbers": measured at 30° and 90°,
@@ -93,13 +95,14 @@ from rt70.telescope.servo_tuning import (  # noqa: F401  (re-exported: the scena
 METHOD = "LSODA"
 
 
+@refuses_backend
 def run_scenario(
     scene: Scene,
     sc: Scenario,
     drives: DriveFactory | None = None,
     rtol: float = 1e-6,
     samples_per_s: float = 20.0,
-    backend: str = "pinocchio",
+    side: str = "reference",
     method: str | None = None,
     progress: bool = False,
 ) -> ScenarioRun:
@@ -122,8 +125,8 @@ def run_scenario(
         Relative tolerance of the integration (:func:`rt70.simulation.simulate.simulate`).
     samples_per_s : float
         Output samples per second of simulated time.
-    backend : {"pinocchio", "textbook"}
-        Which side evaluates the mechanics.
+    side : {"reference", "textbook"}
+        Which side evaluates the mechanics (:mod:`rt70.model.sides`).
     method : str, optional
         The integration method; default :data:`METHOD` (LSODA, and why).
     progress : bool
@@ -142,7 +145,7 @@ def run_scenario(
         scene,
         (0.0, sc.t_end),
         (q0, np.zeros(scene.textbook.nv)),
-        backend=backend,
+        side=side,
         method=METHOD if method is None else method,
         rtol=rtol,
         t_eval=t_eval,
@@ -234,9 +237,9 @@ def _measured(
         "elevation": np.array([refs[ELEVATION_COORDINATE](x) for x in t]),
     }
     error = {
-        "azimuth": (reference["azimuth"] - result.q[:, ia]) / ARCSEC,
+        "azimuth": (reference["azimuth"] - result.q[:, ia]) / RAD_PER_ARCSEC,
         # elevation = π/2 − base_rx: its error is the coordinate's with the sign turned
-        "elevation": -(reference["elevation"] - result.q[:, ie]) / ARCSEC,
+        "elevation": -(reference["elevation"] - result.q[:, ie]) / RAD_PER_ARCSEC,
     }
     e_ref = sc.elevation_deg + np.array([sc.elevation(x) for x in t])
     a_ref = sc.azimuth_deg + np.array([sc.azimuth(x) for x in t])
@@ -244,7 +247,7 @@ def _measured(
     n = result.outputs[MIRROR_AXIS]
     pointing = sky_error(n, target)
     cosang = np.clip((n * target).sum(1), -1.0, 1.0)
-    total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / ARCSEC
+    total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / RAD_PER_ARCSEC
     torque, current, limits = _drive_torques(components, result, names)
     static = _static_misalignment(scene, q0, sc)
     return ScenarioRun(

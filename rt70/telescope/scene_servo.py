@@ -47,6 +47,7 @@ from rt70.errors import Rt70Error
 from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
+from rt70.model.sides import check_side
 from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE, FRICTION, AxisDrive
 from rt70.simulation.states import StateComponent
 from rt70.telescope.servo_tuning import (
@@ -276,19 +277,19 @@ class SceneServoFactory:
         :data:`rt70.telescope.scenarios.AXIS_TUNING`.
     friction : bool
         Add the book's dry friction on each driven axis.
-    side : {"pinocchio", "reference", "textbook"}
-        Whose kinematics computes θ_d (use the simulation's backend).
+    side : {"reference", "textbook"}
+        Whose kinematics computes θ_d (use the simulation's side).
     """
 
     def __init__(
         self,
         tuning: dict[str, tuple[float, float]] | None = None,
         friction: bool = False,
-        side: str = "pinocchio",
+        side: str = "reference",
     ) -> None:
         self.tuning = {**AXIS_TUNING, **(tuning or {})}
         self.friction = friction
-        self.side = side
+        self.side = check_side(side)
         self.residual = np.nan  # of the last start (scene_equilibrium)
         self._couplings: dict[str, list[SceneCoupling]] = {}
 
@@ -366,7 +367,7 @@ def check_scene_drives(scene: Scene) -> None:
 
 
 def choose_drives(
-    scene: Scene, model: str | None, friction: bool = False, side: str = "pinocchio"
+    scene: Scene, model: str | None, friction: bool = False, side: str = "reference"
 ) -> tuple[object, str]:
     """The drive factory of a scenario and a phrase describing it.
 
@@ -380,7 +381,7 @@ def choose_drives(
         one per axis (its own model of the drives), the coordinate drives otherwise.
     friction : bool
         Add the book's dry friction on both axes.
-    side : {"pinocchio", "textbook"}
+    side : {"reference", "textbook"}
         Which side computes the scene drives' couplings.
 
     Raises

@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from rt70.control.servo import CascadeGains
-from rt70.scenes.rt70_drives import ARCSEC
 from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE
 from rt70.telescope.scenario import ScenarioRun
+from rt70.units import ARCSEC_PER_DEG, RAD_PER_ARCSEC
 
 #: The settling band of the issue's targets, arc seconds.
 BAND_ARCSEC = 1.0
@@ -66,7 +66,7 @@ def predicted_settling(step_arcsec: float, gains: CascadeGains, band: float = BA
     """
     import scipy.linalg
 
-    step = abs(step_arcsec) * ARCSEC
+    step = abs(step_arcsec) * RAD_PER_ARCSEC
     w, omega, k_i = gains.kp_p, gains.rate_limit, gains.ki_p
     e_lin = min(step, omega / w)
     slew = (step - e_lin) / omega
@@ -79,7 +79,7 @@ def predicted_settling(step_arcsec: float, gains: CascadeGains, band: float = BA
     for i in range(t.size):
         errors[i] = x[0]
         x = propagate @ x
-    return float(slew + settling_time(t, errors / ARCSEC, band))
+    return float(slew + settling_time(t, errors / RAD_PER_ARCSEC, band))
 
 
 #: Metrics that are NaN when the run never settled (:func:`settling_time`) or the drive
@@ -126,7 +126,7 @@ def measure(run: ScenarioRun) -> dict[str, float]:
             AZIMUTH_COORDINATE if axis == "azimuth" else ELEVATION_COORDINATE
         ]
     for i, axis in enumerate(("azimuth", "elevation")):
-        step = sc.step_deg[i] * 3600.0
+        step = sc.step_deg[i] * ARCSEC_PER_DEG
         if step:
             e = run.axis_error[axis]
             m["axis_settle_s"] = settling_time(t, e)

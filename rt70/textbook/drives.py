@@ -161,3 +161,23 @@ def drive_force(
     return angle, sum(
         _wrench_force(model, data, w.link, w.xyz, np.asarray(w.force)) for w in wrenches
     )
+
+
+def drive_force_function(model: Model, data: Data, drive: Drive, mesh=None):
+    """``q ↦ (θ_d, ∂θ_d/∂q)``: :func:`drive_force` at unit torque.
+
+    The twin of :func:`rt70.reference.drives.drive_force_function`, which compiles it
+    where it can; here it is :func:`drive_force` itself.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    drive : rt70.urdf.Drive
+        The scene's ``<rt70:drive>``: a torque on a joint's coordinate, or a gear sector.
+    mesh : rt70.physics.loads.SectorMesh, optional
+        The sector's pitch circle of :func:`sector_mesh` (computed at every call when None).
+    """
+    return lambda q: drive_force(model, data, q, drive, 1.0, mesh)

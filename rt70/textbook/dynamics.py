@@ -2,7 +2,8 @@
 
 Every function takes the plain model, its work buffers and the state, in the manner of
 Pinocchio's ``crba(model, data, q)``. This is the dense, readable form of the book:
-L, S and Θ are assembled as full block matrices.
+L, S and Θ are assembled as full block matrices. The kinetic and gravity energies are
+here too, as on the reference side (:mod:`rt70.reference.dynamics`).
 """
 
 from __future__ import annotations
@@ -196,3 +197,41 @@ def forward_dynamics(
     except np.linalg.LinAlgError:
         raise Rt70Error("mass matrix A is not positive definite at this configuration") from None
     return scipy.linalg.cho_solve(factor, rhs)
+
+
+def gravity_potential(model: Model, data: Data, q: np.ndarray) -> float:
+    """Gravity potential ``−Σ m_k g0 · (p_k + c_{0k} p_cm,k)`` of the moving bodies.
+
+    Bodies welded to the ground through fixed joints only are part of E0: their
+    potential is a constant and is left out (Pinocchio's convention too).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    """
+    update_structure(model, data, q)
+    com_world = data.p + np.einsum("kij,kj->ki", data.R, model.com)
+    moving = np.array([model.ndof[model.ancestors(j)].sum() > 0 for j in range(model.nb)])
+    return -float((model.mass * moving) @ (com_world @ model.gravity))
+
+
+def kinetic_energy(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> float:
+    """Kinetic energy ``½ q̇ᵀ A q̇`` (1.61).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q, qd : numpy.ndarray, shape (nv,)
+        Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
+        order (``Model.coordinate_names``).
+    """
+    qd = check_vector("qd", qd, model.nv)
+    return 0.5 * float(qd @ mass_matrix(model, data, q) @ qd)

@@ -8,10 +8,12 @@ The constraint ``B_c q̇ = 0`` that engages in an impact (companion source 004 (
 - a **stow pin** fixes a point of a link to the ground: its three rows are the point's
   velocity Jacobian ``J_v`` in ground axes (4.63), :func:`rt70.textbook.points.point_jacobian`.
 
-The reference side computes the same rows from Pinocchio (:mod:`rt70.reference.impact`).
+The reference side computes the same rows from Pinocchio (:mod:`rt70.reference.locks`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -57,3 +59,31 @@ def pin_rows(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> np.ndar
         The point in the link's frame, m.
     """
     return point_jacobian(model, data, q, link, xyz)[0]
+
+
+def book_rows(
+    model: Model,
+    data: Data,
+    q: np.ndarray,
+    brakes: Sequence[str] = (),
+    pins: Sequence[tuple[str, np.ndarray]] = (),
+) -> np.ndarray:
+    """The locks' rows ``B_c`` in the book's coordinates, (m, nv): brakes, then pins.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    brakes : sequence of str
+        The braked joints (1-DOF), one row each.
+    pins : sequence of (str, array_like)
+        The stow pins: a link and the point fixed to the ground in the link's frame (m),
+        three rows each.
+    """
+    rows = [brake_row(model, joint)[None] for joint in brakes]
+    rows += [pin_rows(model, data, q, link, xyz) for link, xyz in pins]
+    return np.vstack(rows) if rows else np.zeros((0, model.nv))

@@ -22,7 +22,12 @@ import numpy as np
 
 from rt70.guards.arrays import check_vector
 from rt70.textbook.data import Data
-from rt70.textbook.dynamics import body_velocities, structure_matrix_rate
+from rt70.textbook.dynamics import (
+    bias_force,
+    body_velocities,
+    mass_matrix,
+    structure_matrix_rate,
+)
 from rt70.textbook.kinematics import update_structure
 from rt70.textbook.model import Model
 from rt70.textbook.points import ground_bias_acceleration, ground_jacobian, link_point
@@ -104,3 +109,36 @@ def constraint_bias(
         u = v_p + e.radius * np.cross(e.normal, w_g)
         out[i] = np.cross(w_f, d) @ u + d @ (a_p + e.radius * np.cross(e.normal, dw_g))
     return out
+
+
+def reduced_terms(
+    model: Model,
+    data: Data,
+    q: np.ndarray,
+    qd: np.ndarray,
+    basis: np.ndarray,
+    basis_rate_qd: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``A* = 𝔅ᵀ A 𝔅`` and ``a = 𝔅ᵀ (A 𝔅̇ q̇_ind + B q̇)`` (gravity apart), 002 (1.6)–(1.7).
+
+    The book's A and velocity products ``B q̇`` at ``q̇ = 𝔅 q̇_ind``, projected: the
+    twin of :func:`rt70.reference.no_slip.reduced_terms` (Pinocchio's crba and rnea).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
+    qd : numpy.ndarray, shape (nv,)
+        The full velocities ``𝔅 q̇_ind``, rad/s or m/s.
+    basis : numpy.ndarray, shape (nv, n_ind)
+        The velocity map 𝔅 (``q̇ = 𝔅 q̇_ind``, rows in the full order).
+    basis_rate_qd : numpy.ndarray, shape (nv,)
+        ``𝔅̇ q̇_ind``, rad/s² or m/s².
+    """
+    A = mass_matrix(model, data, q)
+    h = bias_force(model, data, q, qd)
+    return basis.T @ A @ basis, basis.T @ (A @ basis_rate_qd + h)

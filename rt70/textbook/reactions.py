@@ -44,7 +44,7 @@ from rt70.guards.arrays import check_vector
 from rt70.physics.loads import Wrench
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import body_velocities, structure_matrix_rate
-from rt70.textbook.kinematics import update_structure
+from rt70.textbook.kinematics import forward_kinematics, update_structure
 from rt70.textbook.model import Model
 from rt70.textbook.points import link_point
 from rt70.textbook.spatial import c1, c2, c3, crf, placement
@@ -298,11 +298,25 @@ def chain_frames(qk: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     ]
 
 
-def joint_frames(model: Model, data: Data) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Ground rotation and origin of every URDF joint's frame from the last forward pass.
+def joint_frames(
+    model: Model, data: Data, q: np.ndarray
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Ground rotation and origin of every URDF joint's frame at q, for ground-axis reports.
 
-    For reports in ground axes: ``F₀ = c F``, ``M₀ = c M`` (about the same origin).
+    ``F₀ = c F``, ``M₀ = c M`` (about the same origin).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : Data
+        Its work buffers; the forward pass fills them.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
     """
+    q = check_vector("q", q, model.nv)
+    data.q_full = model.expand(q)
+    forward_kinematics(model, data, data.q_full)
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     for k, names in enumerate(model.pair_joints):
         if len(names) == 1:

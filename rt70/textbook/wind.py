@@ -99,3 +99,12 @@ def wind_force(model: Model, data: Data, q: np.ndarray, condition: WindCondition
     for value in wind_forces(model, data, q, condition).values():
         Q += value
     return Q
+
+
+def wind_force_function(model: Model, data: Data):
+    """``(q, condition) ↦ Q_w``: :func:`wind_force`.
+
+    The twin of :func:`rt70.reference.wind.wind_force_function`, which compiles it where
+    it can; here it is :func:`wind_force` itself.
+    """
+    return lambda q, condition: wind_force(model, data, q, condition)

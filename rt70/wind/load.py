@@ -4,7 +4,7 @@
 :meth:`~WindLoad.force` is the scene's wind generalised force (``<rt70:wind>``,
 :mod:`rt70.physics.aerodynamics`) at the speed ``v(t) = mean + gust(t)`` along the fixed
 mean direction, computed on one side of the cross-check (:mod:`rt70.textbook.wind` or
-:mod:`rt70.reference.wind`, chosen as :class:`rt70.model.couplings.SceneCoupling` does). The
+:mod:`rt70.reference.wind`, through :func:`rt70.model.sides.side_of`). The
 force is exact in the speed — ``½ ρ (v̄ + v′)² S [c]`` — not linearised about the mean. A
 negative ``v(t)`` (a gust stronger than the mean, against it) is the same flow turned by
 180°. The simulation adds the force to ``Q_u``, so its work is the energy audit's input
@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.model.couplings import SIDES
+from rt70.model.sides import check_side, side_of
 from rt70.physics.aerodynamics import WindCondition
 from rt70.simulation.states import StateComponent
 
@@ -35,9 +35,8 @@ class WindLoad(StateComponent):
         The mean wind: its speed v̄, direction and (optional) air density.
     gust : callable t -> float, optional
         The gust speed v′(t), m/s, along the mean direction; None: a steady wind.
-    side : {"reference", "textbook", "pinocchio"}
-        Which side's kinematics computes the force (``"pinocchio"`` = ``"reference"``);
-        use the simulation's backend (``"pinocchio"`` or ``"textbook"``).
+    side : {"reference", "textbook"}
+        Which side's kinematics computes the force; use the simulation's side.
 
     Raises
     ------
@@ -55,8 +54,10 @@ class WindLoad(StateComponent):
         gust: Callable[[float], float] | None = None,
         side: str = "reference",
     ) -> None:
-        if side not in SIDES:
-            raise Rt70Error(f"wind load: unknown side '{side}' (one of {SIDES})")
+        try:
+            check_side(side)
+        except Rt70Error as exc:
+            raise Rt70Error(f"wind load: {exc}") from None
         if not scene.description.winds:
             raise Rt70Error(
                 f"{scene.name}: no <rt70:wind> elements: nothing for the wind to act on "
@@ -68,21 +69,11 @@ class WindLoad(StateComponent):
             raise Rt70Error(f"wind load: gust must be a callable t -> m/s or None, got {gust!r}")
         self.condition = condition
         self.gust = gust
-        self.side = "textbook" if side == "textbook" else "reference"
+        self.side = side
         self.initial = np.zeros(0)
         self.atol = np.zeros(0)
-        if self.side == "textbook":
-            from rt70.textbook import wind as kin
-
-            model, data = scene.textbook, scene.textbook_data
-        else:
-            from rt70.reference import wind as kin
-
-            model, data = scene.reference, scene.reference_data
-        if self.side == "reference":  # compiled where it can (the same numbers)
-            self._force = kin.wind_force_function(model, data)
-        else:
-            self._force = lambda q, c: kin.wind_force(model, data, q, c)
+        s = side_of(scene, side)  # the reference side compiles it where it can (same numbers)
+        self._force = s.wind.wind_force_function(s.model, s.data)
 
     def speed(self, t: float) -> float:
         """The wind speed ``v̄ + v′(t)`` along the mean direction, m/s.

@@ -7,7 +7,7 @@ Every case is a variant of a scene built from URDF text in memory and reports
   LAPACK ``dpocon`` 1-norm estimate from a Cholesky factor, marked ``≈``);
 - the cross-check error: the largest relative error over the ten quantities of
   :func:`rt70.crosscheck.validate.cross_check` (textbook against Pinocchio) on a few random states;
-- a short simulation (:func:`rt70.simulation.simulate.simulate`, Pinocchio backend, BDF,
+- a short simulation (:func:`rt70.simulation.simulate.simulate`, reference side, BDF,
   ``rtol = 1e-6`` unless stated) with its outcome, accepted and rejected steps, the
   number of right-hand-side evaluations, the relative drift of the energy balance
   ``T + U_g + U_c + E_ψ`` and the wall time of the integration, capped in wall time.

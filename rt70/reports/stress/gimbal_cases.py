@@ -189,7 +189,7 @@ def gimbal_mass_matrix_cases(quick: bool = False) -> Table:
     settings = Settings.make(quick)
     table = _mass_matrix_table()
     scene = scene_from_text(remove_spring(rt70_text(), GIMBAL_BUSHING), "rt70_free_cr")
-    backends = {name: cls(scene) for name, cls in BACKENDS.items()}
+    backends = {side: cls(scene) for side, cls in BACKENDS.items()}
     for label, q, v, i in _gimbal_states(settings, scene):
         table.rows.append(_mass_matrix_row(scene, backends, label, q, v, i))
     _mass_matrix_notes(table, _mass_matrix_summary(table))
@@ -239,10 +239,10 @@ def _mass_matrix_row(
         results["dense"] = dynamics.forward_dynamics(model, data, q, v, Qc + Qd)
     except Rt70Error as exc:
         row["dense"] = short_error(exc)
-    for key, name in (("structured", "textbook"), ("pinocchio", "pinocchio")):
+    for key, side in (("structured", "textbook"), ("pinocchio", "reference")):
         try:
             with np.errstate(all="ignore"):
-                results[key] = backends[name].accelerations(q, v, None)[0]
+                results[key] = backends[side].accelerations(q, v, None)[0]
         except (Rt70Error, np.linalg.LinAlgError) as exc:
             row[key] = short_error(exc)
     for key, a in results.items():

@@ -73,7 +73,7 @@ def stiffness_cases(quick: bool = False) -> Table:
         "Every spring and strut of the RT-70 has its stiffness multiplied by 10^k and its "
         f"damping by 0 or by 10^k. f_max is the highest eigenfrequency of the undeformed "
         f"structure (springs only, q = 0). Simulation: {settings.span:g} s from the "
-        f"listing's state, Pinocchio backend, BDF, rtol {SIM_RTOL:g}, cap "
+        f"listing's state, reference side, BDF, rtol {SIM_RTOL:g}, cap "
         f"{settings.cap_s:g} s.",
         [
             ("k", "k"),

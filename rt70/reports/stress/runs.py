@@ -1,6 +1,6 @@
 """Capped simulations of the stress cases, with accepted and rejected steps counted.
 
-A short simulation (:func:`rt70.simulation.simulate.simulate`, Pinocchio backend, BDF,
+A short simulation (:func:`rt70.simulation.simulate.simulate`, reference side, BDF,
 ``rtol = 1e-6`` unless stated) gives its outcome, accepted and rejected steps, the
 number of right-hand-side evaluations, the relative drift of the energy balance
 ``T + U_g + U_c + E_ψ`` and the wall time of the integration. :class:`Settings` holds the
@@ -37,6 +37,7 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.model.scene import Scene
+from rt70.model.sides import refuses_backend
 from rt70.reports.stress.measures import CROSS_CHECK_SAMPLES
 from rt70.simulation.result import SimulationResult
 from rt70.simulation.simulate import simulate
@@ -94,11 +95,12 @@ def count_bdf_steps(times: list[float], t0: float) -> tuple[int, int]:
     return len(attempts) - rejected, rejected
 
 
+@refuses_backend
 def run_capped(
     scene: Scene,
     t_span: tuple[float, float],
     x0: tuple[np.ndarray, np.ndarray] | None = None,
-    backend: str = "pinocchio",
+    side: str = "reference",
     method: str = "BDF",
     rtol: float = SIM_RTOL,
     cap_s: float = TIME_CAP_S,
@@ -109,7 +111,7 @@ def run_capped(
 
     Parameters
     ----------
-    scene, t_span, x0, backend, method, rtol, t_eval
+    scene, t_span, x0, side, method, rtol, t_eval
         As for :func:`rt70.simulation.simulate.simulate`.
     cap_s : float
         The cap, s of ``clock``: checked at every right-hand-side evaluation, the first
@@ -139,7 +141,7 @@ def run_capped(
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            result = simulate(scene, t_span, x0, backend, method, rtol, inputs=hook, t_eval=t_eval)
+            result = simulate(scene, t_span, x0, side, method, rtol, inputs=hook, t_eval=t_eval)
         if not result.success:
             status = f"failed: {result.message}"
     except _OverCap:

@@ -71,7 +71,7 @@ def _chain_table(settings: Settings) -> Table:
         "(`rt70.textbook.structured`) is checked against the dense one; at n = 1000 "
         "(S is 6000 × 6000) only A and S·G (the dense B q̇ loops over nb² blocks), and "
         "cond(A) is LAPACK's 1-norm estimate. Simulation "
-        f"({settings.span:g} s from rest, Pinocchio backend, BDF) only for "
+        f"({settings.span:g} s from rest, reference side, BDF) only for "
         f"n ≤ {settings.chain_sim_max}: the implicit method's Jacobian is dense, O(nv³) "
         "per LU factorisation.",
         [
@@ -218,7 +218,7 @@ def _units_table(settings: Settings, rtol: float) -> Table:
         "with the initial state converted likewise. Frequencies: springs-only K and "
         "A at q = 0, compared with SI over all modes (relative to each SI frequency, the "
         f"rigid modes excluded). Trajectories: {settings.span:g} s from the listing's "
-        f"state, Pinocchio backend, BDF, rtol {rtol:g}, on a common grid of 51 times, "
+        f"state, reference side, BDF, rtol {rtol:g}, on a common grid of 51 times, "
         "converted back to SI and compared per kind of coordinate (lengths, angles) "
         "relative to the largest SI value of that kind. E0: the initial energy "
         "T + U_g + U_c converted back (× 1/(μλ²)).",
@@ -261,8 +261,8 @@ def _unit_run(
     freq = frequencies_hz(scene)
     model, data = scene.textbook, scene.textbook_data
     e0 = (
-        forces.kinetic_energy(model, data, q0, v0)
-        + forces.gravity_potential(model, data, q0)
+        dynamics.kinetic_energy(model, data, q0, v0)
+        + dynamics.gravity_potential(model, data, q0)
         + forces.spring_potential(model, data, q0)
     ) / (mu * lam**2)
     err, _, _ = cross_check_error(scene, settings.samples)
@@ -351,17 +351,17 @@ def free_floating_cases(quick: bool = False) -> Table:
         x0 = free_floating_state(scene)
         rigid = int(np.sum(frequencies_hz(scene) == 0.0))
         err, _, _ = cross_check_error(scene, settings.samples)
-        for backend in ("pinocchio", "textbook"):
+        for side in ("reference", "textbook"):
             run = run_capped(
                 scene,
                 (0.0, span),
                 x0,
-                backend=backend,
+                side=side,
                 method="DOP853",
                 rtol=rtol,
                 cap_s=settings.cap_s,
             )
-            row = {"n": n, "nv": scene.textbook.nv, "backend": backend, "rigid": rigid}
+            row = {"n": n, "nv": scene.textbook.nv, "side": side, "rigid": rigid}
             row.update(xerr=err, span=span, fmax=float(frequencies_hz(scene)[-1]))
             row.update(sim_fields(run, span))
             if run.result is not None:
@@ -388,7 +388,7 @@ def _floating_table(rtol: float) -> Table:
         [
             ("n", "bodies"),
             ("nv", "nv"),
-            ("backend", "backend"),
+            ("side", "side"),
             ("span", "span s"),
             ("fmax", "f_max Hz"),
             ("rigid", "rigid modes"),
@@ -425,7 +425,7 @@ def _floating_notes(table: Table, rtol: float) -> None:
         table.notes.append(
             f"P is conserved to {worst_value(done, 'dP'):.1g} and L_O to "
             f"{worst_value(done, 'dL'):.1g} "
-            f"(relative) at rtol {rtol:g} on both backends; the energy balance to "
+            f"(relative) at rtol {rtol:g} on both sides; the energy balance to "
             f"{worst_value(done, 'drift'):.1g}. The two momentum computations (Pinocchio, "
             f"textbook) agree to {worst_value(done, 'sides'):.1g} along the runs."
         )

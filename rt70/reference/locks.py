@@ -1,4 +1,4 @@
-"""Impacts on the reference side: Pinocchio's ``impulseDynamics`` in book coordinates.
+"""Locks on the reference side: their rows, and their impact by Pinocchio's ``impulseDynamics``.
 
 The sudden constraint (companion source 004 (15)) is built in Pinocchio's own velocity
 space ``v``, independently of the textbook side (:mod:`rt70.textbook.locks`):
