@@ -4,7 +4,7 @@ The book (§2.4, p. 51) gives the RT-70 axes' dry friction as a moment of 7·10�
 rest rising to (1–2)·10⁵ kgf·m at top speed, "relay-like near zero speed"
 (``rt70.scenes.rt70_drives.DryFriction``; this module takes any object with its
 ``static_torque`` and ``slope``, so it knows no telescope). Taken linear between the two points,
-the friction torque on the axis is
+the friction torque on the axis is ::
 
     τ_f(ω) = −sign(ω) (F_s + k |ω|) = −F_s sign(ω) − k ω,      ω ≠ 0,           (relay)
 
@@ -16,7 +16,7 @@ it by a steep continuous law of width ω_ε:
 - ``"linear"``: τ_f = −F_s clip(ω/ω_ε, −1, 1) − k ω (a viscous zone of slope F_s/ω_ε).
 
 Both tend to the relay law as ω_ε → 0 for every ω ≠ 0. Their error is that a stuck axis
-creeps: under a torque τ with |τ| < F_s it moves at ω_ε·atanh(τ/F_s) (tanh) or about
+creeps: under a torque τ with ``|τ| < F_s`` it moves at ω_ε·atanh(τ/F_s) (tanh) or about
 ω_ε·τ/F_s (linear) instead of sticking. docs/drive-train.md measures the price of a
 small ω_ε in integrator steps against that creep.
 

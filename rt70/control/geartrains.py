@@ -7,7 +7,7 @@ and the motors apply opposing ("распорные") torques that take up the de
 module models both.
 
 Backlash (the "dead-zone spring" model, e.g. Nordin & Gutman, Automatica 38, 2002): one
-train of stiffness C and damping D with a gap of half-width b (axis side) transmits
+train of stiffness C and damping D with a gap of half-width b (axis side) transmits ::
 
     τ = C dz(Δ) + D Δ̇     while the teeth touch (|Δ| > b),   τ = 0 inside the gap,
     dz(Δ) = Δ − b sign(Δ),

@@ -175,11 +175,11 @@ def equilibrium(
     ``side``; the residual is always the textbook's static force). Held
     coordinates (``{name: value}``, the drives) keep their values; their generalised
     force is what the drives must supply. Converged when the force residual is below
-    ``tol`` times the force scale (the largest |Q_g + Q_c| at the start, or 1); the
+    ``tol`` times the force scale (the largest ``|Q_g + Q_c|`` at the start, or 1); the
     rounding floor of the RT-70's stiff springs is about 2e-12 of it, but up to 1.2e-10 at
     some pointings of ``rt70_servo`` (30° elevation: the strut packages' force terms, some
     10⁵ times the residual's scale, cancel): so Newton also stops when its step moves no
-    coordinate by more than :data:`STEP_TOL` (relative to the largest |q|, at least 1) —
+    coordinate by more than :data:`STEP_TOL` (relative to the largest ``|q|``, at least 1) —
     the configuration is then fixed to rounding (measured steps there: 1e-14). K is recomputed
     only when the residual fell by less than ``1/REUSE_RATIO`` in the last step (the
     RT-70's sag is small: one K usually suffices).

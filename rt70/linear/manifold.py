@@ -36,7 +36,7 @@ RANK_RTOL = 1e-10
 #: truncation error is O(h²) ≈ 1e-12 relative, the rounding O(ε/h) ≈ 1e-10 relative.
 FD_STEP = 1e-6
 #: Newton (the equilibrium's, and that of a partition's dependent coordinates) stops when
-#: its step moves no coordinate by more than this (relative to the largest |q|, at least
+#: its step moves no coordinate by more than this (relative to the largest ``|q|``, at least
 #: 1): the configuration is fixed to rounding.
 STEP_TOL = 1e-13
 

@@ -401,7 +401,7 @@ class DampedModes:
     Attributes
     ----------
     eigenvalues : ndarray, shape (2n,)
-        λ of ``[[0, 1], [−M⁻¹K, −M⁻¹D]]``, complex, sorted by |λ|.
+        λ of ``[[0, 1], [−M⁻¹K, −M⁻¹D]]``, complex, sorted by ``|λ|``.
     oscillatory : ndarray of complex
         One λ of each complex pair (positive imaginary part), by frequency.
     real : ndarray of float

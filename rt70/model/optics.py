@@ -16,13 +16,13 @@ unit offsets ``e_x, e_y, e_z``. Everything is then a plain formula; the outputs 
 ================================  ======  ====  ==========================================
 name                              unit    size  formula
 ================================  ======  ====  ==========================================
-``main_mirror_axis``              1       3     n5 = Rᵀ(r5f − r5v)/|r5f − r5v| (4.155)
+``main_mirror_axis``              1       3     n5 = Rᵀ(r5f − r5v)/‖r5f − r5v‖ (4.155)
 ``counterreflector_axis``         1       3     n7 likewise through the CR points (4.164)
-``main_mirror_misalignment``      arcsec  1     2 arcsin(|s − n5|/2) (4.157)
+``main_mirror_misalignment``      arcsec  1     2 arcsin(‖s − n5‖/2) (4.157)
 ``main_mirror_error``             arcsec  3     s − n5 in OK, small-angle vector (4.156)
-``counterreflector_misalignment`` arcsec  1     2 arcsin(|n7 − n5|/2) (4.166)
+``counterreflector_misalignment`` arcsec  1     2 arcsin(‖n7 − n5‖/2) (4.166)
 ``counterreflector_error``        arcsec  3     n7 − n5 in OK, small-angle vector (4.165)
-``counterreflector_source_...``   arcsec  1     2 arcsin(|s − n7|/2) (φ7 КИР of 4.1.8)
+``counterreflector_source_...``   arcsec  1     2 arcsin(‖s − n7‖/2) (φ7 КИР of 4.1.8)
 ``focal_offset``                  mm      3     Rᵀ(r7f − r5f) − d (4.152)
 ``pointing_correction``           arcsec  2     [Δα, Δβ] from the x, y rows (4.159)–(4.163)
 ``counterreflector_rotation``     arcsec  3     [Δβ7, Δθ7, Δα7] (4.168)–(4.172)
@@ -47,7 +47,7 @@ from rt70.errors import Rt70Error, SingularConfigurationError
 from rt70.model.outputs import Output, Point
 from rt70.units import ARCSEC_PER_RAD, MM_PER_M
 
-#: Smallest |det| (relative) of the pointing system (4.163) and smallest σ₂/σ₁ of the
+#: Smallest ``|det|`` (relative) of the pointing system (4.163) and smallest σ₂/σ₁ of the
 #: counterreflector system (4.172) before the correction is refused as undefined.
 SINGULAR = 1e-9
 

@@ -118,7 +118,7 @@ class WindCondition:
     Parameters
     ----------
     speed : float
-        Wind speed |v0|, m/s (≥ 0).
+        Wind speed ``|v0|``, m/s (≥ 0).
     direction_deg : float
         The telescope azimuth the wind blows FROM, degrees: the flow velocity is
         ``v0 = −speed · h(direction_deg)`` (:func:`horizontal_direction`), so

@@ -91,7 +91,7 @@ class SectorMesh:
         θ_d = atan2(v·d, u·d),
 
     zero at the construction; when only the driven axis turns (the structure otherwise
-    undeformed) θ_d is that axis' angle. Valid for |θ_d| < π.
+    undeformed) θ_d is that axis' angle. Valid for ``|θ_d| < π``.
     """
 
     centre: np.ndarray

@@ -122,7 +122,7 @@ def plot_mode_shapes(
     ax: Axes | None = None,
     include_rigid: bool = False,
 ) -> Figure:
-    """Mode shapes as lines over the coordinates, each scaled to max |v| = 1.
+    """Mode shapes as lines over the coordinates, each scaled to ``max |v| = 1``.
 
     Parameters
     ----------

@@ -29,7 +29,7 @@ from rt70.guards.arrays import check_vector
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import FrameStack, ReferenceData, ReferenceModel
 
-#: Same threshold as the textbook side: |cos θ| of the 1–2–3 angles below it is gimbal lock.
+#: Same threshold as the textbook side: ``|cos θ|`` of the 1–2–3 angles below it is gimbal lock.
 GIMBAL_LOCK_COS = 1e-8
 
 

@@ -30,7 +30,7 @@ Problems
     ``serial_chain(50)`` (50 revolute joints, about 40 % of them with springs) from
     ``q`` uniform in ±0.3 rad (seed 1), ``q̇ = 0``, over 1 s: the long, non-stiff chain
     (``elastic_chain(20)`` is as stiff as the RT-70 and would add nothing). Over 2 s the
-    chain whips (|q̇| up to 75 rad/s) and is chaotic enough that the errors of all loose
+    chain whips (``|q̇|`` up to 75 rad/s) and is chaotic enough that the errors of all loose
     tolerances saturate at O(1) and the two references part to 2e-9; over 1 s they agree
     to 5e-12.
 

@@ -50,7 +50,7 @@ def fmt(value: float) -> str:
     -------
     str
         The shortest decimal text that reads back as the same float: for
-        1e-4 ≤ |x| < 1e6 Python's ``repr`` without a trailing ``.0`` (``25``,
+        ``1e-4 ≤ |x| < 1e6`` Python's ``repr`` without a trailing ``.0`` (``25``,
         ``13.45``), otherwise scientific notation with the fewest digits
         (``5e+10``, ``5.35e+11``, ``1e-06``); zero (also ``-0.0``) is written ``0``.
 

@@ -77,7 +77,7 @@ class SimulationResult:
 
     @property
     def relative_drift(self) -> float:
-        """Largest |balance| over the run, relative to ``balance_scale``."""
+        """Largest ``|balance|`` over the run, relative to ``balance_scale``."""
         return float(np.max(np.abs(self.balance)) / self.balance_scale)
 
     @property

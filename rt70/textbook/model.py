@@ -11,7 +11,8 @@ constant ``r_c[j]``, ``c_c[j]``; the pair's own motion is one of
     URDF ``continuous`` joints are revolute pairs (the angle is the coordinate);
 ``planar``
     ``q_j = [x, y, α]``: translation in the construction frame's x–y plane, then rotation
-    α about its z axis;
+    α about its z axis.
+
 URDF ``fixed`` joints are no pairs: the child link's inertia is merged into the body
 it is welded to (as Pinocchio does), and its frame is kept as a placement on that body.
 

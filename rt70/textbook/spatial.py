@@ -17,7 +17,7 @@ GIMBAL_LOCK_COS = 1e-8
 
 #: Gimbal-lock threshold of the dynamics of a 6-DOF Euler pair: its M_j = diag(cᵀ, ε)
 #: makes cond(A) grow as 1/cos²θ, and accelerations lose accuracy as ε·cond(A) (the
-#: stress report measures 1e-5 relative at |cos θ| = 1e-4 with springs, and 66 % at
+#: stress report measures 1e-5 relative at ``|cos θ| = 1e-4`` with springs, and 66 % at
 #: 1e-8). Forward dynamics refuses pairs with ``|cos θ|`` below this.
 DYNAMICS_GIMBAL_COS = 1e-4
 

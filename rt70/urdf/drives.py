@@ -20,7 +20,7 @@ from rt70.urdf.text import RT70_NS
 #: Parameters that must be positive (the others, D_m and D_r, may be zero).
 POSITIVE = ("L_a", "R_a", "c_m", "c_e", "J_m", "i_r", "C_r")
 
-#: Largest |axis · direction| of a sector: the tangent must be normal to the axis.
+#: Largest ``|axis · direction|`` of a sector: the tangent must be normal to the axis.
 ORTHOGONALITY = 1e-9
 
 

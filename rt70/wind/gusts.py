@@ -307,7 +307,7 @@ def discretise(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.
     Van Loan (1978): ``expm([[−A, B Bᵀ], [0, Aᵀ]] h) = [[·, F₁₂], [0, F₂₂]]`` gives
     ``Φ(h) = F₂₂ᵀ = e^{A h}`` and ``Q(h) = Φ F₁₂ = ∫₀^h e^{As} B Bᵀ e^{Aᵀs} ds``. Its
     block ``e^{−A h}`` grows like ``e^{|λ|h}`` for a fast stable pole and ``Φ F₁₂`` then
-    cancels catastrophically (at |λ|·h ≈ 300 the result is garbage), so Van Loan's formula
+    cancels catastrophically (at ``|λ|·h ≈ 300`` the result is garbage), so Van Loan's formula
     is applied at ``h = dt/2^k`` with ``‖A‖₁ h ≤ 1/2`` and doubled k times:
     ``Q(2h) = Q(h) + Φ(h) Q(h) Φ(h)ᵀ``, ``Φ(2h) = Φ(h)²`` (sums of positive
     semi-definite terms, no cancellation). Then ``x_{k+1} = Φ x_k + e_k``,

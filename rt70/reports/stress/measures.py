@@ -125,7 +125,7 @@ def rel_error(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def per_body_qdd_error(scene: Scene, samples: int = CROSS_CHECK_SAMPLES, seed: int = 0) -> float:
-    """Largest error of q̈ (textbook against Pinocchio) relative to each body's own |q̈|.
+    """Largest error of q̈ (textbook against Pinocchio) relative to each body's own ``|q̈|``.
 
     Parameters
     ----------
