@@ -13,21 +13,21 @@ link's frame (the book's mirror base, body 4); a frame's rotation ``R`` (columns
 axes in ground axes) is read from the positions of the link's origin and of the three
 unit offsets ``e_x, e_y, e_z``. Everything is then a plain formula; the outputs are:
 
-================================  ======  ====  ==========================================
-name                              unit    size  formula
-================================  ======  ====  ==========================================
-``main_mirror_axis``              1       3     n5 = Rᵀ(r5f − r5v)/‖r5f − r5v‖ (4.155)
-``counterreflector_axis``         1       3     n7 likewise through the CR points (4.164)
-``main_mirror_misalignment``      arcsec  1     2 arcsin(‖s − n5‖/2) (4.157)
-``main_mirror_error``             arcsec  3     s − n5 in OK, small-angle vector (4.156)
-``counterreflector_misalignment`` arcsec  1     2 arcsin(‖n7 − n5‖/2) (4.166)
-``counterreflector_error``        arcsec  3     n7 − n5 in OK, small-angle vector (4.165)
-``counterreflector_source_...``   arcsec  1     2 arcsin(‖s − n7‖/2) (φ7 КИР of 4.1.8)
-``focal_offset``                  mm      3     Rᵀ(r7f − r5f) − d (4.152)
-``pointing_correction``           arcsec  2     [Δα, Δβ] from the x, y rows (4.159)–(4.163)
-``counterreflector_rotation``     arcsec  3     [Δβ7, Δθ7, Δα7] (4.168)–(4.172)
-``counterreflector_translation``  mm      3     Δr7 = Z4 − Z1Δβ7 − Z2Δθ7 − Z3Δα7 (4.173)–(4.175)
-================================  ======  ====  ==========================================
+==================================  ======  ====  ==========================================
+name                                unit    size  formula
+==================================  ======  ====  ==========================================
+``main_mirror_axis``                1       3     n5 = Rᵀ(r5f − r5v)/‖r5f − r5v‖ (4.155)
+``counterreflector_axis``           1       3     n7 likewise through the CR points (4.164)
+``main_mirror_misalignment``        arcsec  1     2 arcsin(‖s − n5‖/2) (4.157)
+``main_mirror_error``               arcsec  3     s − n5 in OK, small-angle vector (4.156)
+``counterreflector_misalignment``   arcsec  1     2 arcsin(‖n7 − n5‖/2) (4.166)
+``counterreflector_error``          arcsec  3     n7 − n5 in OK, small-angle vector (4.165)
+``counterreflector_source_...``     arcsec  1     2 arcsin(‖s − n7‖/2) (φ7 КИР of 4.1.8)
+``focal_offset``                    mm      3     Rᵀ(r7f − r5f) − d (4.152)
+``pointing_correction``             arcsec  2     [Δα, Δβ] from the x, y rows (4.159)–(4.163)
+``counterreflector_rotation``       arcsec  3     [Δβ7, Δθ7, Δα7] (4.168)–(4.172)
+``counterreflector_translation``    mm      3     Δr7 = Z4 − Z1Δβ7 − Z2Δθ7 − Z3Δα7 (4.173)–(4.175)
+==================================  ======  ====  ==========================================
 
 ``s`` is the unit source direction (4.153), ``R`` the OK frame, ``d`` the design offset
 of the counterreflector's focus from the main mirror's in OK axes (zero for a confocal
