@@ -3,10 +3,10 @@
 The statements (``grep -n -i exit README.md docs/*.md``, rt70/cli/main.py's docstring and
 ``rt70 --help``), and where each is run:
 
-- README, "The cross-check": ``validate`` exits 0 when every row is within the
+- docs/validation.md, "``rt70 validate``": ``validate`` exits 0 when every row is within the
   tolerance, 1 when one is not (a NaN or infinity fails its row), 2 on bad input, on a
   model with no degree of freedom and on a run that would check nothing — here.
-- README, "Every command checks its options" and ``rt70 --help``: 0 success, 1 a check
+- docs/commands.md, "Exit codes", and ``rt70 --help``: 0 success, 1 a check
   disagreed / a robot failed unexpectedly / ``simulate``'s integration stopped early,
   2 bad input, 130 Ctrl-C, 141 a closed standard output, 143 SIGTERM; ``bench`` exits 0
   whether or not its targets are met — here, one case of each for every command but
