@@ -19,8 +19,8 @@ the reports, notebooks and tests that draw), never by the core — checked by im
 the core in a fresh interpreter.
 
 The reports and benchmarks (``rt70/reports/``) are built on the core and apart from it:
-no module outside ``rt70/reports/`` imports them, except the command line
-(``rt70/cli/main.py``), which runs them.
+no module outside ``rt70/reports/`` imports them, except the ``rt70 bench`` command
+(``rt70/cli/bench.py``), which runs them.
 """
 
 from __future__ import annotations
@@ -208,8 +208,8 @@ def test_plotting_is_where_matplotlib_is():
     assert proc.stdout.strip() == "True"
 
 
-#: Modules outside rt70/reports/ that may import the reports: the command line runs them.
-REPORT_USERS = ("rt70.cli.main",)
+#: Modules outside rt70/reports/ that may import the reports: ``rt70 bench`` runs them.
+REPORT_USERS = ("rt70.cli.bench",)
 
 
 def _is_report(module: str) -> bool:
@@ -236,7 +236,7 @@ def test_core_never_imports_the_reports(module):
 def test_report_rule_sees_the_reports():
     """The rule has something to check: the reports exist and the command line uses them."""
     assert "rt70.reports.book" in MODULES and "rt70.reports.stress.report" in MODULES
-    assert any(_is_report(m) for m in _imports(MODULES["rt70.cli.main"]))
+    assert any(_is_report(m) for m in _imports(MODULES["rt70.cli.bench"]))
     assert not _is_report("rt70.reporting") and _is_report("rt70.reports.bench")
 
 

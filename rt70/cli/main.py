@@ -3,8 +3,8 @@
 Exit codes: :data:`rt70.cli.session.EXIT_CODES` (the epilog of ``rt70 --help``); ``bench``
 prints each target as met or not and exits 0 either way (timings are the machine's, not
 a verdict). Input read with a caveat (:class:`~rt70.errors.Rt70Warning`) prints one
-``rt70: warning: ...`` line on stderr each. Robots of example-robot-data that rt70
-cannot load are listed as ``not loaded: <name>: <reason>`` lines, no error by themselves.
+``rt70: warning: ...`` line on stderr each. Each command is one module of this folder
+with ``add_parser(sub)`` and ``run(args)``.
 
 Every option is checked before any work starts (:mod:`rt70.cli.options`); SIGTERM becomes a
 normal exit, so outputs being written are cleaned up (:mod:`rt70.guards.atomic`;
@@ -22,11 +22,11 @@ budget: a run its method cannot integrate stops with one line (:mod:`rt70.simula
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import warnings
 
+from rt70.cli import bench as cli_bench
 from rt70.cli import cart as cli_cart
 from rt70.cli import impact as cli_impact
 from rt70.cli import modes as cli_modes
@@ -36,82 +36,9 @@ from rt70.cli import pointing as cli_pointing
 from rt70.cli import reactions as cli_reactions
 from rt70.cli import simulate as cli_simulate
 from rt70.cli import sweep as cli_sweep
+from rt70.cli import validate as cli_validate
 from rt70.cli.session import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 from rt70.errors import Rt70Error
-
-
-def _validate(args: argparse.Namespace) -> int:
-    from rt70.crosscheck.robots import UNEXPECTED, survey
-    from rt70.crosscheck.validate import cross_check, format_table
-    from rt70.model.scene import URDF_DIR, load_scene, require_coordinates, scene_names
-
-    targets = args.targets or scene_names()
-    if not targets:
-        raise Rt70Error(f"no target to check: no scene files in {URDF_DIR}")
-    balance = args.balance_inertia
-    scenes, not_loaded = [], {}
-    for t in targets:  # read everything first: bad input exits 2
-        if t == "robots" or t.startswith("robot:"):  # example-robot-data (rt70.crosscheck.robots)
-            names = None if t == "robots" else [t.removeprefix("robot:")]
-            loaded, failed = survey(names, balance_inertia=balance)
-            scenes += loaded
-            not_loaded.update(failed)
-        else:
-            scenes.append(load_scene(t, balance_inertia=balance))
-    bug = any(reason.startswith(UNEXPECTED) for reason in not_loaded.values())
-    if not scenes:  # every robot asked for failed to load: nothing was checked
-        reasons = "; ".join(f"{name}: {why}" for name, why in not_loaded.items())
-        if bug:
-            print(f"rt70: no target could be checked, a bug in rt70: {reasons}", file=sys.stderr)
-            return 1
-        raise Rt70Error(f"no target could be checked ({reasons})")
-    for scene in scenes:  # build both sides first: a model rt70 refuses exits 2
-        scene.reference  # noqa: B018  Pinocchio's guards first: cheaper than the mass check
-        scene.textbook  # noqa: B018
-        require_coordinates(scene)
-    records = [r for scene in scenes for r in cross_check(scene, args.samples, args.seed)]
-    if args.json:
-        print(json.dumps([r.as_dict() for r in records], indent=2))
-    else:
-        print(format_table(records, args.tolerance))
-        print(
-            f"\n{len(scenes)} target(s), {args.samples} random states each, seed {args.seed}; "
-            f"tolerance {args.tolerance:g} relative to the reference's max-norm."
-        )
-    for name, reason in not_loaded.items():  # reported, not an error by itself
-        print(f"not loaded: {name}: {reason}", file=sys.stderr if args.json else sys.stdout)
-    return 0 if all(r.passed(args.tolerance) for r in records) and not bug else 1
-
-
-def _bench(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    if args.what == "simulate":
-        from rt70.reports import simulation_targets, work_precision, work_precision_results
-
-        say = lambda msg: print(f"  {msg}", file=sys.stderr, flush=True)  # noqa: E731
-        rows = work_precision.run(quick=args.quick, progress=say)
-        print(work_precision_results.format_table(rows))
-        for check in simulation_targets.check(rows, quick=args.quick, progress=say):
-            print(check.line())
-        for path in work_precision_results.write_results(rows, Path(args.out)):
-            print(f"wrote {path}")
-        return 0
-
-    from rt70.reports import bench
-
-    sizes = (10, 20, 50) if args.quick else (10, 20, 50, 100, 200, 400)
-    rounds = 3 if args.quick else 7
-    rows = bench.run(
-        sizes=sizes,
-        K=args.K,
-        rounds=rounds,
-        progress=lambda msg: print(f"  {msg}", file=sys.stderr, flush=True),
-    )
-    print(bench.format_report(rows))
-    for path in bench.write_results(rows, Path(args.out)):
-        print(f"wrote {path}")
-    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -123,8 +50,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action=options.PrintVersion)
     sub = parser.add_subparsers(dest="command", required=True)
-    _add_validate_parser(sub)
-    _add_bench_parser(sub)
+    cli_validate.add_parser(sub)
+    cli_bench.add_parser(sub)
     cli_modes.add_parser(sub)
     cli_plant.add_parser(sub)
     cli_pointing.add_parser(sub, options.add_pointing_arguments)
@@ -134,66 +61,6 @@ def build_parser() -> argparse.ArgumentParser:
     cli_cart.add_parser(sub)
     cli_impact.add_parser(sub)
     return parser
-
-
-def _add_validate_parser(sub: argparse._SubParsersAction) -> None:
-    """``rt70 validate``: the cross-check (run by :func:`_validate`)."""
-    val = sub.add_parser(
-        "validate",
-        help="cross-check the textbook algorithm against Pinocchio",
-        description="Compare mass matrix, bias, gravity, spring/damper forces, forward "
-        "dynamics and energies of the textbook algorithm and Pinocchio on random states.",
-    )
-    val.add_argument(
-        "targets",
-        nargs="*",
-        metavar="TARGET",
-        help="scene name, URDF path, 'robots' (every robot of example-robot-data that "
-        "loads) or 'robot:NAME' (default: every scene in urdf/)",
-    )
-    val.add_argument(
-        "--samples", type=options.positive_int, default=10, help="random states per target"
-    )
-    val.add_argument("--seed", type=options.seed, default=0, help="random seed (≥ 0)")
-    val.add_argument(
-        "--tolerance", type=options.non_negative_float, default=1e-10, help="relative tolerance"
-    )
-    val.add_argument("--json", action="store_true", help="print the records as JSON")
-    val.add_argument(
-        "--balance-inertia",
-        action="store_true",
-        help="repair rotational inertias of moving links that are not positive definite or "
-        "break the triangle inequality (principal moments set to their mean, as MuJoCo's "
-        "balanceinertia) instead of refusing them; each repair is reported",
-    )
-    val.set_defaults(func=_validate)
-
-
-def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
-    """``rt70 bench``: the benchmarks and the work-precision report (run by :func:`_bench`)."""
-    ben = sub.add_parser(
-        "bench",
-        help="benchmark the textbook mass matrix against pin.crba (ratios, one run)",
-        description="Per-call and batched textbook A(q) against pin.crba on rt70, ur5, panda "
-        "and talos_full, and the growth of its cost on serial chains and balanced trees; "
-        "writes CSV and a log-log plot.",
-    )
-    ben.add_argument(
-        "what",
-        nargs="?",
-        default="mass-matrix",
-        choices=("mass-matrix", "simulate"),
-        help="mass-matrix (default) or simulate (the work-precision report)",
-    )
-    ben.add_argument("--K", type=options.batch_size, default=1000, help="batch size")
-    ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")
-    ben.add_argument(
-        "--out",
-        default="rt70-results",
-        help="directory for CSV and PNG output (default: rt70-results in the current "
-        "directory; validation/*.py write the committed validation/results)",
-    )
-    ben.set_defaults(func=_bench)
 
 
 def main(argv: list[str] | None = None) -> int:

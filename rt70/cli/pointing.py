@@ -1,8 +1,8 @@
 """``rt70 pointing``: the wind pointing budget of a scene with drives and wind elements.
 
-Its own module, as ``rt70 sweep``'s (rt70/cli/sweep.py), so that rt70/cli/main.py stays one
-screenful of commands. The budget: :mod:`rt70.telescope.pointing`; the gust record check:
-:mod:`rt70.telescope.gust_run` (docs: 'The wind pointing budget', docs/pointing.md).
+One module per command, as every command of ``rt70`` (rt70/cli/main.py dispatches). The
+budget: :mod:`rt70.telescope.pointing`; the gust record check: :mod:`rt70.telescope.gust_run`
+(docs: 'The wind pointing budget', docs/pointing.md).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``rt70 reactions``: the RT-70's bearing and reducer loads (joint reactions, issue 12).
+"""``rt70 reactions``: the RT-70's bearing and reducer loads (joint reactions).
 
 Its own module, as ``rt70 pointing``'s (rt70/cli/pointing.py). The loads:
 :mod:`rt70.telescope.bearing_loads`; the reactions: :mod:`rt70.textbook.reactions` and

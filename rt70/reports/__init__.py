@@ -6,7 +6,7 @@ The book reproduction (:mod:`~rt70.reports.book`), the stress cases
 :mod:`~rt70.reports.work_precision_results`) and the mass-matrix benchmark
 (:mod:`~rt70.reports.bench`, with :mod:`~rt70.reports.threads` and
 :mod:`~rt70.reports.targets`). They use the core (URDF reading, both sides, scenes,
-analyses, simulation) like any user would; of the package only ``rt70.cli.main`` imports
-them, inside its command functions (tests/test_import_rules.py checks that no core module
+analyses, simulation) like any user would; of the package only ``rt70.cli.bench`` imports
+them, inside its command function (tests/test_import_rules.py checks that no core module
 does).
 """
