@@ -50,7 +50,7 @@ from rt70.scenes.rt70_state import (
 )
 from rt70.simulation.simulate import sample_channels, simulate
 from rt70.simulation.states import StateComponent
-from rt70.telescope.scenario import (  # noqa: F401  (re-exported: the scenarios' API)
+from rt70.telescope.scenario import (
     DEFAULT_ELEVATION,
     DEFAULT_T_END,
     MIRROR_AXIS,
@@ -66,14 +66,14 @@ from rt70.telescope.scenario import (  # noqa: F401  (re-exported: the scenarios
     scenario,
     sky_error,
 )
-from rt70.telescope.servo_metrics import (  # noqa: F401  (re-exported: the scenario's numbers)
+from rt70.telescope.servo_metrics import (
     BAND_ARCSEC,
     measure,
     predicted_settling,
     settling_time,
     summary_lines,
 )
-from rt70.telescope.servo_tuning import (  # noqa: F401  (re-exported: the scenarios' API)
+from rt70.telescope.servo_tuning import (
     AXIS_TUNING,
     EQUILIBRIUM_TOL,
     DriveFactory,
@@ -86,6 +86,43 @@ from rt70.telescope.servo_tuning import (  # noqa: F401  (re-exported: the scena
     tuning_text,
 )
 from rt70.units import RAD_PER_ARCSEC
+
+#: The scenarios' API: the run (:func:`run_scenario`) with the scenario's definitions
+#: (:mod:`rt70.telescope.scenario`), its measurements (:mod:`rt70.telescope.servo_metrics`)
+#: and the drives' tuning (:mod:`rt70.telescope.servo_tuning`), importable from one place.
+__all__ = [
+    "AXIS_TUNING",
+    "BAND_ARCSEC",
+    "DEFAULT_ELEVATION",
+    "DEFAULT_T_END",
+    "DriveFactory",
+    "EQUILIBRIUM_TOL",
+    "METHOD",
+    "MIRROR_AXIS",
+    "Reference",
+    "SCENARIOS",
+    "SIDEREAL_ARCSEC_PER_S",
+    "STEP_DEG",
+    "Scenario",
+    "ScenarioRun",
+    "axis_gains",
+    "choose",
+    "drive_parameters",
+    "elevation_azimuth",
+    "holding_excess",
+    "measure",
+    "mirror_axis_output",
+    "predicted_settling",
+    "preset_servo_state",
+    "run_scenario",
+    "scenario",
+    "servo_drives",
+    "servo_tolerances",
+    "settling_time",
+    "sky_error",
+    "summary_lines",
+    "tuning_text",
+]
 
 #: Integration method of the scenarios. scipy's BDF and Radau stop at random on a hold
 #: ("Required step size is less than spacing between numbers": measured at 30° and 90°,
