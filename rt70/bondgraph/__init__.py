@@ -1,4 +1,4 @@
-"""Bond graphs: a second, independent way to the equations of drives (issue 10, item 2).
+"""Bond graphs: a second, independent way to the equations of drives.
 
 A small, generic linear bond-graph layer after the companion source 003 (Kuzmin 2008):
 elements and bonds (:mod:`.graph`), causality by SCAP (:mod:`.causality`), the state

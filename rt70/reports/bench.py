@@ -278,7 +278,7 @@ def fit_exponent(rows: list[Row], benchmark: str, min_nv: int = 0) -> float:
     return float(np.polyfit(nv, t, 1)[0])
 
 
-#: Targets of issues 3 and 13: per-call ratio ≤ 10 on these scenes, batched ratio ≤ 1 at
+#: The kernel's targets: per-call ratio ≤ 10 on these scenes, batched ratio ≤ 1 at
 #: K = 1000 on the RT-70, growth exponent of the chain ≤ 2.2.
 PER_CALL_TARGET = 10.0
 PER_CALL_SCENES = ("rt70", "talos_full")

@@ -116,7 +116,7 @@ def _invariant_text(
     spectrum: Callable[[np.ndarray, np.ndarray], np.ndarray],
     dev: Callable[[np.ndarray], float],
 ) -> tuple[str, dict]:
-    """The sub-section proving what the search above could only sample (issue 8)."""
+    """The sub-section proving what the search above could only sample."""
     n, rows = _invariant_numbers(printed)
     fit_table, best = _single_value_table(n["printed"], spectrum, dev)
     numbers = {
@@ -217,7 +217,7 @@ def _proof_text(n: dict, rows: list[list[str]], fit_table: str, best: float) -> 
     eig_agrees = "to within 1e-12" if eig_check <= 1e-12 else f"only to {eig_check:.1e}"
     n_trees = 7 ** (7 - 2)  # Cayley: labelled trees on 7 bodies
     n_models = n_trees * math.factorial(6)  # a tree and an order of the six stiffnesses
-    return f"""### A proof instead of a search: the product of the ω² (issue 8)
+    return f"""### A proof instead of a search: the product of the ω²
 
 **Theorem** ([`docs/tree-invariant.md`](../../docs/tree-invariant.md),
 `rt70.linear.tree_invariant`, tested against `eigh` on random trees). For n bodies of

@@ -1,6 +1,6 @@
 """The RT-70's wind pointing budget over wind speeds and elevations, and its figures.
 
-One job: run :func:`rt70.telescope.pointing.pointing_budget` over the issue's table (wind 5, 10,
+One job: run :func:`rt70.telescope.pointing.pointing_budget` over the budget table (wind 5, 10,
 15, 20 m/s × elevation 15°, 45°, 90°, front wind) and over a finer grid for the figure
 of error against speed, and turn the results into a table (Markdown) and the figures of
 :mod:`rt70.plotting.wind`. Used by validation/pointing_budget.py and the notebook.
@@ -19,7 +19,7 @@ from rt70.telescope.pointing import (
     pointing_budget,
 )
 
-#: The issue's table.
+#: The budget table's wind speeds (m/s) and elevations (°).
 TABLE_SPEEDS = (5.0, 10.0, 15.0, 20.0)
 TABLE_ELEVATIONS = (15.0, 45.0, 90.0)
 #: A useful pointing error at 300 GHz: a tenth of the 70-m dish's beam, arc seconds

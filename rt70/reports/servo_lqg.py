@@ -4,7 +4,7 @@ One job: put the LQG of :mod:`rt70.control.lqg` (designed for an RT-70 axis at a
 pointing by :mod:`rt70.reports.servo_loops`: plant reduced to 16–20 states, the other
 axis locked) into the servo scenarios of :mod:`rt70.telescope.scenarios` as a
 :class:`rt70.control.lqg_drive.LqgDrive`, and compare it with its linear closed loop and with
-the PI cascade (issue 10 item 4, "closed around the nonlinear model in simulation").
+the PI cascade, both closed around the nonlinear model in simulation.
 
 - :func:`lqg_drives`: a :data:`rt70.telescope.scenarios.DriveFactory` with the LQG on the azimuth
   (where the PI cascade is held to 0.2 Hz) and the default factory's PI cascade on the

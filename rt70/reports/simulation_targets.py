@@ -1,4 +1,4 @@
-"""The simulation-speed targets of issue 13, measured and judged (``rt70 bench simulate``).
+"""The simulation-speed targets, measured and judged (``rt70 bench simulate``).
 
 Targets (:class:`~rt70.reports.targets.TargetCheck` each)
 ---------------------------------------------------------
@@ -343,7 +343,7 @@ def servo_target(runs: list[dict] | None) -> TargetCheck:
 
 
 def check(rows, quick: bool = False, progress: Say | None = None) -> list[TargetCheck]:
-    """Every issue-13 target of :mod:`this module <rt70.reports.simulation_targets>`.
+    """Every simulation-speed target of :mod:`this module <rt70.reports.simulation_targets>`.
 
     A quick run (``rows`` of the quick problems) judges only the right-hand side and
     Jacobian ratios (with fewer rounds); the rest is reported as not judged.

@@ -1,4 +1,4 @@
-"""A benchmark target of the issues against the value measured in one run."""
+"""A benchmark target against the value measured in one run."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ class TargetCheck:
     Attributes
     ----------
     target : str
-        The target as the issue states it, e.g. ``"per-call ratio ≤ 10 on rt70"``.
+        The target as stated, e.g. ``"per-call ratio ≤ 10 on rt70"``.
     measured : str
         The measured value, with what it was measured on.
     met : bool or None

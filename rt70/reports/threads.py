@@ -3,7 +3,7 @@
 On a small shared machine a threaded BLAS makes small matrix products slower, not
 faster, and its timings swing with the load of the other cores: with OpenBLAS's default
 threading the textbook mass matrix of a 400-body chain took 39.9 ms instead of 1.70 ms
-and the fitted growth exponent came out 3.5 instead of 1.2 (issue 8). The benchmarks time
+and the fitted growth exponent came out 3.5 instead of 1.2. The benchmarks time
 inside :func:`single_threaded`, which pins every thread pool that ``threadpoolctl`` sees
 (OpenBLAS, MKL, BLIS, OpenMP) to one thread and records what the pools would use
 otherwise, so that the output says under which conditions it was measured.

@@ -4,7 +4,7 @@ For each test problem and each ``solve_ivp`` method the run is repeated over a l
 of relative tolerances; every run gives one point (run time, error) of the method's
 work–precision curve.
 
-The problems (the RT-70's 10 s transient of issue 13, the RT-70 over 2 s with the
+The problems (the RT-70's 10 s transient of the speed targets, the RT-70 over 2 s with the
 listing's and with light damping, a double pendulum, a 50-body chain) are built in
 :mod:`rt70.reports.work_precision_problems`; the runs
 happen in a worker process (:mod:`rt70.reports.work_precision_worker`).
@@ -21,7 +21,7 @@ alternate one. The two references are compared with each other by the same formu
 that is the floor of the measurement (``reference_floor``), below which errors mean
 nothing.
 
-Beside it, the engineering metric of issue 13: the largest error over time and bodies
+Beside it, the engineering metric of the speed targets: the largest error over time and bodies
 of the bodies' centres of mass, ``com_error = max_t max_b |c_b(t) − c_b,ref(t)|`` in
 metres (world frame, every Pinocchio joint body with mass, computed on the reference
 side by :func:`rt70.reports.work_precision_worker.com_positions`), against the same
@@ -64,8 +64,8 @@ otherwise).
 Results
 -------
 This module runs the report and gives its rows (:func:`run`, :class:`Row`);
-:mod:`rt70.reports.work_precision_results` reads them: the summary, the targets of
-issues 5 and 13 this report measures, the table, and the CSV and plot.
+:mod:`rt70.reports.work_precision_results` reads them: the summary, the integration
+target this report measures, the table, and the CSV and plot.
 """
 
 from __future__ import annotations

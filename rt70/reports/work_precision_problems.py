@@ -6,12 +6,12 @@ Problems
     ``urdf/rt70.urdf`` from the §4.2.3 listing's initial state over ``T = 2 s`` with the
     listing's damping (mostly 0.1 × stiffness; ξ = 0.105 on the first elastic mode).
 ``rt70_10s``
-    The RT-70 problem of issue 13, what ``rt70 simulate rt70 --t-end 10`` runs: the
+    The RT-70 problem of the speed targets, what ``rt70 simulate rt70 --t-end 10`` runs: the
     same scene and state over ``T = 10 s`` with the axes free (the structural
-    benchmark). The target problem of the issue-13 targets
+    benchmark). The target problem of the simulation-speed targets
     (:mod:`rt70.reports.simulation_targets`); only the stiff methods run on it (the
     explicit ones are over the cap on the 2 s span already) and only the tolerances
-    of the issue's ladder, 1e-4 … 1e-8.
+    of the targets' ladder, 1e-4 … 1e-8.
 ``rt70_light``
     The same scene with every damping replaced by ``δ · stiffness``, δ = 0.1/Ω1 (the
     book's rule (2.16), ξ = 0.05 on the first elastic mode; :func:`light_damping_text`),
@@ -97,7 +97,7 @@ class Problem:
 
 _STIFF_REFS = ("Radau", "BDF")
 _SMOOTH_REFS = ("DOP853", "LSODA")
-#: The tolerances of the issue-13 ladder (its measurements: rtol 1e-4 … 1e-8).
+#: The tolerances of the simulation-speed targets' ladder (rtol 1e-4 … 1e-8).
 ISSUE13_RTOLS = tuple(10.0**-k for k in range(4, 9))
 #: The full report's problems.
 PROBLEMS = (

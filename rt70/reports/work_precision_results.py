@@ -7,9 +7,9 @@ the log–log plot of centre-of-mass error against run time.
 
 Targets
 -------
-The issue-13 targets (10 s transient at 1e-5 m, the whole command, the right-hand side
+The simulation-speed targets (10 s transient at 1e-5 m, the whole command, the right-hand side
 and Jacobian against Pinocchio's) are judged in :mod:`rt70.reports.simulation_targets`.
-:func:`check_targets` judges the targets of issues 5 and 13 that this report measures:
+:func:`check_targets` judges the integration target that this report measures:
 the RT-70 (listing damping) integrated to state error ≤ 1e-6 at ≥ 50× real time, i.e.
 in ≤ T/50 of wall time (0.2 s for the 10 s transient). The report's span is T = 2 s,
 its error the state error above; the quick run's 0.05 s span measures start-up more than
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
 
 #: The accuracy at which the summary compares methods (error ≤ this).
 TARGET_ERROR = 1e-6
-#: The target problem and its targets (issues 5 and 13): error ≤ this, real-time factor ≥ that.
+#: The target problem and its targets: error ≤ this, real-time factor ≥ that.
 TARGET_PROBLEM = "rt70"
 REAL_TIME_TARGET = 50.0
 
@@ -111,7 +111,7 @@ def summary(rows: list[Row], target: float = TARGET_ERROR) -> list[str]:
 
 
 def check_targets(rows: list[Row], target: float = TARGET_ERROR) -> list[TargetCheck]:
-    """The targets of issues 5 and 13 that this report measures, against ``rows``.
+    """The integration target that this report measures, against ``rows``.
 
     The RT-70 (:data:`TARGET_PROBLEM`) must reach state error ≤ ``target`` at
     ≥ :data:`REAL_TIME_TARGET` × real time: the fastest ``ok`` run of any method with
@@ -125,7 +125,7 @@ def check_targets(rows: list[Row], target: float = TARGET_ERROR) -> list[TargetC
     goal = (
         f"{TARGET_PROBLEM} (listing damping, T = {t_end:g} s) to state error ≤ {target:g} in "
         f"≤ {t_end / REAL_TIME_TARGET:.3g} s of integration, i.e. ≥ {REAL_TIME_TARGET:g}× "
-        "real time (issues 5, 13)"
+        "real time"
     )
     methods = dict.fromkeys(r.method for r in mine)
     best = [b for m in methods if (b := time_to_reach(rows, TARGET_PROBLEM, m, target))]
@@ -177,7 +177,7 @@ def format_table(rows: list[Row]) -> str:
         "COM m: largest centre-of-mass position error over time and bodies against the same "
         "reference; steps — where the integrator does not report them (scipy with t_eval); "
         "rhs/jac/integ s: the time split where the method measures it; not measured by this "
-        "report: the energy balance (issue 5; see `rt70 simulate`)"
+        "report: the energy balance (see `rt70 simulate`)"
     )
     return "\n".join(lines)
 
@@ -269,7 +269,7 @@ def _plot_problem(ax: Axes, mine: list[Row], style: dict[str, tuple[str, str]]) 
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.axvline(cap, color="0.5", ls="--", lw=1, label=f"time cap {cap:g} s")
-    if problem == targets.TRANSIENT_PROBLEM:  # the issue-13 target region
+    if problem == targets.TRANSIENT_PROBLEM:  # the simulation-speed target region
         ax.axhline(targets.COM_TARGET_M, color="C3", ls="-.", lw=1)
         ax.axvline(
             mine[0].t_end / targets.REAL_TIME_TARGET,

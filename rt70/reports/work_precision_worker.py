@@ -6,7 +6,7 @@ scenes and runs with BLAS and OpenMP pinned to one thread
 the cap plus a small allowance for the post-processing, then kills the worker (and
 starts a new one for the next run). Besides the state it sends back the positions of
 the bodies' centres of mass on the output grid (:func:`com_positions`), the engineering
-metric of issue 13.
+metric of the simulation-speed targets.
 """
 
 from __future__ import annotations

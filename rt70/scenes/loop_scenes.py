@@ -1,4 +1,4 @@
-"""The closed-chain test mechanisms of issue 12 (docs/loops.md): four-bar, crank–slider.
+"""The closed-chain test mechanisms (docs/loops.md): four-bar, crank–slider.
 
 Both are planar in the x-y plane, every revolute joint about z, links as uniform rods
 (``I_c = m L²/12`` about y and z, a small axial moment about x). The four-bar hangs in a

@@ -1,9 +1,9 @@
 """The RT-70 scenes on the 42-DOF listing of §4.2.3: as listed, as a control object, with a jack.
 
 :func:`rt70_scene` is the listing (errata in ``docs/rt70-errata.md``);
-:func:`rt70_servo_scene` the control object of issue 10, with the counterweight below the
+:func:`rt70_servo_scene` the control object the drives hold, with the counterweight below the
 elevation axis, its two drives (:func:`lumped_drive`) and its exposed bodies;
-:func:`rt70_jack_scene` the listing with an elevation jack closing one loop (issue 12).
+:func:`rt70_jack_scene` the listing with an elevation jack closing one loop.
 Each returns the URDF text; :mod:`rt70.scenes.generate` writes them with every other
 scene.
 """
@@ -44,7 +44,7 @@ def rt70_servo_scene() -> str:
     side, so nothing balances the swinging part: its gravity moment with the axis
     horizontal is 2.66 times the book's nominal drive torque (errata item 12). This
     scene is the listing with the counterweight's offset mirrored to ``[0, 0, −16]`` m
-    (:data:`rt70_data.SERVO_BODIES`), the control object of issue 10, with its two
+    (:data:`rt70_data.SERVO_BODIES`), the control object the drives hold, with its two
     drives (``<rt70:drive>``, :func:`_servo_drives`) and its four exposed bodies
     (``<rt70:wind>``, :func:`_servo_winds`).
     """
@@ -203,8 +203,8 @@ def _rt70_text(
     return uw.end(w)
 
 
-#: The elevation jack of the ``rt70_jack`` scene (issue 12: the RT-70 with one closed
-#: loop). The book's RT-70 drives the elevation through a gear sector; this jack is an
+#: The elevation jack of the ``rt70_jack`` scene (the RT-70 with one closed loop).
+#: The book's RT-70 drives the elevation through a gear sector; this jack is an
 #: illustrative linkage of our own, not the telescope's: a hydraulic-cylinder-like pair
 #: pinned on the alidade (``platform``) 16 m from the counterweight's origin along −y,
 #: level with it, turning about x, a piston sliding along it, the piston's end pinned to
@@ -222,7 +222,7 @@ def _rt70_jack(w: uw.Writer) -> None:
     from rt70.scenes.loop_scenes import loop
 
     jack = RT70_JACK
-    w.comment("Elevation jack (issue 12 test linkage, not the book's drive): cylinder, piston")
+    w.comment("Elevation jack (closed-chain test linkage, not the book's drive): cylinder, piston")
     pivot = jack["pivot"]
     uw.joint(w, "jack_pivot", "revolute", "platform", "jack_cylinder", pivot, axis=(1, 0, 0))
     length, mass, radius = jack["cylinder"]
@@ -246,7 +246,7 @@ def _rt70_jack(w: uw.Writer) -> None:
 
 
 def rt70_jack_scene() -> str:
-    """The 42-DOF RT-70 with an elevation jack closing one loop (issue 12's cost target).
+    """The 42-DOF RT-70 with an elevation jack closing one loop (the closed chains' cost target).
 
     Returns
     -------
@@ -257,7 +257,7 @@ def rt70_jack_scene() -> str:
     return _rt70_text(
         "rt70_jack",
         "RT-70 42-DOF model with an elevation jack closing one loop (an illustrative "
-        "linkage for issue 12, not the book's gear-sector drive)",
+        "linkage for the closed-chain tests, not the book's gear-sector drive)",
         rt70_data.LISTING_BODIES,
         drives=_rt70_jack,
     )

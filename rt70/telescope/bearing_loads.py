@@ -1,6 +1,6 @@
 """The RT-70's bearing and reducer loads: joint reactions at the drive-held equilibrium.
 
-What a structural or drive engineer asks of the model (issue 12, part 1): at a pointing,
+What a structural or drive engineer asks of the model: at a pointing,
 at rest under gravity and optionally a steady wind, what do the azimuth bearing, the
 elevation bearing and the two reducers carry? The answer is the joint reaction
 wrenches of source 004 (9)–(13) (:mod:`rt70.textbook.reactions`, cross-checked by

@@ -4,8 +4,7 @@ One job: run the telescope with its drives closed around the nonlinear model
 (:func:`rt70.simulation.simulate.simulate` with :class:`rt70.control.servo.ServoDrive` components
 on the pointing axes ``platform_rz`` = azimuth and ``base_rx`` = π/2 − elevation) and measure
 what a servo engineer asks of it: settling time to 1″, overshoot, peak motor torque
-against its limit, pointing error in arc seconds and the tracking error after settling
-(issue 10, item 6 and the simulation half of item 4).
+against its limit, pointing error in arc seconds and the tracking error after settling.
 
 The run starts at rest in the static equilibrium of the pointing with the drives holding
 (:func:`rt70.linear.linearize.equilibrium`): the motors' states hold the gravity torque

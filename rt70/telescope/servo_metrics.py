@@ -1,7 +1,7 @@
 """What a servo engineer measures on a scenario run: settling, overshoot, torque, errors.
 
 One job: turn a :class:`rt70.telescope.scenario.ScenarioRun` (trajectory, axis errors, pointing
-error, drive torques) into the numbers of issue 10's targets — settling time into the
+error, drive torques) into the numbers of the servo targets — settling time into the
 1″ band, the settling time derived from the position loop's gains
 (:func:`predicted_settling`), overshoot, peak torque against its limit, the pointing
 drift and the tracking error after settling — and into lines of text.
@@ -16,7 +16,7 @@ from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE
 from rt70.telescope.scenario import ScenarioRun
 from rt70.units import ARCSEC_PER_DEG, RAD_PER_ARCSEC
 
-#: The settling band of the issue's targets, arc seconds.
+#: The settling band of the servo targets, arc seconds.
 BAND_ARCSEC = 1.0
 
 
