@@ -231,6 +231,29 @@ def test_run_capped_time_cap(rt70):
     assert 0.0 < run.t_reached < 1.0
 
 
+def test_run_capped_starts_its_clock_after_the_kernels_are_warm(rt70, monkeypatch):
+    """The cap measures the integration, not the compilation of the kernels: a short run
+    that calls every kernel comes before the first reading of the cap's clock."""
+    from rt70.reports.stress import runs
+
+    events = []
+    real = runs.simulate
+
+    def recording(scene, t_span, *args, **kwargs):
+        events.append(("simulate", t_span[1] - t_span[0]))
+        return real(scene, t_span, *args, **kwargs)
+
+    def clock():
+        events.append(("clock", None))
+        return 0.0
+
+    monkeypatch.setattr(runs, "simulate", recording)
+    run = run_capped(rt70, (0.0, 0.01), listing_initial_state(rt70), clock=clock)
+    assert run.ok
+    warm, first_clock = events.index(("simulate", 1e-9)), events.index(("clock", None))
+    assert warm < first_clock and events[first_clock + 1] == ("simulate", 0.01)
+
+
 def _lines_executed_in(package, call):
     """Python lines executed in ``package``'s files while ``call()`` runs, and its value:
     a count of operations, the same on any machine (``sys.settrace``)."""
