@@ -131,6 +131,43 @@ def test_readme_lists_every_command_with_its_page():
         assert (ROOT / row.group(1)).is_file(), row.group(1)
 
 
+#: A page named in a help text or message: "(docs: 'Title', docs/page.md".
+PAGE_REFERENCE = re.compile(r"docs: '([^']+)',\s*(docs/[\w.-]+\.md)")
+
+
+def _help_texts() -> str:
+    """Every description, help and epilog of the ``rt70`` parser and its subcommands."""
+    from rt70.cli.main import build_parser
+
+    parser = build_parser()
+    parsers = [parser, *next(a for a in parser._actions if a.dest == "command").choices.values()]
+    texts = [t for p in parsers for t in (p.description, p.epilog) if t]
+    texts += [a.help for p in parsers for a in p._actions if a.help]
+    return "\n".join(texts)
+
+
+def _page_references() -> list[tuple[str, str]]:
+    sources = [p.read_text(encoding="utf-8") for p in sorted((ROOT / "rt70").rglob("*.py"))]
+    found = PAGE_REFERENCE.findall("\n".join([_help_texts(), *sources]))
+    # a title wrapped in a docstring is one title; one split across "..." "..." in the
+    # source is seen whole in the parser's help texts
+    return sorted({(" ".join(title.split()), page) for title, page in found if '"' not in title})
+
+
+def test_help_texts_and_messages_name_pages_by_their_titles():
+    """A user who installed with pip finds a page by its title on the site: each title
+    named beside a docs path is that page's first heading."""
+    references = _page_references()
+    assert len(references) >= 8, references  # the search sees the help texts
+    for title, page in references:
+        path = ROOT / page
+        assert path.is_file(), f"{page} (named with '{title}') does not exist"
+        heading = path.read_text(encoding="utf-8").splitlines()[0].removeprefix("# ")
+        assert heading == title or heading.startswith((f"{title}: ", f"{title} (")), (
+            f"{page} is headed '{heading}', named as '{title}'"
+        )
+
+
 def _links(path: Path) -> list[str]:
     text = path.read_text(encoding="utf-8")
     text = re.sub(r"```.*?```", "", text, flags=re.S)

@@ -1,7 +1,7 @@
 """``rt70 validate``: the textbook side cross-checked against the reference on random states.
 
 The rows: :mod:`rt70.crosscheck.validate`; the robots of example-robot-data:
-:mod:`rt70.crosscheck.robots` (docs: 'Validation and its tolerances', docs/validation.md).
+:mod:`rt70.crosscheck.robots` (docs: 'Validation', docs/validation.md).
 Robots rt70 cannot load are listed as ``not loaded: <name>: <reason>`` lines, no error by
 themselves.
 """
