@@ -27,6 +27,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from rt70.guards.atomic import atomic_write_text
+from rt70.reports.provenance import command_line, headed, run_header
+
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "validation" / "results" / "before_after.md"
 
@@ -158,7 +161,7 @@ def main(argv: list[str]) -> int:
         min(commands["after"]), "s")  # fmt: skip
     text = "\n".join(lines) + "\n"
     print(text)
-    OUT.write_text(text, encoding="utf-8")
+    atomic_write_text(OUT, headed(text, run_header(command_line())))
     print(f"wrote {OUT}")
     return 0
 

@@ -31,6 +31,7 @@ from rt70.model.scene import load_scene
 from rt70.physics.baumgarte import DEFAULT_STABILIZATION
 from rt70.reference import loops as ref_loops
 from rt70.reports.bench import compare
+from rt70.reports.provenance import command_line, headed, run_header
 from rt70.reports.threads import single_threaded
 from rt70.simulation.closed_chains import assemble
 from rt70.textbook import dynamics, forces
@@ -122,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     writer.writeheader()
     writer.writerows(rows)
     RESULTS.mkdir(exist_ok=True)
-    atomic_write_text(RESULTS / "bench_loops.md", report)
+    atomic_write_text(RESULTS / "bench_loops.md", headed(report, run_header(command_line())))
     atomic_write_text(RESULTS / "bench_loops.csv", buffer.getvalue())
     sys.stdout.write(report)
     return 0

@@ -28,6 +28,7 @@ from rt70.mechanics import chaplygin_cart as cart
 from rt70.mechanics import nonholonomic_scene as ns
 from rt70.model.scene import load_scene
 from rt70.physics import nonholonomic as nh
+from rt70.reports.provenance import command_line, headed, run_header
 
 OUT = Path(__file__).resolve().parent / "results"
 GAINS = cart.Gains()
@@ -554,7 +555,7 @@ def main() -> int:
     field_table(lines)
     sol, sol_off, t_off, r, alpha0, alpha4 = controlled_cart(cart_scene, lines)
     sleigh_check(sleigh, lines)
-    text = "\n".join(lines)
+    text = headed("\n".join(lines), run_header(command_line()))
     print(text)
     fig = figure(sol, sol_off, t_off, r, alpha0, alpha4)
     OUT.mkdir(parents=True, exist_ok=True)

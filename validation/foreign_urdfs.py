@@ -45,6 +45,7 @@ from rt70 import errors
 from rt70.crosscheck.validate import DEFAULT_TOLERANCE, cross_check
 from rt70.guards.atomic import atomic_write_text
 from rt70.model.scene import load_scene
+from rt70.reports.provenance import command_line, headed, run_header
 
 OUT = Path(__file__).resolve().parent / "results"
 
@@ -372,7 +373,8 @@ def write_report(
         ["file", "nv", "as is", "with balance", "warnings", "Pinocchio alone", "detail (as is)"],
         rows,
     )
-    md = atomic_write_text(out_dir / "foreign_urdfs.md", "\n".join(lines) + "\n")
+    page = headed("\n".join(lines), run_header(command_line()))
+    md = atomic_write_text(out_dir / "foreign_urdfs.md", page + "\n")
 
     buf = io.StringIO()
     names = [f.name for f in fields(Outcome)]

@@ -37,6 +37,7 @@ from rt70.mechanics.engagement import engage_after
 from rt70.mechanics.locks import Brake, StowPin, constraint_rows, engage, labels
 from rt70.model.scene import load_scene
 from rt70.physics.impact import solve_impact
+from rt70.reports.provenance import command_line, headed, run_header
 from rt70.scenes.rt70_drives import TOP_SPEED
 from rt70.scenes.rt70_state import (
     AZIMUTH_COORDINATE,
@@ -266,7 +267,7 @@ def main() -> None:
         OUT / "impacts.json", json.dumps({"cross_check": checks, "rt70": cases}, indent=2) + "\n"
     )
     text = markdown(checks, cases)
-    atomic_write_text(OUT / "impacts.md", text)
+    atomic_write_text(OUT / "impacts.md", headed(text, run_header(command_line())))
     print(text)
 
 

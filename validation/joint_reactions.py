@@ -26,6 +26,7 @@ from rt70.physics.aerodynamics import WindCondition
 from rt70.plotting.reactions import bearing_loads_figure
 from rt70.reference import reactions as ref_reactions
 from rt70.reference import wind as ref_wind
+from rt70.reports.provenance import command_line, headed, run_header
 from rt70.telescope import bearing_loads as bl
 from rt70.textbook import reactions as tb_reactions
 from rt70.textbook import wind as tb_wind
@@ -154,7 +155,8 @@ def main() -> None:
         "```",
         "",
     ]
-    atomic_write_text(OUT / "joint_reactions.md", "\n".join(lines))
+    page = headed("\n".join(lines), run_header(command_line()))
+    atomic_write_text(OUT / "joint_reactions.md", page)
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ from rt70.guards.atomic import atomic_write, atomic_write_text
 from rt70.model.scene import load_scene
 from rt70.plotting.wind import error_vs_speed_figure, maps_figure, mode_shares_figure
 from rt70.reports.pointing_budget import TARGET_ARCSEC, budget_table, format_table
+from rt70.reports.provenance import command_line, headed, run_header
 from rt70.sweep.cluster import local_cluster, on_dask
 from rt70.sweep.run import make_grid, plan, run
 from rt70.telescope.pointing import PointingCase, pointing_budget
@@ -135,11 +136,8 @@ def main() -> None:
         },
     }
     atomic_write_text(OUT / "pointing_budget.json", json.dumps(out, indent=2) + "\n")
-    atomic_write_text(
-        OUT / "pointing_budget.md",
-        "# RT-70 wind pointing budget (rt70_servo, front wind, servos closed)\n\n"
-        "Written by `python validation/pointing_budget.py`.\n\n" + table + "\n",
-    )
+    page = "# RT-70 wind pointing budget (rt70_servo, front wind, servos closed)\n\n" + table
+    atomic_write_text(OUT / "pointing_budget.md", headed(page, run_header(command_line())) + "\n")
     print(f"steady-error exponents (fit over {SPEEDS[0]:g}–{SPEEDS[-1]:g} m/s): {exponents}")
     print(f"sweeps: {speed.metadata['wall_time_s']:.0f} s and {maps.metadata['wall_time_s']:.0f} s")
 
