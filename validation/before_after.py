@@ -39,9 +39,20 @@ import numpy as np
 from rt70.reports.threads import single_threaded
 with single_threaded():
     import pinocchio as pin
-    from rt70.simulation import simulate as sim
-    from rt70.simulation.backends import BACKENDS
-    from rt70.model.scene import load_scene
+    try:  # the package in folders by domain
+        from rt70.simulation import simulate as sim
+        from rt70.simulation.backends import BACKENDS
+        from rt70.model.scene import load_scene
+        from rt70.telescope import scenarios
+        from rt70.telescope.scene_servo import choose_drives
+        REFERENCE = "reference"
+    except ImportError:  # the flat layout of the earlier revisions
+        from rt70 import simulate as sim
+        from rt70.simulate import BACKENDS
+        from rt70.scene import load_scene
+        from rt70 import scenarios
+        from rt70.scene_servo import choose_drives
+        REFERENCE = "pinocchio"
     from rt70.scenes.rt70_state import listing_initial_state
     method, rtol = sys.argv[1], float(sys.argv[2])
     scene = load_scene("rt70")
@@ -52,7 +63,7 @@ with single_threaded():
     if method != "BDF":
         r = sim.simulate(scene, (0.0, 10.0), (q, qd), method=method, rtol=rtol)
         out["method"] = [r.wall_time_s, r.n_steps, r.nfev, r.njev]
-    side = BACKENDS["reference"](scene)
+    side = BACKENDS[REFERENCE](scene)
     ref, rd = scene.reference, scene.reference_data
     tau = np.zeros(ref.pin_model.nv)
     calls = {
@@ -71,8 +82,6 @@ with single_threaded():
                 f()
             best = min(best, (time.perf_counter() - t) / n)
         out[name] = best
-    from rt70.telescope import scenarios
-    from rt70.telescope.scene_servo import choose_drives
     servo = load_scene("rt70_servo")
     sc = scenarios.scenario("step-elevation", 45.0, 0.0, 10.0)
     drives, _ = choose_drives(servo, None)
