@@ -35,7 +35,8 @@ import numpy as np
 
 #: A key, column or heading that names a time or a speed measured on the machine.
 TIMING = re.compile(
-    r"(wall|seconds|elapsed|_ms\b|_us\b|_times\b|time_s|run time|per_call|duration_s|timing|"
+    r"(wall|seconds|elapsed|_ms\b|_us\b|_times\b|time_s|times_s|rhs_s|jacobian_s|integrator_s|"
+    r"run time|per_call|duration_s|timing|"
     r"real.time|µs|\bms\b|case s|\bs\b$)",
     re.I,
 )
