@@ -231,6 +231,16 @@ def test_run_capped_time_cap(rt70):
     assert 0.0 < run.t_reached < 1.0
 
 
+def test_run_capped_evaluation_budget():
+    """The report's cap is a budget of evaluations: the first one past it ends the run,
+    whatever the clock says."""
+    scene = scene_from_text(scale_springs(load_scene("rt70").text, 1e6, 0.0), "stiff")
+    run = run_capped(
+        scene, (0.0, 1.0), listing_initial_state(scene), cap_s=math.inf, max_evaluations=40
+    )
+    assert run.status == "over cap" and run.nfev == 41 and 0.0 < run.t_reached < 1.0
+
+
 def test_run_capped_starts_its_clock_after_the_kernels_are_warm(rt70, monkeypatch):
     """The cap measures the integration, not the compilation of the kernels: a short run
     that calls every kernel comes before the first reading of the cap's clock."""

@@ -152,8 +152,10 @@ def write_report(
         "q̇ ±1); 'energy drift' is the largest |T + U_g + U_c + E_ψ − const| over the "
         "run relative to the energy exchanged; 'rejected' counts rejected step attempts "
         "(solve_ivp does not report them: counted from the right-hand-side evaluation "
-        f"times); each run is capped at {Settings.make(quick).cap_s:g} s of wall time "
-        "('over cap'); 'wall s' is the integration's wall time.",
+        f"times); each run is capped at {Settings.make(quick).max_evaluations} "
+        "right-hand-side evaluations ('over cap': the same on every machine; "
+        f"{Settings.make(quick).cap_s:g} s of wall time as a guard); 'wall s' is the "
+        "integration's wall time.",
         "",
     ]
     body = "\n".join(f"{t.markdown()}" for t in tables.values())

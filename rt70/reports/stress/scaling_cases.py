@@ -112,7 +112,12 @@ def _chain_row(n: int, settings: Settings) -> dict:
         row["xerr"] = "not built (memory)"
     row.update(_structured_against_dense(scene, q, qd))
     if n <= settings.chain_sim_max and model.nv <= MAX_PINOCCHIO_NV:
-        run = run_capped(scene, (0.0, settings.span), cap_s=settings.cap_s)
+        run = run_capped(
+            scene,
+            (0.0, settings.span),
+            cap_s=settings.cap_s,
+            max_evaluations=settings.max_evaluations,
+        )
         row.update(sim_fields(run, settings.span))
     else:
         row["sim"] = "skipped (size)"
@@ -360,6 +365,7 @@ def free_floating_cases(quick: bool = False) -> Table:
                 method="DOP853",
                 rtol=rtol,
                 cap_s=settings.cap_s,
+                max_evaluations=settings.max_evaluations,
             )
             row = {"n": n, "nv": scene.textbook.nv, "side": side, "rigid": rigid}
             row.update(xerr=err, span=span, fmax=float(frequencies_hz(scene)[-1]))
