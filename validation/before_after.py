@@ -141,6 +141,8 @@ def main(argv: list[str]) -> int:
     }
     b, a = best["before"], best["after"]
     lines = [
+        "# Before and after: simulation speed against an earlier revision",
+        "",
         f"Before: {args.before}; after: this checkout. `python validation/before_after.py` "
         f"({args.rounds} rounds alternating, best of each; BLAS pinned to one thread).",
         "",
