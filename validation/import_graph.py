@@ -14,10 +14,11 @@ from __future__ import annotations
 import argparse
 import functools
 import importlib.util
-import subprocess
 import sys
-from datetime import date
 from pathlib import Path
+
+from rt70.guards.atomic import atomic_write_text
+from rt70.reports.provenance import headed, run_header
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -122,20 +123,14 @@ def main(argv: list[str] | None = None) -> int:
     report = format_report(survey())
     print(report)
     if args.out:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True
-        ).stdout.strip()
-        head = (
+        command = f"python validation/import_graph.py --out {args.out.as_posix()}"
+        page = (
             "# The package's folders and imports\n\n"
-            f"> `python validation/import_graph.py --out {args.out.as_posix()}` · "
-            f"commit {commit or 'unknown'} · {date.today().isoformat()}\n\n"
             "Counted from the code by the import finder and the floors of "
             "`tests/test_import_rules.py`; the roles of the folders: "
-            "[architecture](../../docs/architecture.md).\n\n"
+            "[architecture](../../docs/architecture.md).\n\n" + report + "\n"
         )
-        tmp = args.out.with_suffix(args.out.suffix + ".tmp")
-        tmp.write_text(head + report + "\n", encoding="utf-8")
-        tmp.replace(args.out)
+        atomic_write_text(args.out, headed(page, run_header(command)))
         print(f"wrote {args.out}")
     return 0
 
