@@ -47,7 +47,22 @@ def commit(root: Path = ROOT) -> str:
 
 
 def run_header(command: str, revision: str | None = None, today: date | None = None) -> str:
-    """``> `command` · commit <revision> · <date>`` (default: this checkout, today)."""
+    """The run header of a result page.
+
+    Parameters
+    ----------
+    command : str
+        The command that made the result, as a user types it.
+    revision : str, optional
+        The commit (default: this checkout's, :func:`commit`).
+    today : datetime.date, optional
+        The date of the run (default: today).
+
+    Returns
+    -------
+    str
+        ``> `command` · commit <revision> · <date>``.
+    """
     revision = commit() if revision is None else revision
     today = date.today() if today is None else today
     return f"> `{command}` · commit {revision} · {today.isoformat()}"
