@@ -15,6 +15,7 @@ Run: ``python validation/chaplygin.py`` (about a minute).
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from pathlib import Path
@@ -540,7 +541,9 @@ def figure(sol, sol_off, t_off, r, alpha0, alpha4):
     return fig
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     start = time.perf_counter()
     cart_scene, sleigh = load_scene("two_wheeled_cart"), load_scene("chaplygin_sleigh")
     lines = [

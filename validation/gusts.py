@@ -7,6 +7,7 @@ validation/results/gusts.json and validation/results/gusts_spectrum.png. Run:
 ``python validation/gusts.py`` (a few seconds).
 """
 
+import argparse
 import json
 import time
 from pathlib import Path
@@ -39,8 +40,10 @@ def spectrum_variance(speed: float) -> float:
     return value
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     """Compute, print and write the numbers."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     results: dict = {}
     kappa = gusts.DAVENPORT_KAPPA
     var10 = spectrum_variance(10.0)

@@ -21,6 +21,7 @@ Writes validation/results/impacts.json and impacts.md. Run:
 ``python validation/impacts.py`` (about a minute).
 """
 
+import argparse
 import json
 import time
 from pathlib import Path
@@ -254,7 +255,9 @@ def markdown(checks: list[dict], cases: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     with threadpool_limits(1):  # BLAS threads pinned: the small solves' times (ms)
         checks = [cross_check(name) for name in SCENES]
     for c in checks:

@@ -12,6 +12,7 @@ Writes validation/results/joint_reactions.{json,md,csv} and joint_reactions.png.
 Run: ``python validation/joint_reactions.py`` (about a minute on this 2-core machine).
 """
 
+import argparse
 import json
 import time
 from pathlib import Path
@@ -95,7 +96,9 @@ def timing(scene) -> dict:
     return {"textbook_ms": t_tb * 1e3, "pinocchio_ms": t_ref * 1e3, "ratio": t_tb / t_ref}
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     OUT.mkdir(exist_ok=True)
     checks = validate_rows()
     scene = load_scene("rt70_servo")

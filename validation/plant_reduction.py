@@ -19,6 +19,7 @@ Run: ``python validation/plant_reduction.py`` (about two minutes).
 
 from __future__ import annotations
 
+import argparse
 import csv
 import io
 import sys
@@ -178,8 +179,10 @@ def figure(rows: list[dict], full: dict[str, StateSpace], floors: dict[str, rd.H
     return fig
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
     """Compute, print a summary and write the CSV and the figure."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     start = time.perf_counter()
 
     def say(msg: str) -> None:

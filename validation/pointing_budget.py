@@ -16,6 +16,7 @@ pointing_maps.png, pointing_modes.png. Run: ``python validation/pointing_budget.
 (about 6 minutes on this 2-core machine).
 """
 
+import argparse
 import json
 import time
 from pathlib import Path
@@ -46,7 +47,9 @@ def _save(fig, name: str) -> None:
     atomic_write(OUT / name, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     scene = load_scene("rt70_servo")
     start = time.perf_counter()
     budgets = budget_table(scene)

@@ -6,10 +6,11 @@ several (position bandwidth, ratio) pairs and prints the settling time to 1″, 
 overshoot and the largest error of the last 5 s; an unstable loop ends in a solver
 failure or an exception. The numbers of docs/servo-scenarios.md §"Choosing the
 bandwidths" come from it.
-Run: ``python validation/servo_bandwidth_sweep.py AXIS T_END STEP_ARCSEC HZ,RATIO ...``,
-e.g. ``azimuth 25 100 0.2,5 0.3,3``.
+Run: ``python validation/servo_bandwidth_sweep.py AXIS T_END STEP HZ,RATIO ...`` (AXIS
+azimuth or elevation, T_END in s, STEP in arcsec), e.g. ``azimuth 25 100 0.2,5 0.3,3``.
 """
 
+import argparse
 import signal
 import sys
 
@@ -50,13 +51,34 @@ def run(scene, q0, Q, axis, hz, ratio, step, t_end):
     return f'settle1 {ts:.2f} overshoot {(-err).max():.2f}" last5 max {last:.3f}"'
 
 
+def _pair(text: str) -> tuple[float, float]:
+    """``HZ,RATIO``: a position bandwidth (Hz) and the cascade's ratio."""
+    try:
+        hz, ratio = map(float, text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected HZ,RATIO (e.g. 0.2,5), got {text!r}") from None
+    return hz, ratio
+
+
 def main(argv):
-    axis, t_end, step = argv[0], float(argv[1]), float(argv[2]) * RAD_PER_ARCSEC
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "axis",
+        choices=(S.AZIMUTH_DRIVE.name, S.ELEVATION_DRIVE.name),
+        metavar="AXIS",
+        help="the axis stepped: azimuth or elevation",
+    )
+    parser.add_argument("t_end", type=float, metavar="T_END", help="run length, s")
+    parser.add_argument("step", type=float, metavar="STEP", help="step size, arcsec")
+    parser.add_argument(
+        "pairs", type=_pair, nargs="+", metavar="HZ,RATIO", help="position bandwidth and ratio"
+    )
+    args = parser.parse_args(argv)
+    axis, t_end, step = args.axis, args.t_end, args.step * RAD_PER_ARCSEC
     scene = load_scene("rt70_servo")
     q0 = equilibrium(scene, rt70_pointing(45.0, 0.0), tol=S.EQUILIBRIUM_TOL)
     Q = static_force(scene, q0)
-    for spec in argv[3:]:
-        hz, ratio = map(float, spec.split(","))
+    for hz, ratio in args.pairs:
         print(axis, hz, ratio, run(scene, q0, Q, axis, hz, ratio, step, t_end), flush=True)
     return 0
 

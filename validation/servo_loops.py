@@ -10,6 +10,7 @@ Run: ``python validation/servo_loops.py [--quick | --figures]`` (about 7 minutes
 busy cores; --quick skips the bisection, --figures writes the figures only).
 """
 
+import argparse
 import json
 import sys
 import time
@@ -81,8 +82,12 @@ def _finite(x):
 
 
 def main(argv: list[str]) -> int:
-    quick = "--quick" in argv
-    figures_only = "--figures" in argv
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--quick", action="store_true", help="skip the bisection")
+    group.add_argument("--figures", action="store_true", help="write the figures only")
+    args = parser.parse_args(argv)
+    quick, figures_only = args.quick, args.figures
     start = time.perf_counter()
 
     def say(msg: str) -> None:

@@ -14,6 +14,7 @@ Writes validation/results/servo_lqg.{json,png}. Run:
 processes; the LQG's fast estimator poles, ~6000 rad/s, make it stiff).
 """
 
+import argparse
 import json
 import sys
 import time
@@ -118,6 +119,8 @@ def _finite(x):
 
 
 def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     from rt70.model.scene import load_scene
     from rt70.reports import servo_lqg as sl
 

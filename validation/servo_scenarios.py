@@ -15,6 +15,7 @@ to results).
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 import time
@@ -24,7 +25,7 @@ from rt70.errors import Rt70Error
 from rt70.guards.atomic import atomic_write_all
 from rt70.model.scene import load_scene
 from rt70.telescope import scenarios as S
-from rt70.telescope.scene_servo import choose_drives
+from rt70.telescope.scene_servo import DRIVE_MODELS, choose_drives
 
 OUT = Path(__file__).resolve().parent / "results"
 HOLD_ELEVATIONS = (10.0, 30.0, 45.0, 60.0, 80.0, 90.0)
@@ -73,10 +74,19 @@ def targets(runs: dict[str, S.ScenarioRun]) -> list[dict]:
 
 
 def main(argv: list[str]) -> int:
-    quick = "--quick" in argv
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--quick", action="store_true", help="5 s holds at two elevations, short steps, not written"
+    )
+    parser.add_argument(
+        "--drives",
+        choices=DRIVE_MODELS,
+        help="the drives' model (default: the scene's own drives, as rt70 simulate chooses)",
+    )
+    args = parser.parse_args(argv)
+    quick, model = args.quick, args.drives
     start = time.perf_counter()
     scene = load_scene("rt70_servo")
-    model = argv[argv.index("--drives") + 1] if "--drives" in argv else None
     drives, label = choose_drives(scene, model)
     print(f"{scene.name}: {label}")
     plan = [

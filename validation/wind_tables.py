@@ -5,6 +5,7 @@ docs/wind.md (tests/test_wind.py checks the files against the formulas below). R
 ``python validation/wind_tables.py`` (rewrites both files atomically).
 """
 
+import argparse
 from pathlib import Path
 
 import numpy as np
@@ -79,8 +80,10 @@ def table_text(header: str, rows: np.ndarray) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     """Write both tables."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     for name, header, rows in (
         ("dish", DISH_HEADER, dish_rows(THETA_DEG)),
         ("cylinder", CYLINDER_HEADER, cylinder_rows(THETA_DEG)),

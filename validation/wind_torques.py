@@ -8,6 +8,8 @@ reaches the book's nominal wind torque 5·10⁵ kgf·m (formalism §4.5). Nothin
 Run: ``python validation/wind_torques.py`` (a few seconds).
 """
 
+import argparse
+
 import numpy as np
 
 from rt70.model.scene import load_scene
@@ -23,8 +25,10 @@ NOMINAL = 5.0e5 * KGF_M
 DIRECTIONS = np.arange(0.0, 360.0, 5.0)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     """Print the table."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.parse_args(argv)
     scene = load_scene("rt70_servo")
     names = scene.coordinate_names
     axes = {"elevation": names.index("base_rx"), "azimuth": names.index("platform_rz")}

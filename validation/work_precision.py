@@ -11,6 +11,7 @@ Run: ``python validation/work_precision.py [--quick]`` (under 10 minutes; --quic
 seconds).
 """
 
+import argparse
 import sys
 import time
 from pathlib import Path
@@ -21,7 +22,9 @@ OUT = Path(__file__).resolve().parent / "results"
 
 
 def main(argv: list[str]) -> int:
-    quick = "--quick" in argv
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="a smoke run of a few seconds")
+    quick = parser.parse_args(argv).quick
     start = time.perf_counter()
 
     def say(msg: str) -> None:
