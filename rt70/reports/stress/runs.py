@@ -151,8 +151,7 @@ def run_capped(
         Rt70 errors (gimbal lock, a singular mass matrix) and numpy's LinAlgError end the
         run as ``error: …``; nothing is raised.
     """
-    nv = scene.textbook.nv
-    zero = np.zeros(nv)
+    zero = np.zeros(scene.textbook.nv)
     times: list[float] = []
     _warm_up(scene, t_span, x0, side)
     start = clock()
