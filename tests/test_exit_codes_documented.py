@@ -182,6 +182,9 @@ def _signalled(signum: int) -> tuple[int, str]:
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         env={**os.environ, "MPLBACKEND": "Agg"},
+        # as from a terminal, even when the tests run in the background (SIGINT ignored,
+        # which rt70 then keeps ignoring: tests/test_hostile_guards.py)
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     watchdog = threading.Timer(300, proc.kill)  # only if it never starts
     watchdog.start()

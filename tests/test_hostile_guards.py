@@ -216,12 +216,41 @@ def test_a_lost_stop_is_raised_again_at_the_next_evaluation(limited):
         assert rhs(0.0, np.ones(1))[0] == -1.0 and not stop.requested()
 
 
-def test_stop_signals_record_and_raise_and_clear(monkeypatch):
+def test_stop_signals_record_and_raise_and_clear():
     """The command line's SIGINT and SIGTERM handlers raise, record, and forget on exit."""
     import signal
 
     from rt70.cli.session import stop_signals
     from rt70.guards import stop
+
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a terminal
+    try:
+        _raise_record_and_clear(stop_signals, stop)
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def test_a_sigint_ignored_from_the_start_stays_ignored():
+    """A job started in the background ignores SIGINT; the command line leaves it so."""
+    import signal
+
+    from rt70.cli.session import stop_signals
+    from rt70.guards import stop
+
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with stop_signals(143):
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+            signal.raise_signal(signal.SIGINT)  # ignored: nothing raised, nothing recorded
+            assert not stop.requested()
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def _raise_record_and_clear(stop_signals, stop) -> None:
+    import signal
 
     with stop_signals(143):
         with pytest.raises(KeyboardInterrupt):
@@ -237,7 +266,6 @@ def test_stop_signals_record_and_raise_and_clear(monkeypatch):
         with pytest.raises(SystemExit):
             stop.check()
     assert not stop.requested()
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_a_run_kept_step_by_step_checks_its_pace_against_memory():

@@ -164,7 +164,8 @@ def stop_signals(code: int) -> Iterator[None]:
     (:func:`rt70.guards.stop.request`), so one raised where it gets lost is raised again
     at the integrators' next right-hand side (:func:`rt70.guards.stop.check`). The previous
     handlers are restored afterwards and the record cleared; outside the main thread
-    nothing changes.
+    nothing changes. A SIGINT the process was started ignoring (a job started in the
+    background, ``nohup``) stays ignored, as Python itself leaves it.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -176,10 +177,9 @@ def stop_signals(code: int) -> Iterator[None]:
     def interrupt(signum: int, _frame: object) -> NoReturn:
         stop.request(KeyboardInterrupt)
 
-    previous = {
-        signal.SIGTERM: signal.signal(signal.SIGTERM, terminate),
-        signal.SIGINT: signal.signal(signal.SIGINT, interrupt),
-    }
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, terminate)}
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # a background job's stays
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, interrupt)
     try:
         yield
     finally:
