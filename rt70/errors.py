@@ -65,7 +65,7 @@ class SingularConfigurationError(Rt70Error):
 
 
 class SceneError(Rt70Error):
-    """A scene name is unknown."""
+    """A scene name is unknown, or a scene lacks a declaration an analysis needs."""
 
 
 class UnknownLinkError(Rt70Error):

@@ -30,6 +30,7 @@ DYNAMICS = {"bushings", "joint_springs", "drives", "winds", "air_density", "loop
 ELSEWHERE = {
     "optical_points": "outputs of either side by link and offset (rt70.model.outputs)",
     "no_slips": "constraints on a scene's velocities (rt70.mechanics, rt70.crosscheck)",
+    "mount": "the pointing axes, read where a pointing is asked for (rt70.model.antenna)",
     "inertia_repairs": "the repairs the scene writes into the text both sides read (model.scene)",
 }
 

@@ -185,6 +185,7 @@ def test_the_table_has_every_kind_the_reader_reads():
         "air",
         "loop",
         "no_slip",
+        "mount",
     }
     assert set(KINDS) > {("bushing", "frame1"), ("strut_package", "strut"), ("drive", "sector")}
 

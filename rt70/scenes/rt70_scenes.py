@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from rt70.control.geartrains import parallel_drive
-from rt70.scenes import rt70_data, rt70_drives, rt70_wind
+from rt70.scenes import rt70_data, rt70_drives, rt70_state, rt70_wind
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.urdf_writer import ZERO3, check_name, fmt, fmt_vec
 from rt70.urdf.description import DRIVE_PARAMETERS
@@ -198,9 +198,40 @@ def _rt70_text(
             ("link", check_name(point["link"])),
             ("xyz", fmt_vec(point["xyz"])),
         )
+    _mount(w)
     if drives is not None:
         drives(w)
     return uw.end(w)
+
+
+def _mount(w: uw.Writer) -> None:
+    """The RT-70's pointing axes (``<rt70:mount>``).
+
+    Azimuth A = ``platform_rz``, elevation E with ``base_rx = π/2 − E`` (q = 0 is the
+    zenith); E from 0 (horizon) to 90° (zenith), A one turn either way (the ranges the
+    command line holds).
+    """
+    w.comment("Pointing axes: q = 0 looks at the zenith; base_rx = 90 deg - E")
+    w.open("rt70:mount", ("type", "az-el"))
+    w.empty(
+        "rt70:axis",
+        ("name", "azimuth"),
+        ("joint", rt70_state.AZIMUTH_COORDINATE),
+        ("zero_deg", "0"),
+        ("sign", "1"),
+        ("min_deg", "-360"),
+        ("max_deg", "360"),
+    )
+    w.empty(
+        "rt70:axis",
+        ("name", "elevation"),
+        ("joint", rt70_state.ELEVATION_COORDINATE),
+        ("zero_deg", "90"),
+        ("sign", "-1"),
+        ("min_deg", "0"),
+        ("max_deg", "90"),
+    )
+    w.close("rt70:mount")
 
 
 #: The elevation jack of the ``rt70_jack`` scene (the RT-70 with one closed loop).

@@ -180,6 +180,50 @@ class OpticalPoint:
     xyz: np.ndarray
 
 
+#: Mount types and the axes each one has, in order (``<rt70:mount type>``).
+MOUNT_AXES = {"az-el": ("azimuth", "elevation")}
+
+
+@dataclass(frozen=True)
+class MountAxis:
+    """A pointing axis of a mount: which joint turns it and how its angle is counted.
+
+    The joint's coordinate is ``q = sign · (angle − zero)``, rad: for the RT-70's
+    elevation, ``base_rx = −(E − 90°) = π/2 − E`` (``zero`` = π/2, ``sign`` = −1).
+    ``lower`` and ``upper`` bound the pointing angle (rad), not the coordinate.
+    """
+
+    name: str
+    joint: str
+    zero: float
+    sign: int
+    lower: float
+    upper: float
+
+    def coordinate(self, angle: float) -> float:
+        """The joint coordinate, rad, that points the axis at ``angle``, rad."""
+        return self.sign * (angle - self.zero)
+
+    def angle(self, coordinate: float) -> float:
+        """The pointing angle, rad, of a joint coordinate, rad."""
+        return self.zero + self.sign * coordinate
+
+
+@dataclass(frozen=True)
+class Mount:
+    """How the structure points: the mount's type and its axes (``<rt70:mount>``)."""
+
+    type: str
+    axes: tuple[MountAxis, ...]
+
+    def axis(self, name: str) -> MountAxis:
+        """The axis called ``name`` (KeyError if the mount has none)."""
+        for axis in self.axes:
+            if axis.name == name:
+                return axis
+        raise KeyError(name)
+
+
 #: Motor and reducer parameters of a ``<rt70:drive>``, in the order of
 #: :class:`rt70.bondgraph.parameters.DriveParameters` (without the load's ``J_l``, ``D_l``).
 DRIVE_PARAMETERS = ("L_a", "R_a", "c_m", "c_e", "J_m", "D_m", "i_r", "C_r", "D_r")
@@ -309,6 +353,8 @@ class RobotDescription:
         Loop closures (``<rt70:loop>``), in document order.
     no_slips : tuple of NoSlip
         Linear velocity constraints (``<rt70:no_slip>``), in document order.
+    mount : Mount or None
+        The pointing axes (``<rt70:mount>``), if the file declares them.
     """
 
     name: str
@@ -326,6 +372,7 @@ class RobotDescription:
     air_density: float = DEFAULT_AIR_DENSITY
     loops: list[Loop] = field(default_factory=list)
     no_slips: tuple[NoSlip, ...] = ()
+    mount: Mount | None = None
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

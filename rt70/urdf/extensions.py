@@ -3,10 +3,11 @@
 One job: once the links and joints of the tree are read (:mod:`rt70.urdf.reader`), turn
 the ``<rt70:...>`` elements at the top of ``<robot>`` into the description's gravity,
 joint springs, bushings and strut packages, loops, drives, winds, air density, no-slip
-constraints and optical points, refusing what is wrong with an
-:class:`~rt70.errors.ExtensionError` naming the file and the element. The drives, winds
-and no-slip constraints have modules of their own (:mod:`rt70.urdf.drives`,
-:mod:`rt70.urdf.wind`, :mod:`rt70.urdf.no_slip`); the others are read here.
+constraints, the mount and optical points, refusing what is wrong with an
+:class:`~rt70.errors.ExtensionError` naming the file and the element. The drives, winds,
+no-slip constraints and the mount have modules of their own (:mod:`rt70.urdf.drives`,
+:mod:`rt70.urdf.wind`, :mod:`rt70.urdf.no_slip`, :mod:`rt70.urdf.mount`); the others are
+read here.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from rt70.urdf.description import (
 )
 from rt70.urdf.drives import read_drive
 from rt70.urdf.elements import ZERO3, ElementReader
+from rt70.urdf.mount import read_mount
 from rt70.urdf.no_slip import read_no_slip
 from rt70.urdf.text import RT70_NS
 from rt70.urdf.wind import read_air, read_wind
@@ -41,8 +43,8 @@ def read_extensions(
     """The description with the rt70 extension elements of ``root`` read into it.
 
     The lists of ``desc`` (springs, bushings, loops, drives, optical points) and its
-    gravity are filled in place; the winds, the air density and the no-slip constraints
-    are set on a copy when the file has any.
+    gravity are filled in place; the winds, the air density, the no-slip constraints and
+    the mount are set on a copy when the file has any.
 
     Parameters
     ----------
@@ -64,6 +66,7 @@ def read_extensions(
     winds: list = []
     air: list[float] = []
     no_slips: list = []
+    mount: list = []
     joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
     for elem in root:
         if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
@@ -87,6 +90,8 @@ def read_extensions(
             air.append(read_air(reader, elem))
         elif kind == "no_slip":
             no_slips.append(read_no_slip(reader, elem, desc, no_slips))
+        elif kind == "mount":
+            mount.append(read_mount(reader, elem, joints))
         elif kind == "optical_point":
             name = reader.name_of(elem)
             link = reader.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
@@ -94,13 +99,14 @@ def read_extensions(
         else:  # a kind declared in RT70 must be read here, never skipped
             raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
     _check_unique_names(reader, desc)
-    if not (winds or air or no_slips):
+    if not (winds or air or no_slips or mount):
         return desc
     return dataclasses.replace(
         desc,
         winds=tuple(winds),
         air_density=air[0] if air else desc.air_density,
         no_slips=tuple(no_slips),
+        mount=mount[0] if mount else None,
     )
 
 

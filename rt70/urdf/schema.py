@@ -151,6 +151,21 @@ RT70 = Spec(
                 optional=("xyz", "frame", "radius", "normal"),
             )
         ),
+        "mount": Child(
+            Spec(
+                required=("type",),
+                children={
+                    "axis": Child(
+                        Spec(
+                            required=("name", "joint"),
+                            optional=("zero_deg", "sign", "min_deg", "max_deg"),
+                        ),
+                        least=1,
+                    )
+                },
+            ),
+            most=1,
+        ),
     }
 )
 
