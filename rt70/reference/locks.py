@@ -115,6 +115,11 @@ def constraint_rows(
         three rows each.
     """
     qp, _, _, _ = to_pinocchio(model, q)
+    return _pinocchio_rows(model, data, qp, brakes, pins)
+
+
+def _pinocchio_rows(model, data, qp, brakes, pins) -> np.ndarray:
+    """:func:`constraint_rows` at Pinocchio's configuration ``qp``."""
     rows = [brake_row(model, j)[None] for j in brakes]
     rows += [pin_rows(model, data, qp, link, xyz) for link, xyz in pins]
     return np.vstack(rows) if rows else np.zeros((0, model.pin_model.nv))
@@ -144,8 +149,8 @@ def book_rows(
         The stow pins: a link and the point fixed to the ground in the link's frame (m),
         three rows each.
     """
-    _, _, J, _ = to_pinocchio(model, q)
-    J_c = constraint_rows(model, data, q, brakes, pins)
+    qp, _, J, _ = to_pinocchio(model, q)
+    J_c = _pinocchio_rows(model, data, qp, brakes, pins)
     return J_c if J is None else J_c @ J
 
 
