@@ -31,6 +31,7 @@ ELSEWHERE = {
     "optical_points": "outputs of either side by link and offset (rt70.model.outputs)",
     "no_slips": "constraints on a scene's velocities (rt70.mechanics, rt70.crosscheck)",
     "mount": "the pointing axes, read where a pointing is asked for (rt70.model.antenna)",
+    "optics": "the reflector system: the pointing outputs (rt70.model.antenna)",
     "inertia_repairs": "the repairs the scene writes into the text both sides read (model.scene)",
 }
 

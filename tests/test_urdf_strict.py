@@ -1,6 +1,6 @@
 """A mistake in a model must not pass silently (issue 21 §2; rt70/urdf/schema.py).
 
-rt70's extension elements are checked against one table, :data:`rt70.urdf.schema.RT70`:
+rt70's extension elements are checked against one table, :data:`rt70.urdf.vocabulary.RT70`:
 an unknown or misspelt attribute, a missing required one, an unknown child, a child too
 many or too few, text content, a misplaced rt70 element, a namespace that looks like
 rt70's and an undeclared ``rt70:`` prefix are each an :class:`~rt70.errors.ExtensionError`
@@ -186,6 +186,7 @@ def test_the_table_has_every_kind_the_reader_reads():
         "loop",
         "no_slip",
         "mount",
+        "optics",
     }
     assert set(KINDS) > {("bushing", "frame1"), ("strut_package", "strut"), ("drive", "sector")}
 
@@ -298,6 +299,7 @@ def test_the_table_is_the_documented_one():
         "at most one": (0, 1),
         "exactly one": (1, 1),
         "one or more": (1, None),
+        "one or two": (1, 2),
     }
     documented = {}
     for row in re.findall(r"^\| `<rt70:.*$", section, flags=re.M):

@@ -113,7 +113,7 @@ def main(argv: list[str] | None = None) -> None:
         for d, label in WINDS.items()
     }
     loads_s = time.perf_counter() - start
-    text = bl.format_table(scene.name, table)
+    text = bl.format_table(scene.name, table, bl.bearing_joints(scene))
     print(text)
     bl.write_output(OUT / "joint_reactions.csv", table)
     fig = bearing_loads_figure(

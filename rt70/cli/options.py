@@ -24,7 +24,6 @@ from typing import NoReturn
 from rt70.cli.session import numerical_message
 from rt70.errors import OutputError, Rt70Error
 from rt70.model.sides import SIDES, check_side
-from rt70.scenes.rt70_state import ELEVATION_RANGE
 
 #: Largest magnitude of an azimuth or a wind direction on the command line, degrees: one
 #: turn either way holds every direction; beyond it a float's spacing grows until the
@@ -203,12 +202,15 @@ def batch_size(text: str) -> int:
 
 
 def elevation(text: str) -> float:
-    """An RT-70 elevation in degrees, within :data:`rt70.scenes.rt70_state.ELEVATION_RANGE`."""
+    """An elevation in degrees, at most a quarter turn beyond the horizon or the zenith.
+
+    The scene's own range (``<rt70:axis name="elevation" min_deg max_deg>``) is checked
+    once the scene is read (:func:`rt70.model.antenna.pointing`).
+    """
     value = _number(text)
-    low, high = ELEVATION_RANGE
-    if not low <= value <= high:
+    if not -90.0 <= value <= 180.0:
         raise argparse.ArgumentTypeError(
-            f"the RT-70 points from {low:g}° (horizon) to {high:g}° (zenith), got {text}"
+            f"an elevation lies between -90 and 180 degrees, got {text}"
         )
     return value
 
@@ -277,9 +279,9 @@ def add_side_argument(
     parser.add_argument("--backend", action=RenamedBackend)
 
 
-# --- the RT-70's pointing ----------------------------------------------------------------
+# --- the pointing of a scene's mount ----------------------------------------------------
 def add_pointing_arguments(parser: argparse.ArgumentParser, default: str = "zenith") -> None:
-    """``--elevation`` and ``--azimuth`` of the RT-70 (read back by :func:`asked_pointing`).
+    """``--elevation`` and ``--azimuth`` of a scene's mount (read by :func:`asked_pointing`).
 
     Parameters
     ----------
@@ -291,16 +293,19 @@ def add_pointing_arguments(parser: argparse.ArgumentParser, default: str = "zeni
     parser.add_argument(
         "--elevation",
         type=elevation,
-        help=f"RT-70 elevation, degrees, 0 (horizon) to 90 (zenith); default {default}",
+        help="elevation, degrees, within the range of the scene's <rt70:mount> elevation "
+        f"axis (the RT-70: 0, horizon, to 90, zenith); default {default}",
     )
-    parser.add_argument("--azimuth", type=angle_deg, help="RT-70 azimuth, degrees (default 0)")
+    parser.add_argument("--azimuth", type=angle_deg, help="azimuth, degrees (default 0)")
 
 
 def asked_pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, float, float, dict]:
-    """The RT-70 pointing asked for: (has axes, elevation, azimuth, held coordinates).
+    """The pointing asked for: (has a mount, elevation, azimuth, held coordinates).
 
-    Elevation 90° and azimuth 0° unless given, held on the scene's pointing axes
-    (:func:`rt70.scenes.rt70_state.rt70_pointing`); a scene without them holds nothing.
+    Azimuth 0° and elevation 90° unless given — the zenith, or the end of the
+    elevation axis's range nearest to it — held on the axes of the scene's
+    ``<rt70:mount>`` (:func:`rt70.model.antenna.pointing`); a scene without a mount
+    holds nothing.
 
     Parameters
     ----------
@@ -315,23 +320,24 @@ def asked_pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, fl
     ------
     Rt70Error
         If the scene has no degree of freedom, or a pointing is given for a scene
-        without the RT-70's pointing axes.
+        without a mount, or lies outside an axis's range.
     """
-    from rt70.scenes import rt70_state
+    from rt70.model.antenna import mount_of, pointing
 
     names = scene.textbook.coordinate_names
     if not names:
         raise Rt70Error(f"{scene.name}: the model has no degree of freedom: no {what}")
-    axes = (rt70_state.AZIMUTH_COORDINATE, rt70_state.ELEVATION_COORDINATE)
-    has_axes = all(axis in names for axis in axes)
+    has_axes = scene.description.mount is not None
     if (args.elevation is not None or args.azimuth is not None) and not has_axes:
-        raise Rt70Error(
-            f"{scene.name}: --elevation/--azimuth need the RT-70 pointing axes ({', '.join(axes)})"
-        )
-    elevation = 90.0 if args.elevation is None else args.elevation
+        mount_of(scene)  # one line naming the element
     azimuth = 0.0 if args.azimuth is None else args.azimuth
-    held = rt70_state.rt70_pointing(elevation, azimuth) if has_axes else {}
-    return has_axes, elevation, azimuth, held
+    if not has_axes:
+        return False, 90.0 if args.elevation is None else args.elevation, azimuth, {}
+    elevation = args.elevation
+    if elevation is None:
+        axis = mount_of(scene).axis("elevation")
+        elevation = min(max(90.0, math.degrees(axis.lower)), math.degrees(axis.upper))
+    return True, elevation, azimuth, pointing(scene, elevation, azimuth)
 
 
 # --- values checked where they are used ------------------------------------------------

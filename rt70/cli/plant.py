@@ -115,9 +115,10 @@ def _check_reduction(args: argparse.Namespace) -> str:
 def _signals(scene, has_axes: bool, elevation: float, azimuth: float, held: dict) -> tuple:
     """``(inputs, outputs)`` of the plant.
 
-    With the RT-70's axes: the drives' torques in; the axis angles, the optical points
-    and (below :data:`ZENITH_KEYHOLE_DEG`) the focal offset and the pointing corrections
-    out. Otherwise a generalised force on, and the value of, every coordinate.
+    With a ``<rt70:mount>``: the torques on its axes in; the axis angles and the optical
+    points out, and, when the scene declares ``<rt70:optics>`` and the pointing is below
+    :data:`ZENITH_KEYHOLE_DEG`, the pointing corrections (and the focal offset of a
+    secondary). Otherwise a generalised force on, and the value of, every coordinate.
     """
     from rt70.linear import plant as pl
     from rt70.model.outputs import optical_point_outputs
@@ -129,10 +130,11 @@ def _signals(scene, has_axes: bool, elevation: float, azimuth: float, held: dict
     inputs = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
     outputs = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
     outputs += optical_point_outputs(scene)
-    if elevation < ZENITH_KEYHOLE_DEG:  # at the zenith Δα, Δβ are undefined (4.160)
-        from rt70.scenes.rt70_optics import rt70_mirror_outputs
+    # at the zenith Δα, Δβ are undefined (4.160)
+    if scene.description.optics is not None and elevation < ZENITH_KEYHOLE_DEG:
+        from rt70.model.antenna import pointing_outputs
 
-        mirror = rt70_mirror_outputs(scene, elevation, azimuth)
+        mirror = pointing_outputs(scene, elevation, azimuth)
         outputs += [o for o in mirror if o.name in ("focal_offset", "pointing_correction")]
     return inputs, outputs
 

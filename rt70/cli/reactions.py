@@ -16,7 +16,7 @@ from rt70.errors import OutputError, Rt70Error
 
 
 def _elevations(text: str) -> tuple[float, ...]:
-    """A comma-separated list of RT-70 elevations, degrees (each 0–90)."""
+    """A comma-separated list of elevations, degrees (each within the scene's range)."""
     parts = [p.strip() for p in text.split(",")]
     if not all(parts):
         raise argparse.ArgumentTypeError(f"expected elevations like 0,45,90, got '{text}'")
@@ -35,9 +35,10 @@ def add_parser(sub) -> argparse.ArgumentParser:
     """The ``reactions`` subcommand."""
     rea = sub.add_parser(
         "reactions",
-        help="bearing and reducer loads of the RT-70 (joint reactions) at rest",
-        description="The wrenches across the azimuth joint (platform_rz) and the elevation "
-        "joint (base_rx) and the drives' reducer torques at the static equilibrium the "
+        help="bearing and reducer loads of an antenna (joint reactions) at rest",
+        description="The wrenches across the azimuth and the elevation joints of the "
+        "scene's <rt70:mount> (the RT-70's platform_rz and base_rx) and the drives' reducer "
+        "torques at the static equilibrium the "
         "drives hold, under gravity and optionally a steady wind (front and back by "
         "default): source 004's joint reactions on both sides (docs: 'Joint reactions', "
         "docs/reactions.md).",
@@ -100,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps({"scene": scene.name, "rows": [b.to_dict() for b in rows]}, indent=2))
     else:
-        print(bl.format_table(scene.name, rows))
+        print(bl.format_table(scene.name, rows, bl.bearing_joints(scene)))
         seconds_tb = sum(b.seconds_textbook for b in rows) / len(rows)
         seconds_ref = sum(b.seconds_reference for b in rows) / len(rows)
         print(

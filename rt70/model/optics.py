@@ -92,14 +92,27 @@ class MirrorSystem:
 
     main_focus: Point
     main_vertex: Point
-    cr_focus: Point
-    cr_vertex: Point
+    cr_focus: Point | None
+    cr_vertex: Point | None
     ok_link: str
     azimuth_axis: tuple[str, tuple[float, float, float]]
     elevation_axis: tuple[str, tuple[float, float, float]]
-    cr_support_link: str
-    cr_link: str
+    cr_support_link: str | None
+    cr_link: str | None
     design_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        secondary = (self.cr_focus, self.cr_vertex, self.cr_support_link, self.cr_link)
+        if any(x is None for x in secondary) and any(x is not None for x in secondary):
+            raise Rt70Error(
+                "a mirror system's counterreflector needs its focus, vertex, support link "
+                "and link, or none of them (a single reflector)"
+            )
+
+    @property
+    def has_counterreflector(self) -> bool:
+        """Whether the system has a second reflector (its outputs and corrections)."""
+        return self.cr_link is not None
 
     def points(self) -> tuple[Point, ...]:
         """The points every output of the system is computed from, in a fixed order."""
@@ -112,14 +125,19 @@ class MirrorSystem:
             link, a = link_axis
             return [(link, zero), (link, tuple(float(x) for x in a))]
 
-        return (
+        primary = (
             self.main_focus,
             self.main_vertex,
-            self.cr_focus,
-            self.cr_vertex,
             *frame(self.ok_link),
             *axis(self.azimuth_axis),
             *axis(self.elevation_axis),
+        )
+        if not self.has_counterreflector:
+            return primary
+        return (
+            *primary,
+            self.cr_focus,
+            self.cr_vertex,
             *frame(self.cr_support_link),
             *frame(self.cr_link),
         )
@@ -155,14 +173,16 @@ class _Geometry:
     """The ground-axis vectors of the mirror system at one set of positions."""
 
     def __init__(self, p: np.ndarray, system: MirrorSystem):
-        self.p5f, self.p5v, self.p7f, self.p7v = p[0], p[1], p[2], p[3]
-        self.R_ok = _frame(p[4:8])
-        self.z_az = p[9] - p[8]  # azimuth axis (platform z), ground axes
-        self.x_el = p[11] - p[10]  # elevation axis (platform x)
-        self.R_support = _frame(p[12:16])  # the counterreflector drive's frame 7c
-        self.o7, self.R7 = p[16], _frame(p[16:20])
+        self.p5f, self.p5v = p[0], p[1]
+        self.R_ok = _frame(p[2:6])
+        self.z_az = p[7] - p[6]  # azimuth axis (the mount's), ground axes
+        self.x_el = p[9] - p[8]  # elevation axis
         self.n5 = _unit(self.p5f - self.p5v)  # main mirror's focal axis (4.155)
-        self.n7 = _unit(self.p7f - self.p7v)  # counterreflector's focal axis (4.164)
+        if system.has_counterreflector:
+            self.p7f, self.p7v = p[10], p[11]
+            self.R_support = _frame(p[12:16])  # the counterreflector drive's frame 7c
+            self.o7, self.R7 = p[16], _frame(p[16:20])
+            self.n7 = _unit(self.p7f - self.p7v)  # counterreflector's focal axis (4.164)
         self.design = np.asarray(system.design_offset, dtype=float)
 
     def in_ok(self, v: np.ndarray) -> np.ndarray:
@@ -255,7 +275,9 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
     Returns
     -------
     list of rt70.model.outputs.Output
-        Evaluate with :func:`rt70.model.outputs.evaluate` on either side.
+        Evaluate with :func:`rt70.model.outputs.evaluate` on either side. A system
+        without a counterreflector has the main mirror's four: ``main_mirror_axis``,
+        ``main_mirror_misalignment``, ``main_mirror_error``, ``pointing_correction``.
     """
     s = np.asarray(source, dtype=float).reshape(3)
     if not np.isfinite(s).all() or np.linalg.norm(s) == 0.0:
@@ -266,9 +288,8 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
     def out(name: str, unit: str, size: int, f: Callable[[_Geometry], np.ndarray]) -> Output:
         return Output(name, unit, size, points, lambda p: f(_Geometry(p, system)))
 
-    return [
+    primary = [
         out("main_mirror_axis", "1", 3, lambda g: g.in_ok(g.n5)),
-        out("counterreflector_axis", "1", 3, lambda g: g.in_ok(g.n7)),
         out(
             "main_mirror_misalignment",
             "arcsec",
@@ -276,6 +297,20 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
             lambda g: ARCSEC_PER_RAD * np.atleast_1d(_angle(s, g.n5)),
         ),
         out("main_mirror_error", "arcsec", 3, lambda g: ARCSEC_PER_RAD * g.in_ok(s - g.n5)),
+        out(
+            "pointing_correction",
+            "arcsec",
+            2,
+            lambda g: ARCSEC_PER_RAD * _pointing_correction(g, s),
+        ),
+    ]
+    if not system.has_counterreflector:
+        return primary
+    return [
+        primary[0],
+        out("counterreflector_axis", "1", 3, lambda g: g.in_ok(g.n7)),
+        primary[1],
+        primary[2],
         out(
             "counterreflector_misalignment",
             "arcsec",
@@ -290,12 +325,7 @@ def mirror_outputs(system: MirrorSystem, source: Sequence[float]) -> list[Output
             lambda g: ARCSEC_PER_RAD * np.atleast_1d(_angle(s, g.n7)),
         ),
         out("focal_offset", "mm", 3, lambda g: MM_PER_M * (g.in_ok(g.p7f - g.p5f) - g.design)),
-        out(
-            "pointing_correction",
-            "arcsec",
-            2,
-            lambda g: ARCSEC_PER_RAD * _pointing_correction(g, s),
-        ),
+        primary[3],
         out("counterreflector_rotation", "arcsec", 3, lambda g: ARCSEC_PER_RAD * _cr_rotation(g)),
         out(
             "counterreflector_translation",

@@ -28,7 +28,7 @@ def servo_figure(run) -> Figure:
         fontsize=11,
     )
     # 1. axis angles vs reference: offsets from the start, arc seconds (elevation upward)
-    signs = {"azimuth": 1.0, "elevation": -1.0}  # base_rx = π/2 − elevation
+    signs = run.axis_signs  # coordinate = sign · (angle − zero)
     colors = {"azimuth": "C0", "elevation": "C1"}
     for axis, ref in run.axis_reference.items():
         angle = ref - run.axis_error[axis] * signs[axis] / ARCSEC_PER_RAD

@@ -199,6 +199,7 @@ def _rt70_text(
             ("xyz", fmt_vec(point["xyz"])),
         )
     _mount(w)
+    _optics(w)
     if drives is not None:
         drives(w)
     return uw.end(w)
@@ -232,6 +233,29 @@ def _mount(w: uw.Writer) -> None:
         ("max_deg", "90"),
     )
     w.close("rt70:mount")
+
+
+def _optics(w: uw.Writer) -> None:
+    """The RT-70's reflector system (``<rt70:optics>``, book 4.1.8).
+
+    Gregorian: the counterreflector is an ellipsoid of revolution (book §4.1.8); the
+    reference ring (OK) is the mirror base (body 4); the counterreflector's drive is on
+    the rigel (body 6), its construction frame 7c parallel to the rigel's.
+    """
+    main_focus, main_vertex, cr_focus, cr_vertex = (
+        p["name"] for p in rt70_data.LISTING_OPTICAL_POINTS
+    )
+    w.comment("Reflector system: Gregorian; reference ring = the mirror base")
+    w.open("rt70:optics", ("type", "gregorian"), ("reference_link", "mirror_base"))
+    w.empty("rt70:reflector", ("role", "primary"), ("focus", main_focus), ("vertex", main_vertex))
+    w.empty(
+        "rt70:reflector",
+        ("role", "secondary"),
+        ("focus", cr_focus),
+        ("vertex", cr_vertex),
+        ("support", "rigel"),
+    )
+    w.close("rt70:optics")
 
 
 #: The elevation jack of the ``rt70_jack`` scene (the RT-70 with one closed loop).

@@ -150,12 +150,11 @@ def make_grid(
     Raises
     ------
     SweepError
-        An elevation outside 0…90°, an azimuth or direction beyond one turn, a
-        negative wind speed, an unknown axis or scene parameter, a factor ≤ 0, an empty
-        or repeated axis.
+        An elevation beyond a quarter turn past the horizon or the zenith (the scene's
+        own range is checked by :func:`rt70.sweep.plan.plan`), an azimuth or direction
+        beyond one turn, a negative wind speed, an unknown axis or scene parameter, a
+        factor ≤ 0, an empty or repeated axis.
     """
-    from rt70.scenes.rt70_state import ELEVATION_RANGE
-
     values = dict(values or {})
     unknown = [k for k in values if k not in {name for name, _, _ in AXES}]
     if unknown:
@@ -171,14 +170,13 @@ def make_grid(
         if any(not f > 0.0 for f in factors):
             raise SweepError(f"--scale {name}: factors must be greater than 0")
         axes.append(Axis(f"scale:{name}", "1", tuple(float(f) for f in factors)))
-    low, high = ELEVATION_RANGE
     for axis in axes:
         if not axis.values:
             raise SweepError(f"--{axis.name}: no values")
         if len(set(axis.values)) != len(axis.values):
             raise SweepError(f"--{axis.name}: a value is repeated")
-    if any(not low <= e <= high for e in axes[0].values):
-        raise SweepError(f"--elevation: the RT-70 points from {low:g}° to {high:g}°")
+    if any(not -90.0 <= e <= 180.0 for e in axes[0].values):
+        raise SweepError("--elevation: elevations lie between -90° and 180°")
     if any(w < 0.0 for w in axes[2].values):
         raise SweepError("--wind: speeds must be at least 0 m/s")
     for axis in (axes[1], axes[3]):

@@ -252,8 +252,6 @@ def plan(
         A sweep larger than this machine can hold (:func:`check_size`), checked before
         the scene is read.
     """
-    from rt70.scenes.rt70_state import missing_axes
-
     if chunk < 1:
         raise SweepError(f"--chunk must be at least 1, got {chunk}")
     unknown = [q for q in quantities if q not in QUANTITIES]
@@ -264,10 +262,7 @@ def plan(
     check_size(grid, chosen, chunk)
     source = SceneSource.read(target)
     scene = build_scene(source)
-    names = scene.textbook.coordinate_names
-    missing = missing_axes(names)
-    if missing:
-        raise SweepError(f"{source.name}: no RT-70 pointing axis {', '.join(missing)} to sweep")
+    _check_pointings(source.name, scene, grid)
     for axis in grid.axes:
         if axis.name.startswith("scale:"):
             check_factors(scene, axis.name.removeprefix("scale:"), axis.values)
@@ -275,6 +270,26 @@ def plan(
         if q.check is not None:
             q.check(scene)
     return Sweep(source, grid, chosen, chunk)
+
+
+def _check_pointings(name: str, scene, grid: Grid) -> None:
+    """Refuse a scene without a mount, or a grid elevation or azimuth outside its ranges."""
+    from rt70.model.antenna import mount_of
+
+    try:
+        mount = mount_of(scene)
+    except Rt70Error as exc:
+        raise SweepError(f"no pointing axes to sweep: {exc}") from None
+    for axis_name in ("elevation", "azimuth"):
+        axis = mount.axis(axis_name)
+        low, high = math.degrees(axis.lower), math.degrees(axis.upper)
+        values = next(a.values for a in grid.axes if a.name == axis_name)
+        outside = [v for v in values if not low - 1e-9 <= v <= high + 1e-9]
+        if outside:
+            raise SweepError(
+                f"--{axis_name} {outside[0]:g}: {name} points its {axis_name} axis from "
+                f"{low:g}° to {high:g}° (<rt70:axis name='{axis_name}'>)"
+            )
 
 
 def peak_bytes(grid: Grid, quantities: Sequence[Quantity], chunk: int) -> int:

@@ -37,7 +37,8 @@ class SweepPoint:
     Attributes
     ----------
     elevation, azimuth : float
-        RT-70 pointing, degrees (:func:`rt70.scenes.rt70_state.rt70_pointing`).
+        The pointing, degrees, of the scene's ``<rt70:mount>``
+        (:func:`rt70.model.antenna.pointing`).
     wind, direction : float
         Wind speed (m/s) and the direction it blows from (degrees); carried for the
         quantities that use them (none of the built-in ones does).
@@ -53,12 +54,11 @@ class SweepPoint:
     scales: dict[str, float] = field(default_factory=dict)
     _equilibrium: np.ndarray | Exception | None = field(default=None, repr=False)
 
-    @property
-    def held(self) -> dict[str, float]:
-        """The RT-70 axes held at this pointing (coordinate name → angle, rad)."""
-        from rt70.scenes.rt70_state import rt70_pointing
+    def held(self, scene: Scene) -> dict[str, float]:
+        """The mount's axes held at this pointing (coordinate name → angle, rad)."""
+        from rt70.model.antenna import pointing
 
-        return rt70_pointing(self.elevation, self.azimuth)
+        return pointing(scene, self.elevation, self.azimuth)
 
     def equilibrium(self, scene: Scene) -> np.ndarray:
         """Static equilibrium under gravity with the axes held (solved once per point).
@@ -72,7 +72,7 @@ class SweepPoint:
         if self._equilibrium is None:
             try:
                 with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported
-                    self._equilibrium = equilibrium(scene, self.held)
+                    self._equilibrium = equilibrium(scene, self.held(scene))
             except Rt70Error as exc:
                 self._equilibrium = exc
         if isinstance(self._equilibrium, Exception):
@@ -184,7 +184,7 @@ def _first_frequency(scene: Scene, point: SweepPoint) -> dict[str, Any]:
 
     q = point.equilibrium(scene)
     drives = bool(scene.description.drives)
-    model = lin.linearize(scene, q, locked=() if drives else tuple(point.held))
+    model = lin.linearize(scene, q, locked=() if drives else tuple(point.held(scene)))
     if drives:
         model = lin.locked_rotor(scene, model)
     result = modal.modes(model.M, model.K)
@@ -209,11 +209,11 @@ def _sag(scene: Scene, point: SweepPoint) -> dict[str, Any]:
     (:mod:`rt70.model.optics`), both from the reference side's kinematics (as
     ``rt70 simulate``'s static misalignment, :mod:`rt70.telescope.scenarios`).
     """
+    from rt70.model.antenna import pointing_outputs
     from rt70.model.outputs import evaluate
-    from rt70.scenes.rt70_optics import rt70_mirror_outputs
 
     wanted = ("main_mirror_misalignment", "main_mirror_error")
-    outs = [o for o in rt70_mirror_outputs(scene, point.elevation, point.azimuth)]
+    outs = [o for o in pointing_outputs(scene, point.elevation, point.azimuth)]
     chosen = [o for o in outs if o.name in wanted]
     values = evaluate(scene, point.equilibrium(scene), chosen, "reference")
     return {"sag": float(values[wanted[0]][0]), "sag_error": values[wanted[1]]}
@@ -225,20 +225,24 @@ def _check_mirror(scene: Scene) -> None:
     A missing or repeated optical point, or a focus on its mirror's vertex (no focal
     axis n5 or n7, (4.155)).
     """
-    from rt70.scenes.rt70_optics import OPTICAL_POINTS, rt70_mirror_system
+    from rt70.model.antenna import mirror_system
 
-    system = rt70_mirror_system(scene)  # raises naming the missing optical points
+    system = mirror_system(scene)  # raises naming a missing <rt70:mount> or <rt70:optics>
+    optics = scene.description.optics
+    used = {optics.primary.focus, optics.primary.vertex}
+    if optics.secondary is not None:
+        used |= {optics.secondary.focus, optics.secondary.vertex}
     names = [p.name for p in scene.description.optical_points]
-    repeated = sorted({n for n in names if n in OPTICAL_POINTS and names.count(n) > 1})
+    repeated = sorted({n for n in names if n in used and names.count(n) > 1})
     if repeated:
         raise Rt70Error(
             f"{scene.name}: <rt70:optical_point name='{repeated[0]}'> is given "
             f"{names.count(repeated[0])} times: which one is meant?"
         )
-    for focus, vertex, what in (
-        (system.main_focus, system.main_vertex, "main mirror"),
-        (system.cr_focus, system.cr_vertex, "counterreflector"),
-    ):
+    pairs = [(system.main_focus, system.main_vertex, "main mirror")]
+    if system.has_counterreflector:
+        pairs.append((system.cr_focus, system.cr_vertex, "secondary reflector"))
+    for focus, vertex, what in pairs:
         if focus[0] == vertex[0] and np.array_equal(focus[1], vertex[1]):
             raise Rt70Error(
                 f"{scene.name}: the {what}'s focus and vertex are the same point "

@@ -1,4 +1,4 @@
-"""The RT-70's bearing and reducer loads: joint reactions at the drive-held equilibrium.
+"""Bearing and reducer loads of an antenna: joint reactions at the drive-held equilibrium.
 
 What a structural or drive engineer asks of the model: at a pointing,
 at rest under gravity and optionally a steady wind, what do the azimuth bearing, the
@@ -6,7 +6,8 @@ elevation bearing and the two reducers carry? The answer is the joint reaction
 wrenches of source 004 (9)–(13) (:mod:`rt70.textbook.reactions`, cross-checked by
 :mod:`rt70.reference.reactions`) at the static equilibrium the drives hold
 (:func:`rt70.telescope.scene_servo.scene_equilibrium`, the wind's generalised force added as in
-:mod:`rt70.telescope.pointing`). In the RT-70 scenes (rt70_servo; docs/reactions.md):
+:mod:`rt70.telescope.pointing`). The bearings are the joints of the scene's
+``<rt70:mount>`` axes; in the RT-70 scenes (rt70_servo; docs/reactions.md):
 
 - **azimuth bearing**: the wrench across the azimuth joint ``platform_rz`` (ground →
   the platform and all it carries, through the ``ground_platform`` bushing: the
@@ -45,9 +46,6 @@ from rt70.model.scene import Scene
 from rt70.model.sides import side_of
 from rt70.physics.loads import Wrench
 
-#: The joints whose reactions are the RT-70's bearing loads (rt70_state's pointing axes).
-AZIMUTH_JOINT = "platform_rz"
-ELEVATION_JOINT = "base_rx"
 #: The default elevations of the report, degrees.
 ELEVATIONS = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
 
@@ -151,39 +149,37 @@ class BearingLoads:
 
 
 def check_scene(scene: Scene, wind: bool) -> None:
-    """Refuse a scene without the RT-70 bearing joints, drives (or wind elements if asked).
+    """Refuse a scene without a mount, drives on its axes (or wind elements if asked).
 
     Raises
     ------
     Rt70Error
         Naming the scene and what it lacks.
     """
-    from rt70.scenes.rt70_state import POINTING_AXES
+    from rt70.model.antenna import mount_of
     from rt70.telescope.scene_servo import has_scene_drives
 
-    joints = {j.name for j in scene.description.joints}
-    missing = [j for j in (AZIMUTH_JOINT, ELEVATION_JOINT) if j not in joints]
-    if missing or any(a not in scene.coordinate_names for a in POINTING_AXES):
-        raise Rt70Error(
-            f"{scene.name}: no RT-70 bearing joints {AZIMUTH_JOINT}, {ELEVATION_JOINT} "
-            "(the azimuth and elevation axes): no bearing loads"
-        )
+    mount_of(scene)  # one line naming the element when the scene has no axes
     if not has_scene_drives(scene):
         raise Rt70Error(
-            f"{scene.name}: needs a <rt70:drive> on each RT-70 axis to hold the pointing "
-            "(rt70_servo has them)"
+            f"{scene.name}: needs a <rt70:drive> on each axis of its <rt70:mount> to hold the "
+            "pointing"
         )
     if wind and not scene.description.winds:
         raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (docs/wind.md)")
 
 
 def check_case(case: LoadCase) -> None:
-    """Refuse a non-finite case, an elevation outside 0–90° or a negative wind speed."""
+    """Refuse a non-finite case, an elevation beyond a quarter turn or a negative wind speed.
+
+    The scene's own range is checked where the pointing is held
+    (:func:`rt70.model.antenna.pointing`).
+    """
     values = [case.elevation_deg, case.azimuth_deg, case.wind_speed, case.wind_from]
     if not np.isfinite(values).all():
         raise Rt70Error(f"load case must be finite, got {case}")
-    if not 0.0 <= case.elevation_deg <= 90.0:
-        raise Rt70Error(f"elevation {case.elevation_deg:g}° outside 0–90°")
+    if not -90.0 <= case.elevation_deg <= 180.0:
+        raise Rt70Error(f"elevation {case.elevation_deg:g}° outside -90…180°")
     if case.wind_speed < 0.0:
         raise Rt70Error(f"wind speed must not be negative, got {case.wind_speed:g} m/s")
 
@@ -195,8 +191,8 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
     then computes its own loads (wind Wrenches, the sector's mesh Wrenches at the
     elevation drive's torque) and reactions at it.
     """
+    from rt70.model.antenna import pointing
     from rt70.physics.aerodynamics import WindCondition
-    from rt70.scenes.rt70_state import rt70_pointing
     from rt70.telescope.scene_servo import SceneServoFactory, scene_equilibrium
 
     check_case(case)
@@ -208,7 +204,7 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
         ref, rd = scene.reference, scene.reference_data
         load = lambda q: ref_wind.wind_force(ref, rd, q, condition)  # noqa: E731
     couplings = SceneServoFactory(side="reference").couplings(scene)
-    held = rt70_pointing(case.elevation_deg, case.azimuth_deg)
+    held = pointing(scene, case.elevation_deg, case.azimuth_deg)
     q, K, residual = scene_equilibrium(scene, couplings, held, load=load)
     torques = {c.drive.name: float(k) for c, k in zip(couplings, K, strict=True)}
     drives = {c.drive.name: c.drive for c in couplings}
@@ -224,7 +220,8 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
     diff = float(np.max(np.abs(stacked_tb - stacked_ref)) / np.max(np.abs(stacked_ref)))
     model = scene.textbook
     g = float(np.linalg.norm(model.gravity))
-    below = _subtree_mass(scene, ELEVATION_JOINT)
+    azimuth_joint, elevation_joint = bearing_joints(scene)
+    below = _subtree_mass(scene, elevation_joint)
     return BearingLoads(
         case,
         azimuth=tb[0],
@@ -233,7 +230,7 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
         mesh_force=tb[3],
         vertical=tb[4],
         torques=torques,
-        weight_azimuth=_subtree_mass(scene, AZIMUTH_JOINT) * g,
+        weight_azimuth=_subtree_mass(scene, azimuth_joint) * g,
         weight_elevation=below * g,
         sides_difference=diff,
         residual=residual,
@@ -266,12 +263,13 @@ def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict,
     total = reactions.joint_reactions(model, data, q, zero, zero, loads)
     bearing = reactions.joint_reactions(model, data, q, zero, zero, loads + mesh)
     poses = reactions.joint_frames(model, data, q)
-    c_az, c_el = poses[AZIMUTH_JOINT][0], poses[ELEVATION_JOINT][0]
+    az, el = bearing_joints(scene)
+    c_az, c_el = poses[az][0], poses[el][0]
     up = -np.asarray(scene.description.gravity, dtype=float)
     up /= np.linalg.norm(up)
     vertical = (
-        float(up @ c_az @ total[AZIMUTH_JOINT][:3]),
-        float(up @ c_el @ total[ELEVATION_JOINT][:3]),
+        float(up @ c_az @ total[az][:3]),
+        float(up @ c_el @ total[el][:3]),
     )
     to_alidade = c_az.T @ c_el  # elevation joint axes → the alidade's
 
@@ -279,12 +277,20 @@ def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict,
         return np.concatenate([c @ w[:3], c @ w[3:]])
 
     return (
-        total[AZIMUTH_JOINT],
-        turned(to_alidade, bearing[ELEVATION_JOINT]),
-        turned(to_alidade, total[ELEVATION_JOINT]),
+        total[az],
+        turned(to_alidade, bearing[el]),
+        turned(to_alidade, total[el]),
         mesh_force,
         vertical,
     )
+
+
+def bearing_joints(scene: Scene) -> tuple[str, str]:
+    """The azimuth and elevation joints of the scene's ``<rt70:mount>``: its bearings."""
+    from rt70.model.antenna import mount_of
+
+    mount = mount_of(scene)
+    return mount.axis("azimuth").joint, mount.axis("elevation").joint
 
 
 def _subtree_mass(scene: Scene, joint: str) -> float:
@@ -332,8 +338,18 @@ def load_table(
     return [bearing_loads(scene, case) for case in cases]
 
 
-def format_table(scene_name: str, rows: list[BearingLoads]) -> str:
-    """The loads as a fixed-width text table (kN, kN·m), with the checks' extremes."""
+def format_table(scene_name: str, rows: list[BearingLoads], joints: tuple[str, str]) -> str:
+    """The loads as a fixed-width text table (kN, kN·m), with the checks' extremes.
+
+    Parameters
+    ----------
+    scene_name : str
+        The scene, for the title.
+    rows : list of BearingLoads
+        The cases (:func:`bearing_loads`).
+    joints : (str, str)
+        The azimuth and elevation joints (:func:`bearing_joints`).
+    """
     head = (
         f"{'elev':>5} {'wind':>11} | {'az axial':>9} {'radial':>8} {'overturn':>9} "
         f"{'reducer':>9} | {'el axial':>8} {'radial':>8} {'bending':>8} {'axis M':>7} "
@@ -346,8 +362,8 @@ def format_table(scene_name: str, rows: list[BearingLoads]) -> str:
     lines = [
         f"{scene_name}: bearing and reducer loads at the drive-held equilibrium "
         "(docs/reactions.md)",
-        "  azimuth: wrench across platform_rz; elevation: across base_rx, mesh force taken "
-        "out; both in the alidade's axes (z: azimuth axis, x: elevation axis)",
+        f"  azimuth: wrench across {joints[0]}; elevation: across {joints[1]}, mesh force "
+        "taken out; both in the alidade's axes (z: azimuth axis, x: elevation axis)",
         head,
         units,
     ]

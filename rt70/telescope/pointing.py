@@ -118,16 +118,16 @@ class PointingBudget:
 
 def budget_outputs(scene: Scene, case: PointingCase) -> list[Output]:
     """The mirror-system outputs of :data:`BUDGET_OUTPUTS` for the case's source."""
-    from rt70.scenes.rt70_optics import rt70_mirror_outputs
+    from rt70.model.antenna import pointing_outputs
 
-    found = {o.name: o for o in rt70_mirror_outputs(scene, case.elevation_deg, case.azimuth_deg)}
+    found = {o.name: o for o in pointing_outputs(scene, case.elevation_deg, case.azimuth_deg)}
     return [found[n] for n in BUDGET_OUTPUTS]
 
 
-def _held(case: PointingCase) -> dict[str, float]:
-    from rt70.scenes.rt70_state import rt70_pointing
+def _held(scene: Scene, case: PointingCase) -> dict[str, float]:
+    from rt70.model.antenna import pointing
 
-    return rt70_pointing(case.elevation_deg, case.azimuth_deg)
+    return pointing(scene, case.elevation_deg, case.azimuth_deg)
 
 
 def check_case(case: PointingCase) -> None:
@@ -142,17 +142,13 @@ def check_case(case: PointingCase) -> None:
 def check_scene(scene: Scene) -> None:
     """Refuse a scene that cannot give a budget, before any work.
 
-    It needs the RT-70 pointing axes, the mirror system's optical points, a
-    ``<rt70:drive>`` on each axis and at least one ``<rt70:wind>`` element.
+    It needs a ``<rt70:mount>``, an ``<rt70:optics>``, a ``<rt70:drive>`` on each
+    axis and at least one ``<rt70:wind>`` element.
     """
-    from rt70.scenes.rt70_optics import rt70_mirror_system
-    from rt70.scenes.rt70_state import missing_axes
+    from rt70.model.antenna import mirror_system
     from rt70.telescope.scene_servo import check_scene_drives
 
-    missing = missing_axes(scene.coordinate_names)
-    if missing:
-        raise Rt70Error(f"{scene.name}: no RT-70 pointing axis {', '.join(missing)}: no budget")
-    rt70_mirror_system(scene)  # raises naming the missing optical points
+    mirror_system(scene)  # raises naming the missing <rt70:mount> or <rt70:optics>
     check_scene_drives(scene)
     if not scene.description.winds:
         raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (see docs/wind.md)")
@@ -245,7 +241,7 @@ def wind_equilibria(scene: Scene, case: PointingCase, windy: WindyScene) -> Wind
     from rt70.telescope.scene_servo import SceneServoFactory, scene_equilibrium
 
     couplings = SceneServoFactory(side="reference").couplings(scene)
-    held = _held(case)
+    held = _held(scene, case)
     q0, K0, _ = scene_equilibrium(scene, couplings, held)
     q1, K1, res = scene_equilibrium(scene, couplings, held, load=windy.force)
     return WindState(q0, q1, K0, K1, [c.drive.name for c in couplings], res)

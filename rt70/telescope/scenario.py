@@ -15,13 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.model.antenna import SkyFrame, mirror_system, mount_of, optics_of
 from rt70.model.outputs import Output
 from rt70.model.scene import Scene
-from rt70.scenes.rt70_optics import rt70_mirror_system
-from rt70.scenes.rt70_state import (
-    POINTING_AXES,
-    missing_axes,
-)
 from rt70.simulation.result import SimulationResult
 from rt70.simulation.states import StateComponent
 from rt70.telescope.servo_tuning import holding_excess
@@ -165,12 +161,10 @@ def choose(
         cannot hold at that pointing.
     """
     asked = name is not None or elevation_deg is not None or azimuth_deg is not None
-    if missing_axes(scene.coordinate_names):
+    if scene.description.mount is None or scene.description.optics is None:
         if asked:
-            raise Rt70Error(
-                f"{scene.name}: --scenario/--elevation/--azimuth need the RT-70 pointing axes "
-                f"({', '.join(POINTING_AXES)})"
-            )
+            mount_of(scene)  # one line naming the element that is missing
+            optics_of(scene)
         return None, None
     elevation = DEFAULT_ELEVATION if elevation_deg is None else elevation_deg
     azimuth = azimuth_deg or 0.0
@@ -187,7 +181,7 @@ def choose(
 
 def mirror_axis_output(scene: Scene) -> Output:
     """The main mirror's focal axis ``(r5f − r5v)/|r5f − r5v|`` in ground axes (4.155)."""
-    system = rt70_mirror_system(scene)
+    system = mirror_system(scene)
 
     def formula(p: np.ndarray) -> np.ndarray:
         d = p[0] - p[1]
@@ -196,25 +190,23 @@ def mirror_axis_output(scene: Scene) -> Output:
     return Output(MIRROR_AXIS, "1", 3, (system.main_focus, system.main_vertex), formula)
 
 
-def elevation_azimuth(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Elevation E and azimuth A (rad) of mirror-axis directions (rows).
-
-    The inverse of the pointing's axis ``Rz(A) (0, −cos E, sin E)``
-    (:func:`rt70.scenes.rt70_state.rt70_pointing`).
-    """
-    axis = np.atleast_2d(axis)
-    return np.arcsin(np.clip(axis[:, 2], -1.0, 1.0)), np.arctan2(axis[:, 0], -axis[:, 1])
-
-
-def sky_error(axis: np.ndarray, target: np.ndarray) -> np.ndarray:
+def sky_error(frame: SkyFrame, axis: np.ndarray, target: np.ndarray) -> np.ndarray:
     """Cross-elevation and elevation error (arcsec) of mirror axes against targets (rows).
 
-    ``[(A − A_t) cos E_t, E − E_t]``: what the encoders of an elevation-over-azimuth
+    ``[(A − A_t) cos E_t, E − E_t]`` with E, A read by the mount's
+    :class:`~rt70.model.antenna.SkyFrame`: what the encoders of an elevation-over-azimuth
     mount see on the sky (a move in azimuth alone has no elevation error, unlike a
     projection of the chord ``axis − target``, whose second-order term is 15″ at 1°).
+
+    Parameters
+    ----------
+    frame : rt70.model.antenna.SkyFrame
+        The mount's sky frame (:func:`rt70.model.antenna.sky_frame`).
+    axis, target : numpy.ndarray, shape (n, 3)
+        Unit mirror axes and the target axes, ground axes.
     """
-    e, a = elevation_azimuth(axis)
-    e_t, a_t = elevation_azimuth(target)
+    e, a = frame.angles(axis)
+    e_t, a_t = frame.angles(target)
     da = (a - a_t + np.pi) % (2 * np.pi) - np.pi
     return np.column_stack([da * np.cos(e_t), e - e_t]) / RAD_PER_ARCSEC
 
@@ -226,7 +218,10 @@ class ScenarioRun:
     Angles in arc seconds, torques in N·m (axis side), times in s. ``axis_error`` is the
     reference minus the axis angle (the encoder's error) per axis; ``pointing_error`` the
     mirror axis against the target axis, (n_t, 2): cross-elevation, elevation;
-    ``pointing_error_total`` its angle. ``metrics`` holds the numbers of the summary.
+    ``pointing_error_total`` its angle; ``holding_torque`` the drives' torque at the start,
+    by axis. ``metrics`` holds the numbers of the summary; ``axis_signs`` each axis's
+    ``sign`` (``<rt70:axis>``: its coordinate is ``sign · (angle − zero)``; the
+    references are in coordinate radians).
     """
 
     scenario: Scenario
@@ -242,3 +237,4 @@ class ScenarioRun:
     holding_torque: dict[str, float]
     components: list[StateComponent] = field(default_factory=list)
     metrics: dict[str, float] = field(default_factory=dict)
+    axis_signs: dict[str, int] = field(default_factory=dict)

@@ -2,7 +2,7 @@
 
 One job: run the telescope with its drives closed around the nonlinear model
 (:func:`rt70.simulation.simulate.simulate` with :class:`rt70.control.servo.ServoDrive` components
-on the pointing axes ``platform_rz`` = azimuth and ``base_rx`` = π/2 − elevation) and measure
+on the axes of the scene's ``<rt70:mount>``) and measure
 what a servo engineer asks of it: settling time to 1″, overshoot, peak motor torque
 against its limit, pointing error in arc seconds and the tracking error after settling.
 
@@ -36,17 +36,11 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.guards.resources import check_time_series
 from rt70.linear.linearize import equilibrium, static_force
+from rt70.model.antenna import mount_of, pointing, pointing_outputs, sky_frame
 from rt70.model.outputs import evaluate
 from rt70.model.scene import Scene
 from rt70.model.sides import refuses_backend
-from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
-from rt70.scenes.rt70_optics import rt70_mirror_outputs
-from rt70.scenes.rt70_state import (
-    AZIMUTH_COORDINATE,
-    ELEVATION_COORDINATE,
-    missing_axes,
-    rt70_pointing,
-)
+from rt70.scenes.rt70_drives import DRIVES
 from rt70.simulation.simulate import sample_channels, simulate
 from rt70.simulation.states import StateComponent
 from rt70.telescope.scenario import (
@@ -60,7 +54,6 @@ from rt70.telescope.scenario import (
     Scenario,
     ScenarioRun,
     choose,
-    elevation_azimuth,
     mirror_axis_output,
     scenario,
     sky_error,
@@ -107,7 +100,6 @@ __all__ = [
     "axis_gains",
     "choose",
     "drive_parameters",
-    "elevation_azimuth",
     "holding_excess",
     "measure",
     "mirror_axis_output",
@@ -168,9 +160,7 @@ def run_scenario(
     progress : bool
         Show a progress bar on stderr.
     """
-    missing = missing_axes(scene.coordinate_names)
-    if missing:
-        raise Rt70Error(f"{scene.name}: no RT-70 pointing axis '{missing[0]}': no servo scenario")
+    mount_of(scene)  # one line naming the element a scene without axes lacks
     drives = servo_drives() if drives is None else drives
     start = _start(scene, sc, drives)
     q0, torques, _ = start
@@ -204,7 +194,7 @@ def _start(scene: Scene, sc: Scenario, drives: DriveFactory) -> tuple:
     torques on their coordinates (``rest`` None).
     """
     names = scene.coordinate_names
-    held = rt70_pointing(sc.elevation_deg, sc.azimuth_deg)
+    held = pointing(scene, sc.elevation_deg, sc.azimuth_deg)
     start = getattr(drives, "start", None)
     if start is None:
         q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
@@ -217,14 +207,17 @@ def _start(scene: Scene, sc: Scenario, drives: DriveFactory) -> tuple:
 
 
 def _axis_references(scene: Scene, sc: Scenario, q0: np.ndarray) -> dict[str, Reference]:
-    """The axes' references in coordinate radians: platform_rz = A, base_rx = π/2 − E."""
+    """The axes' references in coordinate radians, by joint: ``q0 + sign · offset``.
+
+    ``sign`` is the mount axis's (``q = sign · (angle − zero)``, ``<rt70:axis>``).
+    """
     names = scene.coordinate_names
-    a0 = q0[names.index(AZIMUTH_COORDINATE)]
-    e0 = q0[names.index(ELEVATION_COORDINATE)]
-    return {
-        AZIMUTH_COORDINATE: lambda t: a0 + np.radians(sc.azimuth(t)),
-        ELEVATION_COORDINATE: lambda t: e0 - np.radians(sc.elevation(t)),
-    }
+    offsets = {"azimuth": sc.azimuth, "elevation": sc.elevation}
+    refs = {}
+    for axis in mount_of(scene).axes:
+        start, sign, offset = q0[names.index(axis.joint)], axis.sign, offsets[axis.name]
+        refs[axis.joint] = lambda t, a=start, s=sign, f=offset: a + s * np.radians(f(t))
+    return refs
 
 
 def _sample_times(
@@ -265,26 +258,22 @@ def _measured(
     :func:`_start`'s.
     """
     names = scene.coordinate_names
-    ia, ie = names.index(AZIMUTH_COORDINATE), names.index(ELEVATION_COORDINATE)
     q0, torques, rest = start
     t = result.t
-    reference = {
-        "azimuth": np.array([refs[AZIMUTH_COORDINATE](x) for x in t]),
-        "elevation": np.array([refs[ELEVATION_COORDINATE](x) for x in t]),
-    }
-    error = {
-        "azimuth": (reference["azimuth"] - result.q[:, ia]) / RAD_PER_ARCSEC,
-        # elevation = π/2 − base_rx: its error is the coordinate's with the sign turned
-        "elevation": -(reference["elevation"] - result.q[:, ie]) / RAD_PER_ARCSEC,
-    }
+    reference, error = {}, {}
+    for axis in mount_of(scene).axes:
+        reference[axis.name] = np.array([refs[axis.joint](x) for x in t])
+        # the angle's error: the coordinate's times the axis's sign (q = sign·(angle − zero))
+        k = names.index(axis.joint)
+        error[axis.name] = axis.sign * (reference[axis.name] - result.q[:, k]) / RAD_PER_ARCSEC
     e_ref = sc.elevation_deg + np.array([sc.elevation(x) for x in t])
     a_ref = sc.azimuth_deg + np.array([sc.azimuth(x) for x in t])
     target = _target_axes(scene, q0, t, e_ref, a_ref, rest)
     n = result.outputs[MIRROR_AXIS]
-    pointing = sky_error(n, target)
+    sky = sky_error(sky_frame(scene), n, target)
     cosang = np.clip((n * target).sum(1), -1.0, 1.0)
     total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / RAD_PER_ARCSEC
-    torque, current, limits = _drive_torques(components, result, names)
+    torque, current, limits = _drive_torques(scene, components, result)
     static = _static_misalignment(scene, q0, sc)
     return ScenarioRun(
         sc,
@@ -294,11 +283,12 @@ def _measured(
         torque,
         limits,
         current,
-        pointing,
+        sky,
         total,
         static,
-        torques,
+        {a.name: torques[a.joint] for a in mount_of(scene).axes},
         list(components),
+        axis_signs={a.name: a.sign for a in mount_of(scene).axes},
     )
 
 
@@ -317,7 +307,7 @@ def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
     for k in knots:
         key = (round(float(e_ref[k]), 12), round(float(a_ref[k]), 12))
         if key not in cache:
-            held = rt70_pointing(*key)
+            held = pointing(scene, *key)
             q = equilibrium(scene, held, tol=EQUILIBRIUM_TOL) if rest is None else rest(held)
             cache[key] = evaluate(scene, q, [out], "reference")[MIRROR_AXIS]
         axes.append(cache[key])
@@ -329,13 +319,15 @@ def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
 
 def _static_misalignment(scene: Scene, q0: np.ndarray, sc: Scenario) -> float:
     """(4.157) of the main mirror at the start equilibrium: the gravity sag, arc seconds."""
-    outs = [o for o in rt70_mirror_outputs(scene, sc.elevation_deg, sc.azimuth_deg)]
+    outs = [o for o in pointing_outputs(scene, sc.elevation_deg, sc.azimuth_deg)]
     outs = [o for o in outs if o.name == "main_mirror_misalignment"]
     return float(evaluate(scene, q0, outs, "reference")["main_mirror_misalignment"][0])
 
 
-def _drive_torques(components: Sequence[StateComponent], result, names):
+def _drive_torques(scene: Scene, components: Sequence[StateComponent], result):
     """Axis-side reducer torque and motor current of each drive that has them."""
+    names = scene.coordinate_names
+    axis_of = {names.index(a.joint): a.name for a in mount_of(scene).axes}
     torque, current, limits = {}, {}, {}
     for c in components:
         if not hasattr(c, "reducer_torque"):
@@ -346,7 +338,7 @@ def _drive_torques(components: Sequence[StateComponent], result, names):
             [c.reducer_torque(q, qd, x) for q, qd, x in zip(result.q, result.qd, s, strict=True)]
         )
         current[axis] = s[:, 0]
-        table = AZIMUTH_DRIVE if c.index == names.index(AZIMUTH_COORDINATE) else ELEVATION_DRIVE
+        table = DRIVES[axis_of[c.index]]
         peak = getattr(getattr(c, "g", None), "current_limit", np.inf) * c.p.c_m * c.p.i_r
         limits[axis] = (table.nominal_torque, float(peak))
     return torque, current, limits

@@ -45,10 +45,11 @@ from rt70.control.friction import AxisFriction
 from rt70.control.servo import CascadeGains, cascade_gains
 from rt70.errors import Rt70Error
 from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
+from rt70.model.antenna import mount_of
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
 from rt70.model.sides import check_side
-from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE, FRICTION, AxisDrive
+from rt70.scenes.rt70_drives import DRIVES, FRICTION, AxisDrive
 from rt70.simulation.states import StateComponent
 from rt70.telescope.servo_tuning import (
     AXIS_TUNING,
@@ -58,8 +59,12 @@ from rt70.telescope.servo_tuning import (
     servo_tolerances,
 )
 
-#: The RT-70 table's axis by the coordinate its scene drive turns.
-AXES = {"platform_rz": AZIMUTH_DRIVE, "base_rx": ELEVATION_DRIVE}
+
+def axis_tables(scene: Scene) -> dict[str, AxisDrive]:
+    """The drive table of each axis of the scene's ``<rt70:mount>``, by the joint it turns."""
+    return {a.joint: DRIVES[a.name] for a in mount_of(scene).axes}
+
+
 #: Friction regularisation (docs/drive-train.md §2: ``rt70.reports.drivetrain``).
 FRICTION_WIDTH = 1e-6 * FRICTION.top_speed
 FRICTION_KIND = "linear"
@@ -84,7 +89,7 @@ def scene_axis_gains(
     p : DriveParameters
         The scene drive's lumped parameters (:func:`rt70.control.drives.drive_parameters`).
     axis : AxisDrive
-        The RT-70 table's axis it drives (:data:`AXES`): the limits and reference inertia.
+        The RT-70 table's axis it drives (:func:`axis_tables`): the limits and reference inertia.
     position_hz : float
         Bandwidth of the position loop, Hz.
     ratio : float
@@ -254,11 +259,14 @@ def scene_servos(
     as the factory's.
     """
     tuning = {**AXIS_TUNING, **(tuning or {})}
+    tables = axis_tables(scene)
     out = {}
     for d in scene.description.drives:
-        if d.joint not in AXES:
-            raise Rt70Error(f"{scene.name}: drive '{d.name}' turns '{d.joint}', not an RT-70 axis")
-        axis = AXES[d.joint]
+        if d.joint not in tables:
+            raise Rt70Error(
+                f"{scene.name}: drive '{d.name}' turns '{d.joint}', no axis of its <rt70:mount>"
+            )
+        axis = tables[d.joint]
         p = drive_parameters(d, axis.reference_inertia)
         out[d.name] = (p, scene_axis_gains(p, axis, *tuning[axis.name]))
     return out
@@ -305,11 +313,12 @@ class SceneServoFactory:
             drives = scene.description.drives
             if not drives:
                 raise Rt70Error(f"{scene.name}: no <rt70:drive>: use the coordinate drives")
+            tables = axis_tables(scene)
             for d in drives:
-                if d.joint not in AXES:
+                if d.joint not in tables:
                     raise Rt70Error(
-                        f"{scene.name}: drive '{d.name}' turns '{d.joint}', not an RT-70 axis "
-                        f"({', '.join(AXES)})"
+                        f"{scene.name}: drive '{d.name}' turns '{d.joint}', no axis of its "
+                        f"<rt70:mount> ({', '.join(tables)})"
                     )
             self._couplings[scene.name] = [SceneCoupling(scene, d, self.side) for d in drives]
         return self._couplings[scene.name]
@@ -324,10 +333,11 @@ class SceneServoFactory:
     def __call__(self, scene, q0, torques, references) -> list[StateComponent]:
         """The servos (and frictions), preset to hold ``torques`` at ``q0``."""
         names = scene.coordinate_names
+        tables = axis_tables(scene)
         out: list[StateComponent] = []
         for c in self.couplings(scene):
             joint = names[c.index]
-            axis = AXES[joint]
+            axis = tables[joint]
             p = drive_parameters(c.drive, axis.reference_inertia)
             gains = scene_axis_gains(p, axis, *self.tuning[axis.name])
             initial = preset_servo_state(p, gains, c.angle(q0), torques[joint])
@@ -354,15 +364,19 @@ DRIVE_MODELS = ("scene", "coordinate")
 
 
 def has_scene_drives(scene: Scene) -> bool:
-    """Whether every RT-70 axis of ``scene`` has a ``<rt70:drive>`` (rt70_servo has)."""
-    return set(AXES) <= {d.joint for d in scene.description.drives}
+    """Whether every axis of the scene's ``<rt70:mount>`` has a ``<rt70:drive>``."""
+    mount = scene.description.mount
+    if mount is None:
+        return False
+    return {a.joint for a in mount.axes} <= {d.joint for d in scene.description.drives}
 
 
 def check_scene_drives(scene: Scene) -> None:
-    """Refuse a scene without a ``<rt70:drive>`` on each RT-70 axis (:class:`Rt70Error`)."""
+    """Refuse a scene without a ``<rt70:drive>`` on each mount axis (:class:`Rt70Error`)."""
+    joints = [a.joint for a in mount_of(scene).axes]
     if not has_scene_drives(scene):
         raise Rt70Error(
-            f"{scene.name}: --drives scene needs a <rt70:drive> on each of {', '.join(AXES)}"
+            f"{scene.name}: --drives scene needs a <rt70:drive> on each of {', '.join(joints)}"
         )
 
 
@@ -403,7 +417,8 @@ def choose_drives(
         return base, "coordinate drives"
 
     def build(scene, q0, torques, references):
-        return base(scene, q0, torques, references) + axis_frictions(scene, list(AXES))
+        joints = [a.joint for a in mount_of(scene).axes]
+        return base(scene, q0, torques, references) + axis_frictions(scene, joints)
 
     return build, f"coordinate drives{extra}"
 
@@ -411,12 +426,13 @@ def choose_drives(
 def axis_frictions(scene: Scene, joints: list[str]) -> list[StateComponent]:
     """The book's dry friction (:data:`FRICTION_WIDTH`) on each of the axis ``joints``."""
     names = list(scene.coordinate_names)
+    tables = axis_tables(scene)
     return [
         AxisFriction(
-            f"{AXES[j].name}_friction",
+            f"{tables[j].name}_friction",
             names,
             j,
-            AXES[j].friction,
+            tables[j].friction,
             FRICTION_WIDTH,
             FRICTION_KIND,
             FRICTION_ATOL,

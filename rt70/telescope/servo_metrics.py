@@ -12,7 +12,6 @@ from __future__ import annotations
 import numpy as np
 
 from rt70.control.servo import CascadeGains
-from rt70.scenes.rt70_state import AZIMUTH_COORDINATE, ELEVATION_COORDINATE
 from rt70.telescope.scenario import ScenarioRun
 from rt70.units import ARCSEC_PER_DEG, RAD_PER_ARCSEC
 
@@ -122,9 +121,7 @@ def measure(run: ScenarioRun) -> dict[str, float]:
     for axis, tau in run.axis_torque.items():
         m[f"peak_torque_{axis}_Nm"] = float(np.abs(tau).max())
         m[f"peak_torque_{axis}_of_limit"] = float(np.abs(tau).max() / run.torque_limits[axis][1])
-        m[f"holding_torque_{axis}_Nm"] = run.holding_torque[
-            AZIMUTH_COORDINATE if axis == "azimuth" else ELEVATION_COORDINATE
-        ]
+        m[f"holding_torque_{axis}_Nm"] = run.holding_torque[axis]
     for i, axis in enumerate(("azimuth", "elevation")):
         step = sc.step_deg[i] * ARCSEC_PER_DEG
         if step:

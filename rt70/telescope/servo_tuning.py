@@ -18,13 +18,9 @@ from rt70.control.antiwindup import BackCalculationServo
 from rt70.control.geartrains import equivalent_drive
 from rt70.control.servo import CascadeGains, ServoDrive, cascade_gains
 from rt70.linear.linearize import equilibrium, static_force
+from rt70.model.antenna import mount_of, pointing
 from rt70.model.scene import Scene
-from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE, AxisDrive
-from rt70.scenes.rt70_state import (
-    AZIMUTH_COORDINATE,
-    ELEVATION_COORDINATE,
-    rt70_pointing,
-)
+from rt70.scenes.rt70_drives import DRIVES, AxisDrive
 from rt70.simulation.states import StateComponent
 
 #: Position-loop bandwidths (Hz) and the ratio between nested loops chosen for the
@@ -141,10 +137,8 @@ def servo_drives(tuning: dict[str, tuple[float, float]] | None = None) -> DriveF
     def build(scene, q0, torques, references):
         names = scene.coordinate_names
         out: list[StateComponent] = []
-        for coordinate, axis in (
-            (AZIMUTH_COORDINATE, AZIMUTH_DRIVE),
-            (ELEVATION_COORDINATE, ELEVATION_DRIVE),
-        ):
+        for mount_axis in mount_of(scene).axes:
+            coordinate, axis = mount_axis.joint, DRIVES[mount_axis.name]
             p = drive_parameters(axis)
             gains = axis_gains(axis, *tuning[axis.name])
             k = names.index(coordinate)
@@ -181,14 +175,12 @@ def holding_excess(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0)
     azimuth_deg : float
         The azimuth, degrees.
     """
-    held = rt70_pointing(elevation_deg, azimuth_deg)
+    held = pointing(scene, elevation_deg, azimuth_deg)
     q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
     Q0 = static_force(scene, q0)
     names = scene.coordinate_names
-    for coordinate, axis in (
-        (AZIMUTH_COORDINATE, AZIMUTH_DRIVE),
-        (ELEVATION_COORDINATE, ELEVATION_DRIVE),
-    ):
+    for mount_axis in mount_of(scene).axes:
+        coordinate, axis = mount_axis.joint, DRIVES[mount_axis.name]
         torque = abs(float(Q0[names.index(coordinate)]))
         if torque > axis.nominal_torque:
             return (

@@ -224,6 +224,43 @@ class Mount:
         raise KeyError(name)
 
 
+#: Reflector systems (``<rt70:optics type>``) and whether each has a secondary reflector.
+OPTICS_TYPES = {
+    "prime_focus": False,
+    "cassegrain": True,
+    "gregorian": True,
+    "beam_waveguide": True,
+}
+
+
+@dataclass(frozen=True)
+class Reflector:
+    """One reflector of an optics: its focus and vertex (names of optical points).
+
+    ``support`` is the link that carries a secondary reflector's drive (its frame gives
+    the drive's axes, book 4.1.8 frame 7c); None for the primary.
+    """
+
+    focus: str
+    vertex: str
+    support: str | None = None
+
+
+@dataclass(frozen=True)
+class Optics:
+    """The reflector system (``<rt70:optics>``): its type, reference frame and reflectors.
+
+    ``reference_link`` is the link whose frame is the reflector's reference frame (the
+    book's reference ring, OK): its z axis is the focal axis at construction.
+    ``secondary`` is None for a single reflector (``prime_focus``).
+    """
+
+    type: str
+    reference_link: str
+    primary: Reflector
+    secondary: Reflector | None = None
+
+
 #: Motor and reducer parameters of a ``<rt70:drive>``, in the order of
 #: :class:`rt70.bondgraph.parameters.DriveParameters` (without the load's ``J_l``, ``D_l``).
 DRIVE_PARAMETERS = ("L_a", "R_a", "c_m", "c_e", "J_m", "D_m", "i_r", "C_r", "D_r")
@@ -355,6 +392,8 @@ class RobotDescription:
         Linear velocity constraints (``<rt70:no_slip>``), in document order.
     mount : Mount or None
         The pointing axes (``<rt70:mount>``), if the file declares them.
+    optics : Optics or None
+        The reflector system (``<rt70:optics>``), if the file declares it.
     """
 
     name: str
@@ -373,6 +412,7 @@ class RobotDescription:
     loops: list[Loop] = field(default_factory=list)
     no_slips: tuple[NoSlip, ...] = ()
     mount: Mount | None = None
+    optics: Optics | None = None
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

@@ -71,7 +71,7 @@ def read_drive(
             need = "positive" if key in POSITIVE else "non-negative"
             raise reader.fail(ExtensionError, f"{where}: {key}={value:g} must be {need}")
         values[key] = value
-    sub = elem.find(f"{{{RT70_NS}}}sector")  # at most one (rt70.urdf.schema.RT70)
+    sub = elem.find(f"{{{RT70_NS}}}sector")  # at most one (rt70.urdf.vocabulary.RT70)
     sector = _sector(reader, sub, desc, name) if sub is not None else None
     if sector is not None and joint.type == "prismatic":
         raise reader.fail(

@@ -3,11 +3,11 @@
 One job: once the links and joints of the tree are read (:mod:`rt70.urdf.reader`), turn
 the ``<rt70:...>`` elements at the top of ``<robot>`` into the description's gravity,
 joint springs, bushings and strut packages, loops, drives, winds, air density, no-slip
-constraints, the mount and optical points, refusing what is wrong with an
+constraints, the mount, the optics and optical points, refusing what is wrong with an
 :class:`~rt70.errors.ExtensionError` naming the file and the element. The drives, winds,
-no-slip constraints and the mount have modules of their own (:mod:`rt70.urdf.drives`,
-:mod:`rt70.urdf.wind`, :mod:`rt70.urdf.no_slip`, :mod:`rt70.urdf.mount`); the others are
-read here.
+no-slip constraints, the mount and the optics have modules of their own
+(:mod:`rt70.urdf.drives`, :mod:`rt70.urdf.wind`, :mod:`rt70.urdf.no_slip`,
+:mod:`rt70.urdf.mount`, :mod:`rt70.urdf.optics`); the others are read here.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from rt70.urdf.drives import read_drive
 from rt70.urdf.elements import ZERO3, ElementReader
 from rt70.urdf.mount import read_mount
 from rt70.urdf.no_slip import read_no_slip
+from rt70.urdf.optics import read_optics
 from rt70.urdf.text import RT70_NS
 from rt70.urdf.wind import read_air, read_wind
 
@@ -44,7 +45,7 @@ def read_extensions(
 
     The lists of ``desc`` (springs, bushings, loops, drives, optical points) and its
     gravity are filled in place; the winds, the air density, the no-slip constraints and
-    the mount are set on a copy when the file has any.
+    the mount and the optics are set on a copy when the file has any.
 
     Parameters
     ----------
@@ -67,11 +68,12 @@ def read_extensions(
     air: list[float] = []
     no_slips: list = []
     mount: list = []
+    optics: list = []
     joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
     for elem in root:
         if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
             continue
-        kind = elem.tag[len(ns) :]  # one of rt70.urdf.schema.RT70's, checked
+        kind = elem.tag[len(ns) :]  # one of rt70.urdf.vocabulary.RT70's, checked
         if kind == "gravity":
             desc.gravity[:] = reader.numbers(elem, "xyz", 3)
         elif kind == "joint_spring":
@@ -92,6 +94,8 @@ def read_extensions(
             no_slips.append(read_no_slip(reader, elem, desc, no_slips))
         elif kind == "mount":
             mount.append(read_mount(reader, elem, joints))
+        elif kind == "optics":
+            optics.append(elem)  # read once every optical point of the file is known
         elif kind == "optical_point":
             name = reader.name_of(elem)
             link = reader.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
@@ -99,7 +103,7 @@ def read_extensions(
         else:  # a kind declared in RT70 must be read here, never skipped
             raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
     _check_unique_names(reader, desc)
-    if not (winds or air or no_slips or mount):
+    if not (winds or air or no_slips or mount or optics):
         return desc
     return dataclasses.replace(
         desc,
@@ -107,6 +111,7 @@ def read_extensions(
         air_density=air[0] if air else desc.air_density,
         no_slips=tuple(no_slips),
         mount=mount[0] if mount else None,
+        optics=read_optics(reader, optics[0], desc) if optics else None,
     )
 
 

@@ -31,7 +31,7 @@ def read_mount(reader: ElementReader, elem: ET.Element, joints: dict[str, Joint]
     reader : ElementReader
         The reader of the file (its name for messages, the attribute readers).
     elem : xml.etree.ElementTree.Element
-        The ``<rt70:mount>`` element, checked against :data:`rt70.urdf.schema.RT70`.
+        The ``<rt70:mount>`` element, checked against :data:`rt70.urdf.vocabulary.RT70`.
     joints : dict of str to Joint
         The file's joints by name.
 

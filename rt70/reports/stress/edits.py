@@ -224,6 +224,7 @@ def convert_units(text: str, length: float = 1.0, mass: float = 1.0) -> str:
     known = {_q(t) for t in ("gravity", "joint_spring", "bushing", "strut_package")}
     known.add(_q("optical_point"))
     known.add(_q("mount"))  # angles only: the same in every unit system
+    known.add(_q("optics"))  # names of links and points only
     for elem in root:
         if isinstance(elem.tag, str) and elem.tag.startswith(f"{{{RT70_NS}}}"):
             if elem.tag not in known:
