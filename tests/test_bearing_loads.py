@@ -61,11 +61,13 @@ def test_side_wind_loads_the_azimuth_reducer(servo):
 
 
 def test_bad_cases_and_scenes_are_refused(servo):
-    with pytest.raises(Rt70Error, match="outside 0–90"):
-        bl.check_case(bl.LoadCase(91.0))
+    with pytest.raises(Rt70Error, match="outside -90…180"):
+        bl.check_case(bl.LoadCase(181.0))
+    with pytest.raises(Rt70Error, match="outside its axis's range 0…90°"):
+        bl.bearing_loads(servo, bl.LoadCase(91.0))
     with pytest.raises(Rt70Error, match="finite"):
         bl.check_case(bl.LoadCase(np.nan))
-    with pytest.raises(Rt70Error, match="bearing joints"):
+    with pytest.raises(Rt70Error, match="declares no pointing axes"):
         bl.check_scene(load_scene("double_pendulum"), wind=False)
     with pytest.raises(Rt70Error, match="rt70:drive"):
         bl.check_scene(load_scene("rt70"), wind=False)
@@ -97,7 +99,7 @@ def _exit_code(argv: list[str]) -> int:
     ("argv", "message"),
     [
         (["--elevation", "0,,30"], "expected elevations"),
-        (["--elevation", "95"], "horizon"),
+        (["--elevation", "95"], "elevation 95° lies outside its axis's range 0…90°"),
         (["--direction", "90"], "--direction needs --wind"),
         (["--output", "loads.txt"], ".csv or .json"),
         (["--wind", "-3"], "--wind"),
@@ -112,4 +114,4 @@ def test_command_refuses_bad_options_in_one_line(argv, message, capsys):
 def test_command_refuses_a_scene_without_axes(capsys):
     assert _exit_code(["reactions", "double_pendulum"]) == 2
     err = capsys.readouterr().err
-    assert "no RT-70 bearing joints" in err and err.count("\n") == 1
+    assert "declares no pointing axes" in err and err.count("\n") == 1

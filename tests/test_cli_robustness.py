@@ -264,7 +264,7 @@ def no_work(monkeypatch):
         (["simulate", "rt70", "--method", "Euler"], "--method"),
         (["simulate", "rt70", "--side", "mujoco"], "--side"),
         (["modes", "rt70", "--elevation", "200"], "--elevation"),
-        (["modes", "rt70", "--elevation", "-1"], "--elevation"),
+        (["modes", "rt70", "--elevation", "-91"], "--elevation"),
         (["modes", "rt70", "--azimuth", "nan"], "--azimuth"),
         (["validate", "rt70", "--samples", "0"], "--samples"),
         (["validate", "rt70", "--samples", "two"], "--samples"),
@@ -428,7 +428,7 @@ def test_sigterm_during_the_renames_is_deferred_until_both_are_done(tmp_path):
 def test_simulate_writes_the_set(tmp_path, capsys):
     out = tmp_path / "run.npz"
     assert main(["simulate", "double_pendulum", "--t-end", "0.05", "--out", str(out)]) == 0
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz", "run.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz", "run.png", "run.units.json"]
     assert f"wrote {out}" in capsys.readouterr().out
 
 

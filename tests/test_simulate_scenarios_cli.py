@@ -61,7 +61,7 @@ def test_free_axes_runs_the_structural_benchmark(capsys):
         (["rt70_servo", "--free-axes", "--scenario", "hold"], "--free-axes"),
         (["rt70_servo", "--free-axes", "--elevation", "30"], "--free-axes"),
         (["rt70_servo", "--scenario", "wobble"], "invalid choice"),
-        (["rt70_servo", "--elevation", "95"], "horizon"),
+        (["rt70_servo", "--elevation", "95"], "elevation 95° lies outside its axis's range 0…90°"),
         ([str(ALL_JOINTS), "--scenario", "hold"], "pointing axes"),
         (["rt70", "--scenario", "hold"], "errata"),
     ],

@@ -273,7 +273,7 @@ def no_work(monkeypatch):
         (["--scale", "stiffness"], "is not NAME=VALUES"),
         (["--workers", "-1"], "argument --workers"),
         (["--chunk", "0"], "argument --chunk"),
-        (["--elevation", "91"], "--elevation: the RT-70 points from 0° to 90°"),
+        (["--elevation", "181"], "--elevation: elevations lie between -90° and 180°"),
         (["--wind", "-5"], "--wind: speeds must be at least 0"),
         (["--scale", "stiffness=0,1"], "factors must be greater than 0"),
         (["--scale", "damping=1", "--scale", "damping=2"], "named twice"),
@@ -300,7 +300,22 @@ def test_bad_output_path_exits_2(no_work, tmp_path, capsys):
 
 def test_scene_without_pointing_axes_exits_2(tmp_path, capsys):
     assert main(["sweep", "three_masses", "--out", str(tmp_path / "s.npz")]) == 2
-    assert "no RT-70 pointing axis" in one_error_line(capsys.readouterr().err)
+    err = one_error_line(capsys.readouterr().err)
+    assert "no pointing axes to sweep" in err and "<rt70:mount>" in err
+
+
+def test_an_elevation_outside_the_scene_s_range_exits_2_before_the_cluster(
+    monkeypatch, tmp_path, capsys
+):
+    def forbidden(*args, **kwargs):
+        raise AssertionError("the cluster started before the grid was checked")
+
+    monkeypatch.setattr("rt70.sweep.cluster.local_cluster", forbidden)
+    out = tmp_path / "s.npz"
+    assert main(["sweep", SCENE, "--out", str(out), "--elevation", "91"]) == 2
+    err = one_error_line(capsys.readouterr().err)
+    assert "--elevation 91" in err and "from 0° to 90°" in err and "<rt70:axis" in err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_unreachable_scheduler_exits_2_quickly(tmp_path, capsys):

@@ -337,7 +337,9 @@ def asked_pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, fl
     if elevation is None:
         axis = mount_of(scene).axis("elevation")
         elevation = min(max(90.0, math.degrees(axis.lower)), math.degrees(axis.upper))
-    return True, elevation, azimuth, pointing(scene, elevation, azimuth)
+    with option_at_fault(f"--elevation {elevation:g} --azimuth {azimuth:g}"):
+        held = pointing(scene, elevation, azimuth)
+    return True, elevation, azimuth, held
 
 
 # --- values checked where they are used ------------------------------------------------

@@ -143,10 +143,12 @@ def _print_solver(result) -> None:
 def _write_simulation(out, result, figure) -> None:
     """The trajectory and its figure (``.png`` beside it), written together atomically."""
     from rt70.guards.atomic import atomic_write_all
+    from rt70.simulation.result import units_path
 
     writers = {out: result.writer(out)}
     if figure is not None:
         writers[out.with_suffix(".png")] = lambda tmp: figure.savefig(tmp, dpi=110)
+    writers[units_path(out)] = result.units_writer(out)
     for path in atomic_write_all(writers):  # the trajectory and its plot appear together
         print(f"  wrote {path}")
 
@@ -217,7 +219,11 @@ def add_parser(
     sim.add_argument(
         "--rtol", type=options.rtol, default=1e-6, help="relative tolerance, 0 < rtol < 1"
     )
-    sim.add_argument("--out", help="output file, .csv or .npz (a .png plot beside it)")
+    sim.add_argument(
+        "--out",
+        help="output file, .csv or .npz (the unit of every column in NAME.units.json and a "
+        ".png plot beside it)",
+    )
     sim.add_argument("--no-plot", action="store_true", help="do not write the plot")
     sim.add_argument("--progress", action="store_true", help="progress bar on stderr")
     sim.set_defaults(func=_simulate)

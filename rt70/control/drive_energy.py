@@ -57,6 +57,10 @@ class AuditedDrive(StateComponent):
         self.initial = np.concatenate([np.asarray(drive.initial, dtype=float), np.zeros(4)])
         self.atol = np.concatenate([np.asarray(drive.atol, dtype=float), np.full(4, atol)])
 
+    def unit(self, name: str) -> str:
+        """The drive's unit for its own states, J for the four flows."""
+        return self.drive.unit(name) if name in self.drive.names else "J"
+
     def force(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> np.ndarray:
         """The drive's generalised force, from its own states.
 

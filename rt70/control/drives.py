@@ -27,6 +27,7 @@ friction and backlash are not modelled.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import ClassVar
 
 import numpy as np
 
@@ -69,6 +70,11 @@ class DcDrive(StateComponent):
 
     #: The drive's states (after ``name:``); a subclass appends its own.
     STATES: tuple[str, ...] = ("current", "motor_angle", "motor_speed")
+    STATE_UNITS: ClassVar[dict[str, str]] = {
+        "current": "A",
+        "motor_angle": "rad",
+        "motor_speed": "rad/s",
+    }
 
     def __init__(
         self,

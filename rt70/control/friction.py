@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import ClassVar, Protocol
 
 import numpy as np
 
@@ -156,6 +156,8 @@ class AxisFriction(StateComponent):
     atol : float
         Absolute tolerance of the dissipated heat, J.
     """
+
+    STATE_UNITS: ClassVar[dict[str, str]] = {"dissipated": "J"}
 
     def __init__(
         self,

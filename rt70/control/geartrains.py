@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -170,6 +171,11 @@ class TwoTrainDrive(StateComponent):
     """
 
     STATES: tuple[str, ...] = tuple(f"{s}{k}" for k in (1, 2) for s in TRAIN_STATES)
+    STATE_UNITS: ClassVar[dict[str, str]] = {
+        f"{s}{k}": u
+        for k in (1, 2)
+        for s, u in zip(TRAIN_STATES, ("A", "rad", "rad/s"), strict=True)
+    }
 
     def __init__(
         self,
@@ -322,6 +328,13 @@ class TwoTrainServo(TwoTrainDrive):
     """
 
     STATES = TwoTrainDrive.STATES + ("int_position", "int_rate", "int_current1", "int_current2")
+    STATE_UNITS: ClassVar[dict[str, str]] = {
+        **TwoTrainDrive.STATE_UNITS,
+        "int_position": "rad·s",
+        "int_rate": "rad",
+        "int_current1": "A·s",
+        "int_current2": "A·s",
+    }
 
     def __init__(
         self,

@@ -22,6 +22,7 @@ reducer) lies above the rate loop: below it, the loops must be designed on the p
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -145,6 +146,12 @@ class ServoDrive(DcDrive):
     """
 
     STATES = DcDrive.STATES + ("int_position", "int_rate", "int_current")
+    STATE_UNITS: ClassVar[dict[str, str]] = {
+        **DcDrive.STATE_UNITS,
+        "int_position": "rad·s",
+        "int_rate": "rad",
+        "int_current": "A·s",
+    }
 
     def __init__(
         self,

@@ -2,12 +2,14 @@
 
 :class:`SimulationResult` holds one run of :func:`rt70.simulation.simulate.simulate`
 (the samples, the energies of the audit and their balance, the extra states, the
-outputs, the solver's statistics and timing) and writes itself atomically as ``.npz``
-or ``.csv`` (:data:`OUTPUT_SUFFIXES`).
+outputs, the measured series of an analysis, the solver's statistics and timing) and
+writes itself atomically as ``.npz`` or ``.csv`` (:data:`OUTPUT_SUFFIXES`), with the
+unit of every column or array in a sidecar ``<name>.units.json`` (:meth:`units`).
 """
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,7 +44,11 @@ class SimulationResult:
     difference-quotient Jacobian), "jacobian" (s inside the analytic Jacobian) and
     "integrator" (the rest: the solver's own work, its linear algebra included).
     ``nlu`` is −1 where the solver does not report it (CVODE), ``n_steps`` −1 when
-    ``t_eval`` was given.
+    ``t_eval`` was given. ``coordinate_units`` holds each coordinate's unit ("rad" or
+    "m"), ``output_units`` and ``state_units`` the outputs' and the extra states' by name;
+    ``series`` holds what an analysis measured on the run (a servo scenario's references,
+    errors, torques and currents, :mod:`rt70.telescope.scenarios`), each an (n_t,) array,
+    with its unit in ``series_units``.
     """
 
     scene: str
@@ -74,6 +80,11 @@ class SimulationResult:
     constraint_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))
     t_events: list[np.ndarray] = field(default_factory=list)
     timing: dict[str, float] = field(default_factory=dict)
+    coordinate_units: list[str] = field(default_factory=list)
+    output_units: dict[str, str] = field(default_factory=dict)
+    state_units: dict[str, str] = field(default_factory=dict)
+    series: dict[str, np.ndarray] = field(default_factory=dict)
+    series_units: dict[str, str] = field(default_factory=dict)
 
     @property
     def relative_drift(self) -> float:
@@ -113,6 +124,7 @@ class SimulationResult:
             if self.constraint_residual.size:  # closed chains: max |Φ| per sample
                 arrays["constraint_residual"] = self.constraint_residual
             arrays.update({f"output:{k}": v for k, v in self.outputs.items()})
+            arrays.update({f"series:{k}": v for k, v in self.series.items()})
             return lambda tmp: np.savez_compressed(tmp, **arrays)
         extra = self._component_states()
         names = ["t"] + [f"q:{c}" for c in self.coordinates] + [f"qd:{c}" for c in self.coordinates]
@@ -128,13 +140,61 @@ class SimulationResult:
         for name, values in self.outputs.items():  # rt70.model.outputs, one column per component
             names += column_labels(name, values.shape[1])
             table = np.column_stack([table, values])
+        for name, values in self.series.items():
+            names.append(f"series:{name}")
+            table = np.column_stack([table, values])
         lines = [",".join(names)] + [",".join(f"{x:.17g}" for x in row) for row in table]
         text = "\n".join(lines) + "\n"
         return lambda tmp: tmp.write_text(text, encoding="utf-8", newline="\n")
 
+    def units(self, path: str | Path) -> dict[str, str]:
+        """The unit of every column (``.csv``) or array (``.npz``) of the file ``path``.
+
+        Coordinates in rad or m (their joints' kind), velocities per second, energies in
+        J, each state, output and series in its own unit; "unknown" only for a state
+        whose component declares none (:attr:`rt70.simulation.states.StateComponent.STATE_UNITS`).
+        """
+        csv = check_output_suffix(path) == ".csv"
+        units = {"t": "s"}
+        for c, u in zip(self.coordinates, self.coordinate_units, strict=True):
+            units[f"q:{c}" if csv else "q"] = u if csv else "rad or m (coordinate_units)"
+            units[f"qd:{c}" if csv else "qd"] = f"{u}/s" if csv else "rad/s or m/s"
+        for name in ("kinetic", "gravity", "elastic", "dissipated", "input_work", "balance"):
+            units[name] = "J"
+        units.update({f"state:{k}": self.state_units[k] for k in self._component_states()})
+        if self.constraint_residual.size:
+            units["constraint_residual"] = "m or rad"
+        for name, values in self.outputs.items():
+            unit = self.output_units[name]
+            if csv:
+                units.update({label: unit for label in column_labels(name, values.shape[1])})
+            else:
+                units[f"output:{name}"] = unit
+        units.update({f"series:{k}": self.series_units[k] for k in self.series})
+        if not csv:
+            units["coordinates"] = "names"
+        return units
+
+    def units_writer(self, path: str | Path) -> Callable[[Path], None]:
+        """The function that writes :meth:`units` as JSON, for ``<name>.units.json``."""
+        header = {
+            "scene": self.scene,
+            "side": self.side,
+            "file": Path(path).name,
+            "coordinate_units": dict(zip(self.coordinates, self.coordinate_units, strict=True)),
+            "units": self.units(path),
+        }
+        text = json.dumps(header, indent=1, ensure_ascii=False) + "\n"
+        return lambda tmp: tmp.write_text(text, encoding="utf-8")
+
     def _component_states(self) -> dict[str, np.ndarray]:
         """The extra states other than the energy audit's (written as ``state:<name>``)."""
         return {k: v for k, v in self.states.items() if k not in EnergyAudit.names}
+
+
+def units_path(path: str | Path) -> Path:
+    """Where the units of a result file go: ``run.csv`` → ``run.units.json``."""
+    return Path(path).with_suffix(".units.json")
 
 
 def check_output_suffix(path: str | Path) -> str:

@@ -135,7 +135,16 @@ def simulate(
     passive = inputs is None and not rhs.pushed
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
     result.outputs = evaluate_trajectory(scene, result.q, outputs, side)
+    result.output_units = {o.name: o.unit for o in outputs}
+    result.state_units = {n: c.unit(n) for c in layout.components for n in c.names}
+    result.coordinate_units = coordinate_units(scene)
     return result
+
+
+def coordinate_units(scene: Scene) -> list[str]:
+    """Each coordinate's unit: "m" for a prismatic joint's, "rad" for any other's."""
+    kinds = {j.name: j.type for j in scene.description.joints}
+    return ["m" if kinds.get(c) == "prismatic" else "rad" for c in scene.textbook.coordinate_names]
 
 
 def _checked_request(

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
@@ -66,6 +66,14 @@ class StateComponent(ABC):
     names: tuple[str, ...]
     initial: np.ndarray
     atol: np.ndarray
+
+    #: Unit of each state by the last part of its name (``current`` of
+    #: ``azimuth:current``); a state not listed is written with the unit "unknown".
+    STATE_UNITS: ClassVar[dict[str, str]] = {}
+
+    def unit(self, name: str) -> str:
+        """The unit of the state ``name`` (one of :attr:`names`), from :attr:`STATE_UNITS`."""
+        return self.STATE_UNITS.get(name.rsplit(":", 1)[-1], "unknown")
 
     @abstractmethod
     def derivative(
@@ -117,6 +125,7 @@ class EnergyAudit(StateComponent):
     """
 
     names = ("dissipated", "input_work")
+    STATE_UNITS: ClassVar[dict[str, str]] = {"dissipated": "J", "input_work": "J"}
 
     def __init__(self, atol: float) -> None:
         self.initial = np.zeros(2)

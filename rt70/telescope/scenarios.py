@@ -275,6 +275,13 @@ def _measured(
     total = np.arctan2(np.linalg.norm(np.cross(n, target), axis=1), cosang) / RAD_PER_ARCSEC
     torque, current, limits = _drive_torques(scene, components, result)
     static = _static_misalignment(scene, q0, sc)
+    _record_series(result, {"elevation": e_ref, "azimuth": a_ref}, error, sky, total)
+    for axis in torque:
+        result.series[f"torque:{axis}"], result.series_units[f"torque:{axis}"] = torque[axis], "N·m"
+        result.series[f"current:{axis}"], result.series_units[f"current:{axis}"] = (
+            current[axis],
+            "A",
+        )
     return ScenarioRun(
         sc,
         result,
@@ -290,6 +297,22 @@ def _measured(
         list(components),
         axis_signs={a.name: a.sign for a in mount_of(scene).axes},
     )
+
+
+def _record_series(result, reference_deg: dict, error: dict, sky, total) -> None:
+    """What the run prints, kept with it: references, encoder and pointing errors."""
+    for axis, values in reference_deg.items():
+        result.series[f"reference:{axis}"], result.series_units[f"reference:{axis}"] = (
+            np.asarray(values, dtype=float),
+            "deg",
+        )
+    for axis, values in error.items():
+        result.series[f"encoder_error:{axis}"] = values
+        result.series_units[f"encoder_error:{axis}"] = "arcsec"
+    pointing = {"cross_elevation": sky[:, 0], "elevation": sky[:, 1], "total": total}
+    for name, values in pointing.items():
+        result.series[f"pointing_error:{name}"] = values
+        result.series_units[f"pointing_error:{name}"] = "arcsec"
 
 
 def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
