@@ -18,7 +18,6 @@ from rt70.telescope import scenarios as S
 from rt70.telescope.scene_servo import (
     SceneServoFactory,
     choose_drives,
-    scene_axis_gains,
     scene_equilibrium,
 )
 from rt70.testing import assert_close
@@ -93,8 +92,8 @@ def test_torque_limit_is_the_tables_for_either_lumping(started):
         assert_close(g.current_limit * p.c_m * p.i_r, 9.80666e7, rel=1e-5)
         assert_close(g.voltage_limit, 440.0, rel=1e-6)
     for axis in (AZIMUTH_DRIVE, ELEVATION_DRIVE):
-        p = S.drive_parameters(axis)
-        g = scene_axis_gains(p, axis, 0.2, 5.0)
+        p = S.drive_parameters(axis)  # the table's motors in series
+        g = S.axis_gains(axis, 0.2, 5.0)
         assert_close(g.current_limit * p.c_m * p.i_r, 9.80666e7, rel=1e-5)
         assert_close(g.voltage_limit, 880.0, rel=1e-6)
 
@@ -139,7 +138,7 @@ def test_choose_drives(servo_scene):
     )
     factory, _ = choose_drives(servo_scene, "scene", friction=True)
     assert factory.friction
-    with pytest.raises(Rt70Error, match="rt70:drive"):
+    with pytest.raises(Rt70Error, match="declares no servo: add an <rt70:servo>"):
         choose_drives(load_scene("rt70"), "scene")
 
 

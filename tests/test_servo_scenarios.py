@@ -16,7 +16,10 @@ from test_servo import STIFF
 from rt70.control.antiwindup import BackCalculationServo
 from rt70.control.servo import ServoDrive, cascade_gains
 from rt70.errors import Rt70Error
+from rt70.linear.linearize import equilibrium, static_force
+from rt70.model.antenna import pointing
 from rt70.model.scene import load_scene, scene_from_text
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
 from rt70.simulation.states import MechanicsForces
 from rt70.telescope import scenarios as S
 from rt70.testing import assert_close
@@ -41,7 +44,7 @@ def test_hold_has_no_start_up_transient(servo_scene):
     # within the solver's absolute tolerance on angles, in arc seconds
     assert_close(m["pointing_drift_arcsec"], 0.0, rel=1.0, scale=run.result.atol / RAD_PER_ARCSEC)
     hold = m["holding_torque_elevation_Nm"]
-    assert 1.0e7 < hold < S.ELEVATION_DRIVE.nominal_torque  # gravity torque, within the drive
+    assert 1.0e7 < hold < ELEVATION_DRIVE.nominal_torque  # gravity torque, within the drive
     torque = run.axis_torque["elevation"]
     assert_close(torque, np.full_like(torque, hold), rel=1e-6)
     # the audit balances (measured 1.0e-8): a relative drift, scale 1
@@ -64,7 +67,7 @@ def test_small_elevation_step_settles_as_derived(servo_scene):
     run = S.run_scenario(servo_scene, sc)
     m = run.metrics
     predicted = S.predicted_settling(
-        step, S.axis_gains(S.ELEVATION_DRIVE, *S.AXIS_TUNING["elevation"])
+        step, S.axis_gains(ELEVATION_DRIVE, *S.declared_tuning(servo_scene)["elevation"])
     )
     assert_close(m["predicted_settle_s"], predicted, rel=1e-12)  # the step is 20/3600·3600
     assert_close(m["axis_settle_s"], predicted, rel=0.1)
@@ -82,7 +85,7 @@ def test_tracking_error_is_bounded(servo_scene):
     """
     run = S.run_scenario(servo_scene, S.scenario("track", 45.0, 0.0, 4.0))
     error = run.axis_error["azimuth"]
-    bound = S.SIDEREAL_ARCSEC_PER_S / (2 * np.pi * S.AXIS_TUNING["azimuth"][0])
+    bound = S.SIDEREAL_ARCSEC_PER_S / (2 * np.pi * S.declared_tuning(servo_scene)["azimuth"][0])
     assert 1.0 < np.abs(error).max() < bound, np.abs(error).max()
     assert abs(error[-1]) < 0.8 * np.abs(error).max()  # past its peak, coming down
     # the pointing error is the encoder error seen on the sky (cross-elevation: × cos E),
@@ -91,9 +94,9 @@ def test_tracking_error_is_bounded(servo_scene):
     assert_close(abs(cross[-1]), abs(error[-1]) * np.cos(np.radians(45)), rel=0.025)
 
 
-def test_predicted_settling_slews_at_the_rate_limit():
+def test_predicted_settling_slews_at_the_rate_limit(servo_scene):
     """Past the linear range, one more degree of step costs exactly 1°/Ω of slewing."""
-    g = S.axis_gains(S.AZIMUTH_DRIVE, *S.AXIS_TUNING["azimuth"])
+    g = S.axis_gains(AZIMUTH_DRIVE, *S.declared_tuning(servo_scene)["azimuth"])
     t1, t2 = S.predicted_settling(3600.0, g), S.predicted_settling(7200.0, g)
     assert_close(t2 - t1, 3600.0 * RAD_PER_ARCSEC / g.rate_limit, rel=1e-9)
     assert S.predicted_settling(0.5, g) == 0.0  # already inside the band: the branch's 0
@@ -127,13 +130,22 @@ def test_bad_scenarios_are_refused(servo_scene):
     with pytest.raises(Rt70Error, match="positive"):
         S.scenario("hold", 45.0, 0.0, 0.0)
     rotor = scene_from_text(ROTOR, "rotor")
-    with pytest.raises(Rt70Error, match="pointing axis"):
+    with pytest.raises(Rt70Error, match="declares no pointing axes: add an <rt70:mount>"):
         S.run_scenario(rotor, S.scenario("hold", 45.0, 0.0, 1.0))
 
 
 def test_listing_as_printed_cannot_be_held(servo_scene):
     """Errata 12: the listing's gravity torque at the horizon is 2.66× the nominal drive
     torque; with its counterweight below the axis (rt70_servo) 0.41×."""
-    excess = S.holding_excess(load_scene("rt70"), 0.0)
-    assert excess is not None and "errata" in excess and "1.3e+08" in excess
+    listing = load_scene("rt70")
+    q0 = equilibrium(listing, pointing(listing, 0.0), tol=S.EQUILIBRIUM_TOL)
+    torque = abs(static_force(listing, q0)[listing.coordinate_names.index("base_rx")])
+    assert_close(torque / ELEVATION_DRIVE.nominal_torque, 2.66, rel=5e-3)
+    with pytest.raises(Rt70Error, match="declares no servo"):  # the listing has no drives
+        S.holding_excess(listing, 0.0)
     assert S.holding_excess(servo_scene, 0.0) is None
+    loaded = scene_from_text(
+        servo_scene.text.replace('nominal_torque="4.903325e+07"', 'nominal_torque="1e7"'), "weak"
+    )
+    excess = S.holding_excess(loaded, 0.0)
+    assert excess is not None and "elevation" in excess and "nominal 1e+07 N·m" in excess

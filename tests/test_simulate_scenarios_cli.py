@@ -45,7 +45,8 @@ def test_servo_scene_runs_a_scenario_and_writes_its_figure(tmp_path, capsys):
 def test_listing_as_printed_runs_the_structural_benchmark_with_a_hint(capsys):
     assert main(["simulate", "rt70", "--t-end", "0.01"]) == 0
     text = capsys.readouterr().out
-    assert "cannot hold" in text and "rt70 simulate rt70_servo" in text
+    assert "declare no <rt70:servo>" in text and "could not hold it" in text
+    assert "rt70 simulate rt70_servo" in text
     assert "balance drift" in text  # today's benchmark output
 
 
@@ -63,7 +64,7 @@ def test_free_axes_runs_the_structural_benchmark(capsys):
         (["rt70_servo", "--scenario", "wobble"], "invalid choice"),
         (["rt70_servo", "--elevation", "95"], "elevation 95° lies outside its axis's range 0…90°"),
         ([str(ALL_JOINTS), "--scenario", "hold"], "pointing axes"),
-        (["rt70", "--scenario", "hold"], "errata"),
+        (["rt70", "--scenario", "hold"], "declares no servo: add an <rt70:servo>"),
     ],
 )
 def test_bad_options_are_refused_in_one_line(args, message, capsys):

@@ -19,6 +19,7 @@ import numpy as np
 from rt70.control.servo import ServoDrive
 from rt70.linear.linearize import equilibrium, static_force
 from rt70.model.scene import load_scene
+from rt70.scenes.rt70_drives import AZIMUTH_DRIVE, ELEVATION_DRIVE
 from rt70.scenes.rt70_state import rt70_pointing
 from rt70.simulation.simulate import simulate
 from rt70.telescope import scenarios as S
@@ -28,7 +29,7 @@ from rt70.units import RAD_PER_ARCSEC
 def run(scene, q0, Q, axis, hz, ratio, step, t_end):
     names = scene.coordinate_names
     comps = []
-    for coord, drive in (("platform_rz", S.AZIMUTH_DRIVE), ("base_rx", S.ELEVATION_DRIVE)):
+    for coord, drive in (("platform_rz", AZIMUTH_DRIVE), ("base_rx", ELEVATION_DRIVE)):
         p, k = S.drive_parameters(drive), names.index(coord)
         s = step if drive.name == axis else 0.0
         g = S.axis_gains(drive, *((hz, ratio) if drive.name == axis else (0.2, 4.0)))
@@ -64,7 +65,7 @@ def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "axis",
-        choices=(S.AZIMUTH_DRIVE.name, S.ELEVATION_DRIVE.name),
+        choices=(AZIMUTH_DRIVE.name, ELEVATION_DRIVE.name),
         metavar="AXIS",
         help="the axis stepped: azimuth or elevation",
     )

@@ -134,7 +134,9 @@ def main(argv: list[str]) -> int:
     report = {
         "scene": scene.name,
         "drives": label,
-        "tuning": {k: {"position_hz": v[0], "ratio": v[1]} for k, v in S.AXIS_TUNING.items()},
+        "tuning": {
+            k: {"position_hz": v[0], "ratio": v[1]} for k, v in S.declared_tuning(scene).items()
+        },
         "targets": rows,
         "runs": {
             name: {

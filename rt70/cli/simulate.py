@@ -15,6 +15,9 @@ from collections.abc import Callable
 from rt70.cli import options
 from rt70.errors import ResourceError, Rt70Error
 
+#: The RT-70 listing as printed, and its control object (a hint for the first).
+LISTING, SERVO_SCENE = "rt70", "rt70_servo"
+
 
 def _simulate(args: argparse.Namespace) -> int:
     from pathlib import Path
@@ -89,6 +92,12 @@ def _servo_scenario(args: argparse.Namespace, scene):
     sc, hint = scenarios.choose(scene, args.scenario, args.elevation, args.azimuth, args.t_end)
     if hint:
         print(f"{scene.name}: {hint}")
+    if hint and scene.name == LISTING:
+        print(
+            f"{scene.name}: the listing as printed has no drives, and drives of the book's "
+            f"torque could not hold it (docs/rt70-errata.md item 12); 'rt70 simulate "
+            f"{SERVO_SCENE}' runs the telescope held by its servo"
+        )
     return sc
 
 
@@ -110,9 +119,10 @@ def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
         progress=args.progress or sys.stderr.isatty(),
     )
     result = run.result
+    tuning = scenarios.tuning_text(scenarios.declared_tuning(scene))
     print(
         f"{scene.name}: {sc.name} at elevation {sc.elevation_deg:g}°, azimuth "
-        f"{sc.azimuth_deg:g}°, {label} and servo holding ({scenarios.tuning_text()}); "
+        f"{sc.azimuth_deg:g}°, {label} and servo holding ({tuning}); "
         f"{result.method} ({args.side}), rtol {args.rtol:g}, 0 … {sc.t_end:g} s: ok"
     )
     _print_solver(result)

@@ -127,6 +127,30 @@ def _labels(y: Output) -> list[str]:
     return column_labels(y.name, y.size) if y.size > 1 else [y.name]
 
 
+#: Each loop's error signal (suffix of ``<drive>_…``).
+ERRORS = {"position": "e_p", "rate": "e_v", "current": "e_i"}
+
+
+def _cascade_blocks(
+    d: str, p: DriveParameters, g: CascadeGains, open_loop: tuple[str, str] | None
+) -> list[control.StateSpace]:
+    """Drive ``d``'s motor and its three PI loops, named ``<d>_…``, one loop maybe broken."""
+
+    def err(loop: str) -> str:
+        return "w" if open_loop == (d, loop) else f"{d}_{ERRORS[loop]}"
+
+    # the drive's own names: voltage, axis_angle, axis_rate → reducer_torque, …
+    return [
+        _renamed(drive_block(p), f"{d}_", d),
+        control.summing_junction([f"{d}_reference", f"-{d}_encoder"], f"{d}_e_p"),
+        pi_block(g.kp_p, g.ki_p, err("position"), f"{d}_speed_ref", p.i_r, f"{d}_position_loop"),
+        control.summing_junction([f"{d}_speed_ref", f"-{d}_motor_speed"], f"{d}_e_v"),
+        pi_block(g.kp_v, g.ki_v, err("rate"), f"{d}_current_ref", name=f"{d}_rate_loop"),
+        control.summing_junction([f"{d}_current_ref", f"-{d}_current"], f"{d}_e_i"),
+        pi_block(g.kp_i, g.ki_i, err("current"), f"{d}_voltage", name=f"{d}_current_loop"),
+    ]
+
+
 def closed_loop(
     scene: Scene,
     lm: lin.Linearization,
@@ -134,6 +158,7 @@ def closed_loop(
     outputs: Sequence[Output],
     servos: Mapping[str, tuple[DriveParameters, CascadeGains]],
     K_extra: np.ndarray | None = None,
+    open_loop: tuple[str, str] | None = None,
 ) -> control.StateSpace:
     """The scene's drives with their PI cascades closed around the structure.
 
@@ -146,13 +171,18 @@ def closed_loop(
         (for the RT-70 :func:`rt70.telescope.scene_servo.scene_servos`, the gains
         :class:`rt70.telescope.scene_servo.SceneServoFactory` simulates with). The clamps are left
         out (a linear analysis).
+    open_loop : (drive, loop), optional
+        Break one drive's ``"position"``, ``"rate"`` or ``"current"`` loop at its error:
+        its PI reads the input ``w`` instead, and the error ``<drive>_e_p|e_v|e_i`` is
+        the last output (:func:`loop_gain`).
 
     Returns
     -------
     control.StateSpace
         Inputs ``<drive>_reference`` (rad, on the encoder's coordinate, about its value
-        at q0) then the disturbances; outputs the requested outputs' components, then
-        each drive's ``encoder``, ``current`` (A) and ``voltage`` (V).
+        at q0) then the disturbances (then ``w``); outputs the requested outputs'
+        components, then each drive's ``encoder``, ``current`` (A) and ``voltage`` (V)
+        (then the broken loop's error).
 
     Raises
     ------
@@ -166,26 +196,45 @@ def closed_loop(
             f"{scene.name}: servos for {', '.join(sorted(servos)) or 'no drive'}, the scene's "
             f"drives are {', '.join(sorted(names)) or 'none'}"
         )
+    if open_loop is not None and (open_loop[0] not in names or open_loop[1] not in ERRORS):
+        raise Rt70Error(f"{scene.name}: no loop {open_loop} to break (drives {sorted(names)})")
     couplings = [SceneCoupling(scene, d, "textbook") for d in drives]
     blocks = [structure_system(scene, lm, couplings, disturbances, outputs, K_extra)]
     extra_out = []
     for c in couplings:
-        d = c.drive.name
-        p, g = servos[d]
-        drive = _renamed(drive_block(p), f"{d}_", d)
-        # the drive's own names: voltage, axis_angle, axis_rate → reducer_torque, …
-        blocks += [
-            drive,
-            control.summing_junction([f"{d}_reference", f"-{d}_encoder"], f"{d}_e_p"),
-            pi_block(g.kp_p, g.ki_p, f"{d}_e_p", f"{d}_speed_ref", p.i_r, f"{d}_position_loop"),
-            control.summing_junction([f"{d}_speed_ref", f"-{d}_motor_speed"], f"{d}_e_v"),
-            pi_block(g.kp_v, g.ki_v, f"{d}_e_v", f"{d}_current_ref", name=f"{d}_rate_loop"),
-            control.summing_junction([f"{d}_current_ref", f"-{d}_current"], f"{d}_e_i"),
-            pi_block(g.kp_i, g.ki_i, f"{d}_e_i", f"{d}_voltage", name=f"{d}_current_loop"),
-        ]
-        extra_out += [f"{d}_encoder", f"{d}_current", f"{d}_voltage"]
+        blocks += _cascade_blocks(c.drive.name, *servos[c.drive.name], open_loop)
+        extra_out += [f"{c.drive.name}_{s}" for s in ("encoder", "current", "voltage")]
     inputs = [f"{c.drive.name}_reference" for c in couplings] + list(disturbances)
     outs = [label for y in outputs for label in _labels(y)] + extra_out
+    if open_loop is not None:
+        inputs.append("w")
+        outs.append(f"{open_loop[0]}_{ERRORS[open_loop[1]]}")
     return control.interconnect(
         blocks, inplist=inputs, outlist=outs, inputs=inputs, outputs=outs, check_unused=False
     )
+
+
+def loop_gain(
+    scene: Scene,
+    lm: lin.Linearization,
+    servos: Mapping[str, tuple[DriveParameters, CascadeGains]],
+    drive: str,
+    loop: str,
+) -> control.StateSpace:
+    """The loop transfer ``L = −e/w`` of one drive's loop broken at its error.
+
+    Every other loop (this drive's inner ones, the other drives') closed, so margins and
+    crossovers are those of ``L`` in python-control's convention (negative feedback),
+    as :func:`rt70.control.loops.loop_transfer` for one axis.
+
+    Parameters
+    ----------
+    scene, lm, servos
+        As :func:`closed_loop`.
+    drive : str
+        The drive whose loop is broken.
+    loop : {"position", "rate", "current"}
+        The loop.
+    """
+    sys = closed_loop(scene, lm, {}, [], servos, open_loop=(drive, loop))
+    return -sys[f"{drive}_{ERRORS[loop]}", "w"]

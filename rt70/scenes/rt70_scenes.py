@@ -10,6 +10,7 @@ scene.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 from rt70.control.geartrains import parallel_drive
@@ -55,6 +56,7 @@ def rt70_servo_scene() -> str:
         "docs/rt70-errata.md) and the azimuth and elevation drives",
         rt70_data.SERVO_BODIES,
         drives=_servo_drives_and_winds,
+        servos=True,
     )
 
 
@@ -135,10 +137,13 @@ def _rt70_text(
     description: str,
     listing_bodies: Sequence[dict],
     drives: Callable[[uw.Writer], None] | None = None,
+    servos: bool = False,
 ) -> str:
     """The 42-DOF RT-70 URDF text with the given bodies (the listing's or a variant).
 
-    ``drives`` writes the scene's ``<rt70:drive>`` elements, after the optical points.
+    ``drives`` writes the scene's ``<rt70:drive>`` elements (or other elements), after the
+    optical points; ``servos`` gives the mount's axes their ``<rt70:servo>`` (on the
+    drives :func:`_servo_drives` writes).
     """
     d = rt70_data
     bodies = {b["name"]: b for b in listing_bodies}
@@ -198,15 +203,15 @@ def _rt70_text(
             ("link", check_name(point["link"])),
             ("xyz", fmt_vec(point["xyz"])),
         )
-    _mount(w)
+    _mount(w, servos=servos)
     _optics(w)
     if drives is not None:
         drives(w)
     return uw.end(w)
 
 
-def _mount(w: uw.Writer) -> None:
-    """The RT-70's pointing axes (``<rt70:mount>``).
+def _mount(w: uw.Writer, servos: bool) -> None:
+    """The RT-70's pointing axes (``<rt70:mount>``), with their servos if it has drives.
 
     Azimuth A = ``platform_rz``, elevation E with ``base_rx = π/2 − E`` (q = 0 is the
     zenith); E from 0 (horizon) to 90° (zenith), A one turn either way (the ranges the
@@ -214,25 +219,55 @@ def _mount(w: uw.Writer) -> None:
     """
     w.comment("Pointing axes: q = 0 looks at the zenith; base_rx = 90 deg - E")
     w.open("rt70:mount", ("type", "az-el"))
-    w.empty(
-        "rt70:axis",
-        ("name", "azimuth"),
-        ("joint", rt70_state.AZIMUTH_COORDINATE),
-        ("zero_deg", "0"),
-        ("sign", "1"),
-        ("min_deg", "-360"),
-        ("max_deg", "360"),
+    axes = (
+        ("azimuth", rt70_state.AZIMUTH_COORDINATE, "0", "1", "-360", "360"),
+        ("elevation", rt70_state.ELEVATION_COORDINATE, "90", "-1", "0", "90"),
     )
-    w.empty(
-        "rt70:axis",
-        ("name", "elevation"),
-        ("joint", rt70_state.ELEVATION_COORDINATE),
-        ("zero_deg", "90"),
-        ("sign", "-1"),
-        ("min_deg", "0"),
-        ("max_deg", "90"),
-    )
+    for name, joint, zero, sign, low, high in axes:
+        attrs = (
+            ("name", name),
+            ("joint", joint),
+            ("zero_deg", zero),
+            ("sign", sign),
+            ("min_deg", low),
+            ("max_deg", high),
+        )
+        if not servos:
+            w.empty("rt70:axis", *attrs)
+            continue
+        w.open("rt70:axis", *attrs)
+        w.empty("rt70:servo", *servo_attributes(rt70_drives.DRIVES[name]))
+        w.close("rt70:axis")
     w.close("rt70:mount")
+
+
+#: Position-loop bandwidths (Hz) chosen for the RT-70 (docs/servo-scenarios.md): the
+#: azimuth loops sit below the 0.92 Hz locked-rotor resonance, the elevation loops
+#: below its 2.77 Hz one; each loop five times faster than the one around it.
+RT70_POSITION_HZ = {"azimuth": 0.2, "elevation": 0.5}
+
+
+def servo_attributes(axis: rt70_drives.AxisDrive) -> tuple[tuple[str, str], ...]:
+    """The ``<rt70:servo>`` of an RT-70 axis: its drive's limits and the chosen design.
+
+    The torque limit is the axis's ``n`` motors at their peak torque through the
+    reducer, ``n T_peak i_r``; the voltage limit the rated voltage (the scene's drive
+    lumps the motors in parallel, :func:`lumped_drive`); the design inertia the
+    listing's (docs/drives.md, ``*.reference_inertia``); the dry friction the book's.
+    """
+    m, f = axis.motor, axis.friction
+    return (
+        ("drive", axis.name),
+        ("position_bandwidth_hz", fmt(RT70_POSITION_HZ[axis.name])),
+        ("loop_ratio", "5"),
+        ("rate_limit_deg_s", fmt(math.degrees(axis.servo.rate_limit))),
+        ("torque_limit", fmt(axis.motors_per_axis * m.peak_torque * axis.reducer.ratio)),
+        ("voltage_limit", fmt(m.rated_voltage)),
+        ("nominal_torque", fmt(axis.nominal_torque)),
+        ("reference_inertia", fmt(axis.reference_inertia)),
+        ("static_friction", fmt(f.static_torque)),
+        ("top_speed_friction", fmt(f.top_speed_torque)),
+    )
 
 
 def _optics(w: uw.Writer) -> None:

@@ -20,6 +20,7 @@ from rt70.model.outputs import Output
 from rt70.model.scene import Scene
 from rt70.simulation.result import SimulationResult
 from rt70.simulation.states import StateComponent
+from rt70.telescope.axis_servos import axis_servos, has_servos
 from rt70.telescope.servo_tuning import holding_excess
 from rt70.units import ARCSEC_PER_DEG, RAD_PER_ARCSEC
 
@@ -166,6 +167,12 @@ def choose(
             mount_of(scene)  # one line naming the element that is missing
             optics_of(scene)
         return None, None
+    if not has_servos(scene):
+        if asked:
+            axis_servos(scene)  # one line naming the axis without its <rt70:servo>
+        return None, (
+            "its axes declare no <rt70:servo>: running the structural benchmark with the axes free"
+        )
     elevation = DEFAULT_ELEVATION if elevation_deg is None else elevation_deg
     azimuth = azimuth_deg or 0.0
     excess = holding_excess(scene, elevation if asked else 0.0, azimuth)

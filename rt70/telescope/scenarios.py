@@ -1,4 +1,4 @@
-"""Servo scenarios of the RT-70: hold, 1° steps and sidereal tracking, closed on the model.
+"""Servo scenarios of an antenna: hold, 1° steps and sidereal tracking, closed on the model.
 
 One job: run the telescope with its drives closed around the nonlinear model
 (:func:`rt70.simulation.simulate.simulate` with :class:`rt70.control.servo.ServoDrive` components
@@ -13,9 +13,10 @@ current and voltage that hold it, so a hold has no start-up transient.
 
 The drives are built by a *drive factory* (:data:`DriveFactory`): the default,
 :func:`servo_drives`, puts one :class:`~rt70.control.servo.ServoDrive` (with
-back-calculation anti-windup, :class:`rt70.control.antiwindup.BackCalculationServo`) per axis on the
-coordinates with the parameters of :mod:`rt70.scenes.rt70_drives` (the two motors of an
-axis lumped, see :func:`drive_parameters`). Another factory (drives with friction and
+back-calculation anti-windup, :class:`rt70.control.antiwindup.BackCalculationServo`) per
+axis on the coordinates, with the motor and reducer of the ``<rt70:drive>`` its
+``<rt70:servo>`` names, and the servo's limits and design
+(:mod:`rt70.telescope.axis_servos`). Another factory (drives with friction and
 backlash, or acting through the gear sector) is passed to :func:`run_scenario` in its
 place; the measurements use only the trajectory, the axis coordinates and, where a
 component has them, its ``reducer_torque`` and motor current.
@@ -40,9 +41,9 @@ from rt70.model.antenna import mount_of, pointing, pointing_outputs, sky_frame
 from rt70.model.outputs import evaluate
 from rt70.model.scene import Scene
 from rt70.model.sides import refuses_backend
-from rt70.scenes.rt70_drives import DRIVES
 from rt70.simulation.simulate import sample_channels, simulate
 from rt70.simulation.states import StateComponent
+from rt70.telescope.axis_servos import axis_servos, declared_tuning, tuning_text
 from rt70.telescope.scenario import (
     DEFAULT_ELEVATION,
     DEFAULT_T_END,
@@ -66,7 +67,6 @@ from rt70.telescope.servo_metrics import (
     summary_lines,
 )
 from rt70.telescope.servo_tuning import (
-    AXIS_TUNING,
     EQUILIBRIUM_TOL,
     DriveFactory,
     axis_gains,
@@ -75,7 +75,6 @@ from rt70.telescope.servo_tuning import (
     preset_servo_state,
     servo_drives,
     servo_tolerances,
-    tuning_text,
 )
 from rt70.units import RAD_PER_ARCSEC
 
@@ -83,7 +82,6 @@ from rt70.units import RAD_PER_ARCSEC
 #: (:mod:`rt70.telescope.scenario`), its measurements (:mod:`rt70.telescope.servo_metrics`)
 #: and the drives' tuning (:mod:`rt70.telescope.servo_tuning`), importable from one place.
 __all__ = [
-    "AXIS_TUNING",
     "BAND_ARCSEC",
     "DEFAULT_ELEVATION",
     "DEFAULT_T_END",
@@ -99,6 +97,7 @@ __all__ = [
     "ScenarioRun",
     "axis_gains",
     "choose",
+    "declared_tuning",
     "drive_parameters",
     "holding_excess",
     "measure",
@@ -350,7 +349,7 @@ def _static_misalignment(scene: Scene, q0: np.ndarray, sc: Scenario) -> float:
 def _drive_torques(scene: Scene, components: Sequence[StateComponent], result):
     """Axis-side reducer torque and motor current of each drive that has them."""
     names = scene.coordinate_names
-    axis_of = {names.index(a.joint): a.name for a in mount_of(scene).axes}
+    servos = {names.index(d.axis.joint): d for d in axis_servos(scene).values()}
     torque, current, limits = {}, {}, {}
     for c in components:
         if not hasattr(c, "reducer_torque"):
@@ -361,7 +360,6 @@ def _drive_torques(scene: Scene, components: Sequence[StateComponent], result):
             [c.reducer_torque(q, qd, x) for q, qd, x in zip(result.q, result.qd, s, strict=True)]
         )
         current[axis] = s[:, 0]
-        table = DRIVES[axis_of[c.index]]
         peak = getattr(getattr(c, "g", None), "current_limit", np.inf) * c.p.c_m * c.p.i_r
-        limits[axis] = (table.nominal_torque, float(peak))
+        limits[axis] = (servos[c.index].servo.nominal_torque, float(peak))
     return torque, current, limits

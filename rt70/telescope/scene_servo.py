@@ -15,12 +15,11 @@ axes (:class:`rt70.control.friction.AxisFriction`).
 - **Encoders.** The position loop reads the axis coordinate (``platform_rz``,
   ``base_rx``: the joint of the drive), not θ_d: a telescope's encoder sits on the axis,
   and the sector's compliance lies between the two (θ_d − base_rx = −45″ of sag at 45°).
-- **Limits.** The scene lumps an axis's two motors in *parallel* (one voltage: L_a, R_a
-  halved, c_m, c_e per motor, J_m doubled); :func:`rt70.telescope.scenarios.drive_parameters`
-  lumps them in series. The limits are taken from the table so that the axis-referred
-  torque limit is the same, n × peak × i_r = 9.81·10⁷ N·m, whatever the lumping: current
-  limit ``n T_peak / c_m`` (:func:`scene_axis_gains`), voltage limit the rated voltage
-  times ``c_e / c_e,motor`` (the lumped back-EMF constant scales with the lumped voltage).
+- **Limits and design.** Each axis's ``<rt70:servo>`` (:mod:`rt70.telescope.axis_servos`):
+  the current clamp is its peak axis torque through the drive's reducer,
+  ``torque_limit / (c_m i_r)`` (for the RT-70, ``n T_peak i_r`` = 9.81·10⁷ N·m
+  whatever the motors' lumping), the rate and voltage clamps as declared, the
+  bandwidths declared or tuned on the model.
 - **Start.** The static equilibrium with the drives' own forces: the encoders held at the
   pointing, the other coordinates free, and the unknown holding torques K_d of the
   drives, ``Q_g(q) + Q_c(q) + Σ_d K_d ∂θ_d/∂q = 0`` (:func:`scene_equilibrium`); the
@@ -40,19 +39,24 @@ import scipy.linalg
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.control.antiwindup import BackCalculationServo
-from rt70.control.drives import drive_parameters
 from rt70.control.friction import AxisFriction
-from rt70.control.servo import CascadeGains, cascade_gains
+from rt70.control.servo import CascadeGains
 from rt70.errors import Rt70Error
 from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
 from rt70.model.antenna import mount_of
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
 from rt70.model.sides import check_side
-from rt70.scenes.rt70_drives import DRIVES, FRICTION, AxisDrive
 from rt70.simulation.states import StateComponent
+from rt70.telescope.axis_servos import (
+    Tuning,
+    axis_servos,
+    declared_tuning,
+    friction_of,
+    servo_gains,
+    servo_parameters,
+)
 from rt70.telescope.servo_tuning import (
-    AXIS_TUNING,
     EQUILIBRIUM_TOL,
     preset_servo_state,
     servo_drives,
@@ -60,52 +64,19 @@ from rt70.telescope.servo_tuning import (
 )
 
 
-def axis_tables(scene: Scene) -> dict[str, AxisDrive]:
-    """The drive table of each axis of the scene's ``<rt70:mount>``, by the joint it turns."""
-    return {a.joint: DRIVES[a.name] for a in mount_of(scene).axes}
+def _servos_by_joint(scene: Scene) -> dict:
+    """Each declared axis servo (:func:`rt70.telescope.axis_servos.axis_servos`) by its joint."""
+    return {d.axis.joint: d for d in axis_servos(scene).values()}
 
 
-#: Friction regularisation (docs/drive-train.md §2: ``rt70.reports.drivetrain``).
-FRICTION_WIDTH = 1e-6 * FRICTION.top_speed
+#: Friction regularisation, a fraction of the axis's rate limit (docs/drive-train.md §2:
+#: ``rt70.reports.drivetrain``).
+FRICTION_WIDTH_OF_RATE = 1e-6
 FRICTION_KIND = "linear"
 #: Absolute tolerance of the friction's dissipated heat, J.
 FRICTION_ATOL = 1e-3
 #: Newton steps of :func:`scene_equilibrium` at most.
 MAX_ITER = 30
-
-
-def scene_axis_gains(
-    p: DriveParameters, axis: AxisDrive, position_hz: float, ratio: float
-) -> CascadeGains:
-    """The cascade of a scene drive with the table's limits, whatever the motors' lumping.
-
-    Current limit ``n T_peak / c_m`` and voltage limit ``U_n c_e / c_e,motor``: the
-    axis-referred torque limit is ``n T_peak i_r`` (9.81·10⁷ N·m for the RT-70) and the
-    top voltage the rated one per motor, for parallel (the scene's) or series
-    (:func:`rt70.telescope.scenarios.drive_parameters`) lumping alike.
-
-    Parameters
-    ----------
-    p : DriveParameters
-        The scene drive's lumped parameters (:func:`rt70.control.drives.drive_parameters`).
-    axis : AxisDrive
-        The RT-70 table's axis it drives (:func:`axis_tables`): the limits and reference inertia.
-    position_hz : float
-        Bandwidth of the position loop, Hz.
-    ratio : float
-        Ratio of the position loop's proportional to integral corner
-        (:func:`rt70.control.servo.cascade_gains`).
-    """
-    m, n = axis.motor, axis.motors_per_axis
-    return cascade_gains(
-        p,
-        axis.reference_inertia,
-        position_hz=position_hz,
-        ratio=ratio,
-        current_limit=n * m.peak_torque / p.c_m,
-        rate_limit=axis.servo.rate_limit,
-        voltage_limit=m.rated_voltage * p.c_e / m.back_emf_constant,
-    )
 
 
 def scene_equilibrium(
@@ -251,24 +222,18 @@ def _newton_step(scene: Scene, J: np.ndarray, R: np.ndarray) -> np.ndarray:
 
 
 def scene_servos(
-    scene: Scene, tuning: dict[str, tuple[float, float]] | None = None
+    scene: Scene, tuning: Tuning | None = None
 ) -> dict[str, tuple[DriveParameters, CascadeGains]]:
     """Each scene drive's parameters and cascade gains, as :class:`SceneServoFactory` uses.
 
     For the linear closed loop (:func:`rt70.control.scene_loop.closed_loop`); ``tuning``
-    as the factory's.
+    overrides the scene's (:func:`rt70.telescope.axis_servos.declared_tuning`).
     """
-    tuning = {**AXIS_TUNING, **(tuning or {})}
-    tables = axis_tables(scene)
+    design = {**declared_tuning(scene), **(tuning or {})}
     out = {}
-    for d in scene.description.drives:
-        if d.joint not in tables:
-            raise Rt70Error(
-                f"{scene.name}: drive '{d.name}' turns '{d.joint}', no axis of its <rt70:mount>"
-            )
-        axis = tables[d.joint]
-        p = drive_parameters(d, axis.reference_inertia)
-        out[d.name] = (p, scene_axis_gains(p, axis, *tuning[axis.name]))
+    for name, declared in axis_servos(scene).items():
+        p = servo_parameters(scene, declared)
+        out[declared.drive.name] = (p, servo_gains(p, declared.servo, *design[name]))
     return out
 
 
@@ -281,8 +246,8 @@ class SceneServoFactory:
     Parameters
     ----------
     tuning : dict, optional
-        ``{"azimuth": (position_hz, ratio), ...}`` by table axis; default
-        :data:`rt70.telescope.scenarios.AXIS_TUNING`.
+        ``{"azimuth": (position_hz, ratio), ...}`` by axis, overriding the scene's
+        (:func:`rt70.telescope.axis_servos.declared_tuning`).
     friction : bool
         Add the book's dry friction on each driven axis.
     side : {"reference", "textbook"}
@@ -291,11 +256,11 @@ class SceneServoFactory:
 
     def __init__(
         self,
-        tuning: dict[str, tuple[float, float]] | None = None,
+        tuning: Tuning | None = None,
         friction: bool = False,
         side: str = "reference",
     ) -> None:
-        self.tuning = {**AXIS_TUNING, **(tuning or {})}
+        self.tuning = dict(tuning or {})
         self.friction = friction
         self.side = check_side(side)
         self.residual = np.nan  # of the last start (scene_equilibrium)
@@ -313,12 +278,12 @@ class SceneServoFactory:
             drives = scene.description.drives
             if not drives:
                 raise Rt70Error(f"{scene.name}: no <rt70:drive>: use the coordinate drives")
-            tables = axis_tables(scene)
+            servos = {d.drive.name for d in axis_servos(scene).values()}
             for d in drives:
-                if d.joint not in tables:
+                if d.name not in servos:
                     raise Rt70Error(
-                        f"{scene.name}: drive '{d.name}' turns '{d.joint}', no axis of its "
-                        f"<rt70:mount> ({', '.join(tables)})"
+                        f"{scene.name}: drive '{d.name}' is no axis's servo drive "
+                        f"(<rt70:servo drive>: {', '.join(sorted(servos))})"
                     )
             self._couplings[scene.name] = [SceneCoupling(scene, d, self.side) for d in drives]
         return self._couplings[scene.name]
@@ -333,13 +298,14 @@ class SceneServoFactory:
     def __call__(self, scene, q0, torques, references) -> list[StateComponent]:
         """The servos (and frictions), preset to hold ``torques`` at ``q0``."""
         names = scene.coordinate_names
-        tables = axis_tables(scene)
+        servos = _servos_by_joint(scene)
+        design = {**declared_tuning(scene), **self.tuning}
         out: list[StateComponent] = []
         for c in self.couplings(scene):
             joint = names[c.index]
-            axis = tables[joint]
-            p = drive_parameters(c.drive, axis.reference_inertia)
-            gains = scene_axis_gains(p, axis, *self.tuning[axis.name])
+            declared = servos[joint]
+            p = servo_parameters(scene, declared)
+            gains = servo_gains(p, declared.servo, *design[declared.axis.name])
             initial = preset_servo_state(p, gains, c.angle(q0), torques[joint])
             servo = BackCalculationServo(
                 c.drive.name,
@@ -394,15 +360,17 @@ def choose_drives(
         or torques on the axis coordinates; None: the scene's drives where it declares
         one per axis (its own model of the drives), the coordinate drives otherwise.
     friction : bool
-        Add the book's dry friction on both axes.
+        Add each axis's declared dry friction (``<rt70:servo static_friction …>``).
     side : {"reference", "textbook"}
         Which side computes the scene drives' couplings.
 
     Raises
     ------
     Rt70Error
-        An unknown model, or ``"scene"`` for a scene without a drive on each axis.
+        An axis without a ``<rt70:servo>``, an unknown model, or ``"scene"`` for a scene
+        without a drive on each axis.
     """
+    axis_servos(scene)  # one line naming an axis without its <rt70:servo>
     if model is None:
         model = "scene" if has_scene_drives(scene) else "coordinate"
     if model not in DRIVE_MODELS:
@@ -424,16 +392,19 @@ def choose_drives(
 
 
 def axis_frictions(scene: Scene, joints: list[str]) -> list[StateComponent]:
-    """The book's dry friction (:data:`FRICTION_WIDTH`) on each of the axis ``joints``."""
+    """Each axis's declared dry friction on the axis ``joints``.
+
+    Regularised over :data:`FRICTION_WIDTH_OF_RATE` of the axis's rate limit.
+    """
     names = list(scene.coordinate_names)
-    tables = axis_tables(scene)
+    servos = _servos_by_joint(scene)
     return [
         AxisFriction(
-            f"{tables[j].name}_friction",
+            f"{servos[j].axis.name}_friction",
             names,
             j,
-            tables[j].friction,
-            FRICTION_WIDTH,
+            friction_of(scene, servos[j]),
+            FRICTION_WIDTH_OF_RATE * servos[j].servo.rate_limit,
             FRICTION_KIND,
             FRICTION_ATOL,
         )

@@ -1,10 +1,12 @@
-"""The servo tuning of the RT-70's axes: drive parameters, cascade gains, tolerances, holding.
+"""How the scenarios' servos are built: drive parameters, gains, presets, tolerances, holding.
 
-One job: say how the scenarios' servos are built from the RT-70's drive data
-(:mod:`rt70.scenes.rt70_drives`): the cascade gains of each axis at the chosen position-loop
-bandwidth (:data:`AXIS_TUNING`, docs/servo-scenarios.md), the state a servo starts in when
-it already holds the structure, the integration tolerances of its states, and whether the
-drives can hold the telescope at a pointing at all.
+One job: say how a scene's servos are built from what it declares
+(:mod:`rt70.telescope.axis_servos`: each axis's ``<rt70:servo>`` and the ``<rt70:drive>``
+it closes around): the coordinate drive factory (:func:`servo_drives`), the state a servo
+starts in when it already holds the structure, the integration tolerances of its states,
+and whether the drives can hold the structure at a pointing at all. The RT-70 table's
+own helpers (:func:`drive_parameters`, :func:`axis_gains`, on
+:mod:`rt70.scenes.rt70_drives`) serve the RT-70's analyses.
 """
 
 from __future__ import annotations
@@ -18,16 +20,17 @@ from rt70.control.antiwindup import BackCalculationServo
 from rt70.control.geartrains import equivalent_drive
 from rt70.control.servo import CascadeGains, ServoDrive, cascade_gains
 from rt70.linear.linearize import equilibrium, static_force
-from rt70.model.antenna import mount_of, pointing
+from rt70.model.antenna import pointing
 from rt70.model.scene import Scene
-from rt70.scenes.rt70_drives import DRIVES, AxisDrive
+from rt70.scenes.rt70_drives import AxisDrive
 from rt70.simulation.states import StateComponent
-
-#: Position-loop bandwidths (Hz) and the ratio between nested loops chosen for the
-#: RT-70 (see docs/servo-scenarios.md): the azimuth loops sit below the 0.92 Hz
-#: locked-rotor resonance, the elevation loops below its 2.77 Hz one.
-AXIS_TUNING = {"azimuth": (0.2, 5.0), "elevation": (0.5, 5.0)}
-
+from rt70.telescope.axis_servos import (
+    Tuning,
+    axis_servos,
+    declared_tuning,
+    servo_gains,
+    servo_parameters,
+)
 
 #: Force tolerance of the static equilibria (relative): rt70_servo's Newton residual
 #: stalls at its rounding floor, 1.2e-10 at elevation 30° (above equilibrium's default
@@ -44,7 +47,7 @@ DriveFactory = Callable[
 
 
 def drive_parameters(axis: AxisDrive) -> DriveParameters:
-    """One :class:`DcDrive`'s parameters for an axis's motors, lumped.
+    """One :class:`DcDrive`'s parameters for an RT-70 table axis's motors, lumped.
 
     The axis's ``n`` identical motors turn the same gear at the same speed; taken with
     their armatures in series (one current), they are one motor with ``n`` times the
@@ -123,69 +126,67 @@ def servo_tolerances(p: DriveParameters, axis_atol: float = 1e-9) -> np.ndarray:
     return np.array([amp, motor, motor, axis_atol, motor, amp])
 
 
-def servo_drives(tuning: dict[str, tuple[float, float]] | None = None) -> DriveFactory:
-    """The default factory: one ServoDrive per axis, on the coordinates, holding at start.
+def servo_drives(tuning: Tuning | None = None) -> DriveFactory:
+    """The coordinate drives: one servo per declared axis, its torque on the axis coordinate.
+
+    Each axis's ``<rt70:servo>`` names its ``<rt70:drive>``: the drive's motor and
+    reducer (:func:`rt70.telescope.axis_servos.servo_parameters`) push on the joint's
+    coordinate itself, not through a gear sector the element may have (the scene's own
+    drive model is :class:`rt70.telescope.scene_servo.SceneServoFactory`).
 
     Parameters
     ----------
     tuning : dict, optional
-        ``{"azimuth": (position_hz, ratio), "elevation": (...)}``; default
-        :data:`AXIS_TUNING`.
+        ``{"azimuth": (position_hz, ratio), ...}`` overriding the scene's
+        (:func:`rt70.telescope.axis_servos.declared_tuning`).
     """
-    tuning = {**AXIS_TUNING, **(tuning or {})}
 
     def build(scene, q0, torques, references):
         names = scene.coordinate_names
+        design = {**declared_tuning(scene), **(tuning or {})}
         out: list[StateComponent] = []
-        for mount_axis in mount_of(scene).axes:
-            coordinate, axis = mount_axis.joint, DRIVES[mount_axis.name]
-            p = drive_parameters(axis)
-            gains = axis_gains(axis, *tuning[axis.name])
+        for name, declared in axis_servos(scene).items():
+            coordinate = declared.axis.joint
+            p = servo_parameters(scene, declared)
+            gains = servo_gains(p, declared.servo, *design[name])
             k = names.index(coordinate)
             initial = preset_servo_state(p, gains, q0[k], torques[coordinate])
             ref = references[coordinate]
             atol = servo_tolerances(p)
-            out.append(
-                BackCalculationServo(axis.name, names, coordinate, p, gains, ref, initial, atol)
-            )
+            out.append(BackCalculationServo(name, names, coordinate, p, gains, ref, initial, atol))
         return out
 
     return build
-
-
-def tuning_text(tuning: dict[str, tuple[float, float]] | None = None) -> str:
-    """The position-loop bandwidths in one phrase, e.g. ``position loops az 0.2 Hz, el 0.5 Hz``."""
-    t = {**AXIS_TUNING, **(tuning or {})}
-    return f"position loops az {t['azimuth'][0]:g} Hz, el {t['elevation'][0]:g} Hz"
 
 
 def holding_excess(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> str | None:
     """Why the drives cannot hold ``scene`` at a pointing, or None if they can.
 
     The static torque the drives must supply on each axis at the equilibrium of the
-    pointing, against the table's nominal (continuous) drive torque. The RT-70 listing
-    as printed needs 2.66× it on elevation at the horizon (docs/rt70-errata.md item 12).
+    pointing, against the servo's declared nominal (continuous) torque
+    (``<rt70:servo nominal_torque>``). The RT-70 listing as printed would need 2.66×
+    its drives' on elevation at the horizon (docs/rt70-errata.md item 12).
 
     Parameters
     ----------
     scene : Scene
-        A scene with the RT-70's pointing axes.
+        A scene whose mount's axes declare their servos.
     elevation_deg : float
         The elevation, degrees.
     azimuth_deg : float
         The azimuth, degrees.
     """
+    servos = axis_servos(scene)
     held = pointing(scene, elevation_deg, azimuth_deg)
     q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
     Q0 = static_force(scene, q0)
     names = scene.coordinate_names
-    for mount_axis in mount_of(scene).axes:
-        coordinate, axis = mount_axis.joint, DRIVES[mount_axis.name]
-        torque = abs(float(Q0[names.index(coordinate)]))
-        if torque > axis.nominal_torque:
+    for name, declared in servos.items():
+        torque = abs(float(Q0[names.index(declared.axis.joint)]))
+        nominal = declared.servo.nominal_torque
+        if torque > nominal:
             return (
-                f"gravity torque {torque:.3g} N·m on {axis.name} at elevation {elevation_deg:g}° "
-                f"exceeds the drive's nominal {axis.nominal_torque:.3g} N·m "
-                "(docs/rt70-errata.md item 12)"
+                f"gravity torque {torque:.3g} N·m on {name} at elevation {elevation_deg:g}° "
+                f"exceeds the drive's nominal {nominal:.3g} N·m"
             )
     return None

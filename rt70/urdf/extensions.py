@@ -93,7 +93,7 @@ def read_extensions(
         elif kind == "no_slip":
             no_slips.append(read_no_slip(reader, elem, desc, no_slips))
         elif kind == "mount":
-            mount.append(read_mount(reader, elem, joints))
+            mount.append(elem)  # read once every drive of the file is known
         elif kind == "optics":
             optics.append(elem)  # read once every optical point of the file is known
         elif kind == "optical_point":
@@ -110,7 +110,7 @@ def read_extensions(
         winds=tuple(winds),
         air_density=air[0] if air else desc.air_density,
         no_slips=tuple(no_slips),
-        mount=mount[0] if mount else None,
+        mount=read_mount(reader, mount[0], joints, desc.drives) if mount else None,
         optics=read_optics(reader, optics[0], desc) if optics else None,
     )
 

@@ -135,6 +135,27 @@ RT70 = Spec(
                         Spec(
                             required=("name", "joint"),
                             optional=("zero_deg", "sign", "min_deg", "max_deg"),
+                            children={
+                                "servo": Child(
+                                    Spec(
+                                        required=(
+                                            "drive",
+                                            "rate_limit_deg_s",
+                                            "torque_limit",
+                                            "voltage_limit",
+                                        ),
+                                        optional=(
+                                            "position_bandwidth_hz",
+                                            "loop_ratio",
+                                            "nominal_torque",
+                                            "reference_inertia",
+                                            "static_friction",
+                                            "top_speed_friction",
+                                        ),
+                                    ),
+                                    most=1,
+                                )
+                            },
                         ),
                         least=1,
                     )
