@@ -670,7 +670,8 @@ def test_sag_with_the_focus_on_the_vertex_is_an_error_record_past_the_check(tmp_
     sweep = sw.Sweep(sw.SceneSource.read(scene), grid, (QUANTITIES["sag"],), 1)
     result = sw.run(sweep, sw.serial)
     assert np.isnan(result.arrays["sag"]).all() and np.isnan(result.arrays["sag_error"]).all()
-    assert [e["error"] for e in result.errors] == ["sag: sag is not finite at this point (nan)"]
+    [error] = [e["error"] for e in result.errors]
+    assert "focus and vertex are at one place" in error and "no focal axis" in error
 
 
 def test_a_repeated_optical_point_is_refused(tmp_path, capsys):

@@ -226,9 +226,16 @@ def source(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> np.n
     focus, vertex = _point(scene, optics.primary.focus), _point(scene, optics.primary.vertex)
 
     def axis(p: np.ndarray) -> np.ndarray:
-        return (p[0] - p[1]) / np.linalg.norm(p[0] - p[1])
+        return p[0] - p[1]
 
-    return evaluate(scene, q, [Output("axis", "1", 3, (focus, vertex), axis)], "textbook")["axis"]
+    chord = evaluate(scene, q, [Output("axis", "m", 3, (focus, vertex), axis)], "textbook")["axis"]
+    length = float(np.linalg.norm(chord))
+    if not length > 0.0:  # NaN or zero: no focal axis
+        raise SceneError(
+            f"{scene.name}: the primary reflector's focus and vertex are at one place "
+            f"({optics.primary.focus}, {optics.primary.vertex}): it has no focal axis to point"
+        )
+    return chord / length
 
 
 def pointing_outputs(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> list[Output]:
