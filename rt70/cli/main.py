@@ -30,10 +30,12 @@ from rt70.cli import bench as cli_bench
 from rt70.cli import cart as cli_cart
 from rt70.cli import impact as cli_impact
 from rt70.cli import modes as cli_modes
+from rt70.cli import new as cli_new
 from rt70.cli import options, session
 from rt70.cli import plant as cli_plant
 from rt70.cli import pointing as cli_pointing
 from rt70.cli import reactions as cli_reactions
+from rt70.cli import servo as cli_servo
 from rt70.cli import simulate as cli_simulate
 from rt70.cli import sweep as cli_sweep
 from rt70.cli import validate as cli_validate
@@ -56,9 +58,11 @@ def build_parser() -> argparse.ArgumentParser:
     cli_plant.add_parser(sub)
     cli_pointing.add_parser(sub, options.add_pointing_arguments)
     cli_reactions.add_parser(sub)
+    cli_servo.add_parser(sub)
     cli_simulate.add_parser(sub, options.add_pointing_arguments)
     cli_sweep.add_parser(sub)
     cli_cart.add_parser(sub)
+    cli_new.add_parser(sub)
     cli_impact.add_parser(sub)
     return parser
 

@@ -48,7 +48,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "--elevation",
         type=_elevations,
         metavar="LIST",
-        help="elevations, degrees, comma-separated (default 0,15,30,45,60,75,90)",
+        help="elevations, degrees, comma-separated (default: seven from the elevation axis's "
+        "lowest to its highest; the RT-70: 0,15,30,45,60,75,90)",
     )
     rea.add_argument(
         "--azimuth", type=options.angle_deg, default=0.0, help="azimuth, degrees (default 0)"
@@ -89,11 +90,11 @@ def run(args: argparse.Namespace) -> int:
     if args.direction is not None and args.wind is None:
         raise Rt70Error("--direction needs --wind")
     out = None if args.output is None else _check_output(args.output)
-    elevations = bl.ELEVATIONS if args.elevation is None else args.elevation
     directions = (None, args.azimuth + 180.0) if args.direction is None else args.direction
     speed = 0.0 if args.wind is None else args.wind
     scene = load_scene(args.scene)
     bl.check_scene(scene, speed > 0.0)
+    elevations = bl.default_elevations(scene) if args.elevation is None else args.elevation
     rows = bl.load_table(scene, elevations, args.azimuth, speed, directions)
     options.check_finite([b.to_dict() for b in rows], f"{scene.name}: reactions")
     if out is not None:

@@ -178,9 +178,42 @@ def mirror_system(scene: Scene) -> MirrorSystem:
         cr_support_link=cr[2],
         cr_link=cr[3],
     )
+    _check_reference_frame(scene, system)
     if secondary is None:
         return system
     return dataclasses.replace(system, design_offset=_design_offset(scene, system))
+
+
+#: How far (a unit vector's components) the primary's focal axis at construction may lie
+#: off the reference frame's z axis.
+FOCAL_AXIS_TOLERANCE = 1e-6
+
+
+def _check_reference_frame(scene: Scene, system: MirrorSystem) -> None:
+    """Refuse a reference frame whose z is not the primary's focal axis at construction.
+
+    The pointing corrections (4.159)–(4.163) solve the frame's x and y rows: they are
+    the transverse components only when z is the focal axis.
+    """
+    zero = (0.0, 0.0, 0.0)
+    frame = [(system.ok_link, zero)] + [(system.ok_link, tuple(e)) for e in np.eye(3)]
+
+    def axis_in_frame(p: np.ndarray) -> np.ndarray:
+        R = (p[3:6] - p[2]).T
+        n = p[0] - p[1]
+        return R.T @ n / np.linalg.norm(n)
+
+    points = (system.main_focus, system.main_vertex, *frame)
+    out = Output("focal_axis", "1", 3, points, axis_in_frame)
+    q0 = np.zeros(len(scene.coordinate_names))
+    n = evaluate(scene, q0, [out], "textbook")["focal_axis"]
+    if not np.max(np.abs(n - np.array([0.0, 0.0, 1.0]))) <= FOCAL_AXIS_TOLERANCE:
+        raise SceneError(
+            f"{scene.name}: <rt70:optics reference_link='{system.ok_link}'>: the frame's z axis "
+            f"is not the primary's focal axis at construction (which lies along "
+            f"{np.array2string(n, precision=3)} in it): give the reflector a frame whose z "
+            "is its boresight"
+        )
 
 
 def _design_offset(scene: Scene, system: MirrorSystem) -> tuple[float, float, float]:

@@ -2,7 +2,8 @@
 
 Every scene is a function returning the URDF text (the RT-70 listing's in
 :mod:`rt70.scenes.rt70_scenes`, the chapter-2 models and mechanisms in
-:mod:`rt70.scenes.book_scenes`, the closed chains in :mod:`rt70.scenes.loop_scenes`);
+:mod:`rt70.scenes.book_scenes`, the closed chains in :mod:`rt70.scenes.loop_scenes`, the
+two other antennas in :mod:`rt70.scenes.antenna_presets`);
 :data:`SCENES` maps scene names to them and :func:`write_all` writes ``<name>.urdf``
 files. The output is deterministic (:mod:`rt70.scenes.urdf_writer`: fixed element and
 attribute order, two-space indentation, numbers written as the shortest text that reads
@@ -18,9 +19,12 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 
 from rt70.guards.atomic import atomic_write_text
+from rt70.scenes.antenna import antenna_urdf
+from rt70.scenes.antenna_presets import PRESETS
 from rt70.scenes.book_scenes import (
     double_pendulum_scene,
     gear_reducer_scene,
@@ -51,6 +55,7 @@ SCENES: dict[str, Callable[[], str]] = {
     "gear_reducer": gear_reducer_scene,
     "four_bar": four_bar_scene,
     "crank_slider": crank_slider_scene,
+    **{name: partial(antenna_urdf, spec) for name, spec in PRESETS.items()},
 }
 
 

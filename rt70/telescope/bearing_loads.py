@@ -36,6 +36,7 @@ weight, and the two sides agree.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import asdict, dataclass
 
@@ -46,8 +47,8 @@ from rt70.model.scene import Scene
 from rt70.model.sides import side_of
 from rt70.physics.loads import Wrench
 
-#: The default elevations of the report, degrees.
-ELEVATIONS = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
+#: How many elevations the report has by default, evenly over the axis's range.
+N_ELEVATIONS = 7
 
 
 @dataclass(frozen=True)
@@ -81,12 +82,12 @@ class LoadCase:
 class BearingLoads:
     """The loads of one case, N and N·m (see the module docstring for the axes).
 
-    ``azimuth`` is the wrench across ``platform_rz`` in its own (the alidade's) axes;
-    ``elevation`` the wrench across ``base_rx`` in the same axes with the mesh force
+    ``azimuth`` is the wrench across the azimuth joint in its own (the alidade's) axes;
+    ``elevation`` the wrench across the elevation joint in the same axes with the mesh force
     taken out, ``elevation_total`` with it left in; ``vertical`` the upward ground
     component of the force across each joint (mesh force left in); ``mesh_force`` the
     sector's force on the counterweight (ground axes); ``torques`` the drives' reducer
-    torques of the equilibrium by drive name; ``weight_azimuth`` and
+    torques of the equilibrium by axis (``azimuth``, ``elevation``); ``weight_azimuth`` and
     ``weight_elevation`` the weights above each joint; ``sides_difference`` the largest
     difference of the two sides' values relative to their max-norm; ``residual`` the
     equilibrium's.
@@ -221,6 +222,7 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
     model = scene.textbook
     g = float(np.linalg.norm(model.gravity))
     azimuth_joint, elevation_joint = bearing_joints(scene)
+    axes = {azimuth_joint: "azimuth", elevation_joint: "elevation"}
     below = _subtree_mass(scene, elevation_joint)
     return BearingLoads(
         case,
@@ -229,7 +231,7 @@ def bearing_loads(scene: Scene, case: LoadCase) -> BearingLoads:
         elevation_total=tb[2],
         mesh_force=tb[3],
         vertical=tb[4],
-        torques=torques,
+        torques={axes[c.drive.joint]: torques[c.drive.name] for c in couplings},
         weight_azimuth=_subtree_mass(scene, azimuth_joint) * g,
         weight_elevation=below * g,
         sides_difference=diff,
@@ -285,6 +287,15 @@ def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict,
     )
 
 
+def default_elevations(scene: Scene) -> tuple[float, ...]:
+    """:data:`N_ELEVATIONS` elevations evenly over the scene's elevation range, degrees."""
+    from rt70.model.antenna import mount_of
+
+    axis = mount_of(scene).axis("elevation")
+    low, high = math.degrees(axis.lower), math.degrees(axis.upper)
+    return tuple(float(round(e, 9)) for e in np.linspace(low, high, N_ELEVATIONS))
+
+
 def bearing_joints(scene: Scene) -> tuple[str, str]:
     """The azimuth and elevation joints of the scene's ``<rt70:mount>``: its bearings."""
     from rt70.model.antenna import mount_of
@@ -306,7 +317,7 @@ def _subtree_mass(scene: Scene, joint: str) -> float:
 
 def load_table(
     scene: Scene,
-    elevations=ELEVATIONS,
+    elevations=None,
     azimuth_deg: float = 0.0,
     wind_speed: float = 0.0,
     directions: tuple[float | None, ...] = (None,),
@@ -318,7 +329,7 @@ def load_table(
     scene : Scene
         A scene with the RT-70's drives (and ``<rt70:wind>`` elements for a wind).
     elevations : sequence of float
-        The elevations, degrees (:data:`ELEVATIONS`).
+        The elevations, degrees; None: :func:`default_elevations`.
     azimuth_deg : float
         The azimuth of every case, degrees.
     wind_speed : float
@@ -328,7 +339,7 @@ def load_table(
         ``wind_speed`` > 0.
     """
     cases = []
-    for e in elevations:
+    for e in default_elevations(scene) if elevations is None else elevations:
         cases.append(LoadCase(float(e), azimuth_deg))
         if wind_speed > 0.0:
             cases += [LoadCase(float(e), azimuth_deg, wind_speed, d) for d in directions]

@@ -117,11 +117,14 @@ class PointingBudget:
 
 
 def budget_outputs(scene: Scene, case: PointingCase) -> list[Output]:
-    """The mirror-system outputs of :data:`BUDGET_OUTPUTS` for the case's source."""
+    """The mirror-system outputs of :data:`BUDGET_OUTPUTS` for the case's source.
+
+    A single reflector (``<rt70:optics type="prime_focus">``) has the first only.
+    """
     from rt70.model.antenna import pointing_outputs
 
     found = {o.name: o for o in pointing_outputs(scene, case.elevation_deg, case.azimuth_deg)}
-    return [found[n] for n in BUDGET_OUTPUTS]
+    return [found[n] for n in BUDGET_OUTPUTS if n in found]  # a single reflector: the first
 
 
 def _held(scene: Scene, case: PointingCase) -> dict[str, float]:
@@ -457,6 +460,8 @@ def format_budget(scene_name: str, b: PointingBudget) -> str:
         f"  {'output':<40} {'steady':>10} {'gust rms':>10}  unit",
     ]
     for name, unit in BUDGET_OUTPUTS.items():
+        if name not in b.steady:  # a single reflector has no secondary's outputs
+            continue
         lines.append(
             f"  {TITLES[name]:<40} {b.steady[name]:>10.4g} {b.gust_rms[name]:>10.4g}  {unit}"
         )

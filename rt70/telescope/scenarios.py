@@ -354,7 +354,7 @@ def _drive_torques(scene: Scene, components: Sequence[StateComponent], result):
     for c in components:
         if not hasattr(c, "reducer_torque"):
             continue
-        axis = c.names[0].split(":")[0]
+        axis = servos[c.index].axis.name
         s = np.column_stack([result.states[n] for n in c.names])
         torque[axis] = np.array(
             [c.reducer_torque(q, qd, x) for q, qd, x in zip(result.q, result.qd, s, strict=True)]
