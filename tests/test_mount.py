@@ -151,3 +151,67 @@ def test_a_wrong_mount_is_refused_naming_file_and_element(mount, message):
     with pytest.raises(ExtensionError, match=message) as err:
         read_urdf_string(_turret(mount), "turret.urdf")
     assert str(err.value).startswith("turret.urdf: ")
+
+
+#: Two drives for the turret (the elevation one on az: a servo naming it is refused).
+DRIVES = """
+  <rt70:drive name="az_drive" joint="az" L_a="0.01" R_a="0.5" c_m="1" c_e="1" J_m="0.01"
+              D_m="0" i_r="100" C_r="1e6" D_r="0"/>
+  <rt70:drive name="other" joint="az" L_a="0.01" R_a="0.5" c_m="1" c_e="1" J_m="0.01"
+              D_m="0" i_r="100" C_r="1e6" D_r="0"/>"""
+
+SERVO = (
+    '<rt70:servo drive="az_drive" rate_limit_deg_s="2" torque_limit="500" '
+    'voltage_limit="400" EXTRA/>'
+)
+
+
+def _servoed(servo: str) -> str:
+    mount = GOOD.replace('<rt70:axis name="azimuth" joint="az"/>',
+                         f'<rt70:axis name="azimuth" joint="az">{servo}</rt70:axis>')  # fmt: skip
+    return _turret(mount + DRIVES)
+
+
+def test_a_servo_reads_in_si_and_defaults_what_it_may():
+    servo = read_urdf_string(_servoed(SERVO.replace(" EXTRA", "")), "t.urdf").mount.axes[0].servo
+    assert (servo.drive, servo.torque_limit, servo.voltage_limit) == ("az_drive", 500.0, 400.0)
+    assert_close(servo.rate_limit, math.radians(2.0), rel=MIN_REL, scale=1.0, what="rate")
+    assert servo.position_bandwidth_hz is None and servo.reference_inertia is None
+    assert servo.loop_ratio == 5.0 and servo.nominal_torque == 500.0
+    assert servo.static_friction is None and servo.top_speed_friction is None
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ('drive="nope"', r"drive 'nope' is no <rt70:drive> of the file \(az_drive, other\)"),
+        ('loop_ratio="1"', r"loop_ratio=1 must be above 1"),
+        ('position_bandwidth_hz="0"', r"position_bandwidth_hz=0 must be positive"),
+        ('nominal_torque="-5"', r"nominal_torque=-5 must be positive"),
+        ('static_friction="10"', r"give static_friction and top_speed_friction together"),
+        (
+            'static_friction="10" top_speed_friction="5"',
+            r"give static_friction and top_speed_friction together, the second not below",
+        ),
+        ('bandwidth_hz="1"', r"unknown attribute 'bandwidth_hz'"),
+    ],
+)
+def test_a_wrong_servo_is_one_line_naming_the_element(extra, message):
+    servo = SERVO.replace("EXTRA", extra)
+    if extra.startswith("drive="):
+        servo = servo.replace('drive="az_drive" ', "")
+    with pytest.raises(ExtensionError, match=message) as err:
+        read_urdf_string(_servoed(servo), "t.urdf")
+    assert "t.urdf" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_servo_on_a_drive_of_another_joint_is_refused():
+    text = _servoed(SERVO.replace(" EXTRA", "")).replace(
+        '<rt70:axis name="elevation" joint="el"',
+        '<rt70:axis name="elevation" joint="el"><rt70:servo drive="other" rate_limit_deg_s="1" '
+        'torque_limit="1" voltage_limit="1"/></rt70:axis><rt70:axis name="x" joint="el"',
+    )
+    with pytest.raises(
+        ExtensionError, match=r"drive 'other' turns joint 'az', the axis turns 'el'"
+    ):
+        read_urdf_string(text, "t.urdf")
