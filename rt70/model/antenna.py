@@ -198,15 +198,17 @@ def _check_reference_frame(scene: Scene, system: MirrorSystem) -> None:
     zero = (0.0, 0.0, 0.0)
     frame = [(system.ok_link, zero)] + [(system.ok_link, tuple(e)) for e in np.eye(3)]
 
-    def axis_in_frame(p: np.ndarray) -> np.ndarray:
-        R = (p[3:6] - p[2]).T
-        n = p[0] - p[1]
-        return R.T @ n / np.linalg.norm(n)
+    def chord_in_frame(p: np.ndarray) -> np.ndarray:
+        return (p[3:6] - p[2]) @ (p[0] - p[1])  # the frame's axes are the rows
 
     points = (system.main_focus, system.main_vertex, *frame)
-    out = Output("focal_axis", "1", 3, points, axis_in_frame)
+    out = Output("focal_chord", "m", 3, points, chord_in_frame)
     q0 = np.zeros(len(scene.coordinate_names))
-    n = evaluate(scene, q0, [out], "textbook")["focal_axis"]
+    chord = evaluate(scene, q0, [out], "textbook")["focal_chord"]
+    length = float(np.linalg.norm(chord))
+    if not length > 0.0:
+        return  # no focal axis: refused where one is needed (source, the sweep's check)
+    n = chord / length
     if not np.max(np.abs(n - np.array([0.0, 0.0, 1.0]))) <= FOCAL_AXIS_TOLERANCE:
         raise SceneError(
             f"{scene.name}: <rt70:optics reference_link='{system.ok_link}'>: the frame's z axis "

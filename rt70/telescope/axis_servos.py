@@ -122,26 +122,6 @@ def servo_gains(
     )
 
 
-def declared_tuning(scene: Scene) -> Tuning:
-    """Each axis's ``(position_bandwidth_hz, loop_ratio)`` as declared.
-
-    An axis whose servo gives no bandwidth is tuned on the model
-    (:func:`rt70.telescope.servo_design.design`) — once per scene.
-    """
-    servos = axis_servos(scene)
-    if all(d.servo.position_bandwidth_hz is not None for d in servos.values()):
-        return {k: (d.servo.position_bandwidth_hz, d.servo.loop_ratio) for k, d in servos.items()}
-    from rt70.telescope.servo_design import design
-
-    return design(scene).tuning
-
-
-def tuning_text(tuning: Tuning) -> str:
-    """The position-loop bandwidths in one phrase: ``position loops azimuth 0.2 Hz, …``."""
-    parts = ", ".join(f"{axis} {hz:.3g} Hz" for axis, (hz, _) in tuning.items())
-    return f"position loops {parts}"
-
-
 @dataclass(frozen=True)
 class DeclaredFriction:
     """An axis's dry friction as declared: F_s at rest, its rise k per rad/s (linear).

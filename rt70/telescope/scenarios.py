@@ -43,7 +43,7 @@ from rt70.model.scene import Scene
 from rt70.model.sides import refuses_backend
 from rt70.simulation.simulate import sample_channels, simulate
 from rt70.simulation.states import StateComponent
-from rt70.telescope.axis_servos import axis_servos, declared_tuning, tuning_text
+from rt70.telescope.axis_servos import axis_servos
 from rt70.telescope.scenario import (
     DEFAULT_ELEVATION,
     DEFAULT_T_END,
@@ -59,6 +59,7 @@ from rt70.telescope.scenario import (
     scenario,
     sky_error,
 )
+from rt70.telescope.servo_design import declared_tuning, tuning_text
 from rt70.telescope.servo_metrics import (
     BAND_ARCSEC,
     measure,

@@ -32,17 +32,13 @@ axes (:class:`rt70.control.friction.AxisFriction`).
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
-import scipy.linalg
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.control.antiwindup import BackCalculationServo
 from rt70.control.friction import AxisFriction
 from rt70.control.servo import CascadeGains
 from rt70.errors import Rt70Error
-from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
 from rt70.model.antenna import mount_of
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
@@ -51,13 +47,13 @@ from rt70.simulation.states import StateComponent
 from rt70.telescope.axis_servos import (
     Tuning,
     axis_servos,
-    declared_tuning,
     friction_of,
     servo_gains,
     servo_parameters,
 )
+from rt70.telescope.drive_equilibrium import scene_equilibrium
+from rt70.telescope.servo_design import declared_tuning
 from rt70.telescope.servo_tuning import (
-    EQUILIBRIUM_TOL,
     preset_servo_state,
     servo_drives,
     servo_tolerances,
@@ -75,150 +71,6 @@ FRICTION_WIDTH_OF_RATE = 1e-6
 FRICTION_KIND = "linear"
 #: Absolute tolerance of the friction's dissipated heat, J.
 FRICTION_ATOL = 1e-3
-#: Newton steps of :func:`scene_equilibrium` at most.
-MAX_ITER = 30
-
-
-def scene_equilibrium(
-    scene: Scene,
-    couplings: list[SceneCoupling],
-    held: dict[str, float],
-    tol: float = EQUILIBRIUM_TOL,
-    load: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """Static equilibrium held by the scene's drives, encoders at ``held``.
-
-    Solves ``R(q, K) = Q_g(q) + Q_c(q) + Q_l(q) + Σ_d K_d ∂θ_d/∂q = 0`` for the coordinates not
-    held and the drives' reducer torques K_d (one per coupling): n equations, n unknowns
-    when each held coordinate is a drive's joint. Newton's method with the stiffness
-    matrix (:func:`rt70.linear.linearize.stiffness_matrix`) and the columns ∂θ_d/∂q for
-    the K_d, leaving out the term ``K_d ∂²θ_d/∂q²`` (the sector's geometric stiffness,
-    some 10⁻⁴ of the structure's: it slows the convergence, not the answer). ``Q_l`` is
-    an external static load; its stiffness is left out of Newton's matrix likewise.
-
-    Parameters
-    ----------
-    scene : Scene
-        A scene with ``<rt70:drive>`` elements.
-    couplings : list of SceneCoupling
-        The drives' couplings to the structure (:meth:`SceneServoFactory.couplings`).
-    held : dict of str to float
-        The encoders' readings: each driven joint's coordinate, rad.
-    tol : float
-        Convergence: ``max |R|`` relative to the force scale (below).
-    load : callable q -> Q_l, optional
-        An external static generalised force, shape (nv,), N·m or N (a steady wind's);
-        default none.
-
-    Returns
-    -------
-    q : numpy.ndarray
-        The configuration.
-    torques : numpy.ndarray
-        K_d, N·m on θ_d, in the order of ``couplings``.
-    residual : float
-        ``max |R|`` relative to the static force of the undeformed structure (the
-        weights: the scale of :func:`rt70.linear.linearize.equilibrium`). Newton also
-        stops, as there, when its step moves no coordinate by more than ``STEP_TOL``.
-
-    Raises
-    ------
-    Rt70Error
-        If a held coordinate is not a drive's joint, or Newton does not converge.
-    """
-    names = scene.coordinate_names
-    joints = sorted(names[c.index] for c in couplings)
-    if sorted(held) != joints:
-        raise Rt70Error(
-            f"{scene.name}: the drives hold {', '.join(joints)}, asked to hold "
-            f"{', '.join(sorted(held)) or 'nothing'}"
-        )
-    q = equilibrium(scene, held, tol=tol)  # the coordinate equilibrium: a close start
-    Q = static_force(scene, q)
-    K = np.array([-float(Q[c.index]) for c in couplings])
-    scale = _force_scale(scene, held)
-    free = np.array([i for i in range(len(names)) if names[i] not in held])
-    S = stiffness_matrix(scene, q)
-
-    def force(q: np.ndarray) -> np.ndarray:
-        return static_force(scene, q) if load is None else static_force(scene, q) + load(q)
-
-    return _drives_newton(scene, couplings, force, (q, K), (S, free), scale, tol)
-
-
-def _force_scale(scene: Scene, held: dict[str, float]) -> float:
-    """The force scale of :func:`rt70.linear.linearize.equilibrium`, at least 1.
-
-    The static force of the undeformed structure (the weights) at the held pointing;
-    the held torques alone have none at the zenith.
-    """
-    names = scene.coordinate_names
-    undeformed = np.zeros(len(names))
-    for name, value in held.items():
-        undeformed[names.index(name)] = value
-    return max(float(np.max(np.abs(static_force(scene, undeformed)))), 1.0)
-
-
-def _drives_newton(
-    scene: Scene,
-    couplings: list[SceneCoupling],
-    force: Callable[[np.ndarray], np.ndarray],
-    start: tuple[np.ndarray, np.ndarray],
-    jacobian: tuple[np.ndarray, np.ndarray],
-    scale: float,
-    tol: float,
-) -> tuple[np.ndarray, np.ndarray, float]:
-    """Newton's iteration of :func:`scene_equilibrium`: ``(q, K, residual)``.
-
-    From ``start = (q, K)``; ``jacobian = (S, free)``, the stiffness matrix at the start
-    (kept throughout) and the coordinates that move. Stops when ``max |R| / scale ≤ tol``
-    or when a step moves no coordinate by more than ``STEP_TOL``.
-    """
-    q, K = start
-    S, free = jacobian
-    size = np.inf
-    for k in range(MAX_ITER):
-        with np.errstate(over="ignore", invalid="ignore"):  # checked just below
-            G = np.column_stack([c.angle_gradient(q)[1] for c in couplings])
-            R = force(q) + G @ K
-        size = float(np.max(np.abs(R))) / scale
-        if not np.isfinite(size):
-            raise Rt70Error(
-                f"{scene.name}: drives' equilibrium: the static forces are not finite after "
-                f"{k} Newton step(s): the load (a wind?) deforms the structure beyond any "
-                "equilibrium its stiffness can give"
-            )
-        if size <= tol:
-            return q, K, size
-        step = _newton_step(scene, np.column_stack([-S[:, free], G]), R)
-        q[free] += step[: free.size]
-        K += step[free.size :]
-        if np.abs(step[: free.size]).max() <= STEP_TOL * max(1.0, np.abs(q).max()):
-            # the configuration is fixed to rounding (as equilibrium() stops)
-            R = force(q) + np.column_stack([c.angle_gradient(q)[1] for c in couplings]) @ K
-            return q, K, float(np.max(np.abs(R))) / scale
-    raise Rt70Error(
-        f"{scene.name}: drives' equilibrium not found in {MAX_ITER} Newton steps "
-        f"(residual {size:.2g} of the force scale)"
-    )
-
-
-def _newton_step(scene: Scene, J: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """``J⁻¹(−R)`` with J's columns scaled to unit max-norm first.
-
-    The columns mix units (a coordinate's stiffness, N·m/rad, against a sector's angle
-    gradient, 1/m): scaled, the solve's conditioning is the equations', not the units'.
-    """
-    scale = np.max(np.abs(J), axis=0)
-    scale[scale == 0.0] = 1.0
-    try:
-        step = scipy.linalg.solve(J / scale, -R) / scale
-    except (np.linalg.LinAlgError, ValueError):
-        raise Rt70Error(
-            f"{scene.name}: drives' equilibrium: Newton's matrix is singular or not finite "
-            "(a coordinate nothing holds?)"
-        ) from None
-    return step
 
 
 def scene_servos(
@@ -227,7 +79,7 @@ def scene_servos(
     """Each scene drive's parameters and cascade gains, as :class:`SceneServoFactory` uses.
 
     For the linear closed loop (:func:`rt70.control.scene_loop.closed_loop`); ``tuning``
-    overrides the scene's (:func:`rt70.telescope.axis_servos.declared_tuning`).
+    overrides the scene's (:func:`rt70.telescope.servo_design.declared_tuning`).
     """
     design = {**declared_tuning(scene), **(tuning or {})}
     out = {}
@@ -247,7 +99,7 @@ class SceneServoFactory:
     ----------
     tuning : dict, optional
         ``{"azimuth": (position_hz, ratio), ...}`` by axis, overriding the scene's
-        (:func:`rt70.telescope.axis_servos.declared_tuning`).
+        (:func:`rt70.telescope.servo_design.declared_tuning`).
     friction : bool
         Add the book's dry friction on each driven axis.
     side : {"reference", "textbook"}

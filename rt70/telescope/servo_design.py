@@ -40,6 +40,7 @@ from rt70.model.antenna import mount_of, pointing
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
 from rt70.telescope.axis_servos import Tuning, axis_servos, servo_gains, servo_parameters
+from rt70.telescope.drive_equilibrium import scene_equilibrium
 
 #: Bracket of the position-loop bandwidth search, Hz.
 LOW_HZ, HIGH_HZ = 0.01, 5.0
@@ -157,8 +158,6 @@ def _design(scene: Scene) -> ServoDesign:
 
 def _plant(scene: Scene, elevation_deg: float) -> lin.Linearization:
     """The structure linearised at the drive-held equilibrium of a pointing."""
-    from rt70.telescope.scene_servo import scene_equilibrium
-
     couplings = [SceneCoupling(scene, d, "reference") for d in scene.description.drives]
     q0, _, _ = scene_equilibrium(scene, couplings, pointing(scene, elevation_deg, 0.0))
     return lin.linearize(scene, q0)
@@ -253,3 +252,21 @@ def _check(scene: Scene, plants: list, result: ServoDesign) -> None:
 def _worse(a: Margins, b: Margins) -> bool:
     """Whether margins ``a`` are closer to inadequate than ``b`` (least GM, then PM)."""
     return (a.gm_db, a.pm_deg) < (b.gm_db, b.pm_deg)
+
+
+def declared_tuning(scene: Scene) -> Tuning:
+    """Each axis's ``(position_bandwidth_hz, loop_ratio)`` as declared.
+
+    An axis whose servo gives no bandwidth is tuned on the model
+    (:func:`design`) — once per scene.
+    """
+    servos = axis_servos(scene)
+    if all(d.servo.position_bandwidth_hz is not None for d in servos.values()):
+        return {k: (d.servo.position_bandwidth_hz, d.servo.loop_ratio) for k, d in servos.items()}
+    return design(scene).tuning
+
+
+def tuning_text(tuning: Tuning) -> str:
+    """The position-loop bandwidths in one phrase: ``position loops azimuth 0.2 Hz, …``."""
+    parts = ", ".join(f"{axis} {hz:.3g} Hz" for axis, (hz, _) in tuning.items())
+    return f"position loops {parts}"

@@ -24,19 +24,9 @@ from rt70.model.antenna import pointing
 from rt70.model.scene import Scene
 from rt70.scenes.rt70_drives import AxisDrive
 from rt70.simulation.states import StateComponent
-from rt70.telescope.axis_servos import (
-    Tuning,
-    axis_servos,
-    declared_tuning,
-    servo_gains,
-    servo_parameters,
-)
-
-#: Force tolerance of the static equilibria (relative): rt70_servo's Newton residual
-#: stalls at its rounding floor, 1.2e-10 at elevation 30° (above equilibrium's default
-#: 1e-10); 1e-9 of the ~1e7 N·m gravity torque is 0.01 N·m, nothing to the pointing.
-EQUILIBRIUM_TOL = 1e-9
-
+from rt70.telescope.axis_servos import Tuning, axis_servos, servo_gains, servo_parameters
+from rt70.telescope.drive_equilibrium import EQUILIBRIUM_TOL
+from rt70.telescope.servo_design import declared_tuning
 
 #: Builds the drive components: (scene, q0, held torques by coordinate, references in
 #: coordinate radians by coordinate) -> components.
@@ -138,7 +128,7 @@ def servo_drives(tuning: Tuning | None = None) -> DriveFactory:
     ----------
     tuning : dict, optional
         ``{"azimuth": (position_hz, ratio), ...}`` overriding the scene's
-        (:func:`rt70.telescope.axis_servos.declared_tuning`).
+        (:func:`rt70.telescope.servo_design.declared_tuning`).
     """
 
     def build(scene, q0, torques, references):
