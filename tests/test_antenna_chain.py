@@ -125,17 +125,18 @@ def test_a_two_point_sweep(dish):
     assert np.isfinite(result.arrays["sag"]).all()
 
 
-def test_the_command_line_writes_and_runs_it(tmp_path, capsys):
+def test_the_command_line_writes_and_runs_it(dish, tmp_path, capsys):
     out = tmp_path / "mine.urdf"
     argv = [
         "new", "antenna", "--name", "mine", "--diameter", "9", "--masses", "35000,30000",
         "--locked-rotor", "7", "--rate", "5,2.5", "--acceleration", "6",
-        "--elevation-range", "5,88", "--wind", "15", "--out", str(out),
+        "--elevation-range", "5,88", "--wind", "15", "--bandwidth", "1.2,1.3", "--out", str(out),
     ]  # fmt: skip
     assert main(argv) == 0
-    assert scene_from_text(out.read_text(encoding="utf-8"), "mine").description.mount
+    mine = scene_from_text(out.read_text(encoding="utf-8"), "mine")
+    assert [a.servo.position_bandwidth_hz for a in mine.description.mount.axes] == [1.2, 1.3]
     assert main(["modes", str(out), "--elevation", "30"]) == 0
-    assert main(["servo", str(out)]) == 0
+    assert main(["servo", str(dish)]) == 0  # the design of the fixture's text, kept
     text = capsys.readouterr().out
     assert "tuned on the model" in text and "stable" in text
 
