@@ -424,7 +424,7 @@ def check_outputs(args: argparse.Namespace) -> None:
     """Refuse output paths the command could not write, before it starts.
 
     ``simulate --out FILE`` (and the ``.png`` beside it unless ``--no-plot``),
-    ``bench --out DIRECTORY``, ``plant --out FILE.npz`` and ``sweep --out FILE.npz``.
+    ``bench --out DIRECTORY``, ``plant --out FILE.npz|FILE.mat`` and ``sweep --out FILE.npz``.
 
     Raises
     ------
@@ -452,8 +452,8 @@ def check_outputs(args: argparse.Namespace) -> None:
         check_writable_directory(out.parent)
     elif args.command == "plant" and args.out is not None:
         out = Path(args.out)
-        if out.suffix != ".npz" or out.is_dir():
-            raise OutputError(f"{out}: --out must be a .npz file")
+        if out.suffix not in (".npz", ".mat") or out.is_dir():
+            raise OutputError(f"{out}: --out must be a .npz or .mat file")
         check_writable_directory(out.parent)
 
 

@@ -32,14 +32,34 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         description="Linearise a scene at its static equilibrium (the RT-70 at a pointing, "
         "its axes held) and print the state space's named inputs and outputs: for the "
         "RT-70 the axis torques in, the axis angles and the optical points out; for other "
-        "scenes a force on and the value of every coordinate. --out writes A, B, C, D and "
-        "the names (.npz); in Python, rt70.linear.plant.to_control gives python-control's "
-        "StateSpace.",
+        "scenes a force on and the value of every coordinate. --drives: the structure with "
+        "its <rt70:drive> elements, the armature voltages in; --loop closed|open: their "
+        "declared servos closed, or one loop broken. --out writes A, B, C, D and the names "
+        "(.npz, or .mat for MATLAB with the units); in Python, rt70.linear.plant.to_control "
+        "gives python-control's StateSpace.",
     )
     pla.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
     options.add_pointing_arguments(pla)
     pla.add_argument("--json", action="store_true", help="print JSON")
-    pla.add_argument("--out", help="write A, B, C, D and the names to FILE.npz")
+    pla.add_argument(
+        "--out", help="write A, B, C, D and the names to FILE.npz or FILE.mat (MATLAB)"
+    )
+    pla.add_argument(
+        "--drives",
+        action="store_true",
+        help="the structure with its drives (voltage inputs, gear sectors included)",
+    )
+    pla.add_argument(
+        "--loop",
+        choices=("open", "closed"),
+        help="with the drives: every servo closed (references in), or one loop broken",
+    )
+    pla.add_argument(
+        "--at",
+        choices=("position", "rate"),
+        default="position",
+        help="with --loop open: the loop broken on every drive (default position)",
+    )
     pla.add_argument(
         "--reduce",
         type=options.positive_int,
@@ -66,8 +86,21 @@ def run(args: argparse.Namespace) -> int:
     from rt70.model.scene import load_scene
 
     method = _check_reduction(args)
+    if args.loop is not None or args.drives:
+        if args.reduce is not None:
+            raise Rt70Error("--reduce works on the structure's plant, not with --drives/--loop")
+        if args.at != "position" and args.loop != "open":
+            raise Rt70Error("--at needs --loop open")
     scene = load_scene(args.scene)
     has_axes, elevation, azimuth, held = options.asked_pointing(args, scene, "plant")
+    if args.loop is not None or args.drives:
+        from rt70.cli.plant_drives import run_drives
+
+        if not has_axes:
+            from rt70.model.antenna import mount_of
+
+            mount_of(scene)  # one line naming the element
+        return run_drives(args, scene, elevation, azimuth, held)
     inputs, outputs = _signals(scene, has_axes, elevation, azimuth, held)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
@@ -165,15 +198,12 @@ def _reduce(args: argparse.Namespace, scene, method: str, full, info: dict):
 
 def _write(args: argparse.Namespace, scene, ss, info: dict) -> None:
     """Check the plant is finite; with ``--out``, write A, B, C, D and the names (.npz)."""
-    import numpy as np
-
     arrays = {"A": ss.A, "B": ss.B, "C": ss.C, "D": ss.D}
     options.check_finite({**info, **arrays}, f"{scene.name}: plant")
     if args.out:
-        from rt70.guards.atomic import atomic_write
+        from rt70.cli.plant_drives import write_plant
 
-        labels = {k: np.array(info[k]) for k in ("states", "inputs", "outputs")}
-        atomic_write(args.out, lambda tmp: np.savez_compressed(tmp, **arrays, **labels))
+        write_plant(args.out, arrays, info)
 
 
 def _print_text(args: argparse.Namespace, title: str, ss, info: dict) -> None:

@@ -32,6 +32,7 @@ import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.control.axis_plant import drive_block
+from rt70.control.drives import drive_parameters
 from rt70.control.loops import pi_block
 from rt70.control.servo import CascadeGains
 from rt70.errors import Rt70Error
@@ -132,12 +133,18 @@ ERRORS = {"position": "e_p", "rate": "e_v", "current": "e_i"}
 
 
 def _cascade_blocks(
-    d: str, p: DriveParameters, g: CascadeGains, open_loop: tuple[str, str] | None
+    d: str, p: DriveParameters, g: CascadeGains, open_loop: tuple[str, str] | str | None
 ) -> list[control.StateSpace]:
-    """Drive ``d``'s motor and its three PI loops, named ``<d>_…``, one loop maybe broken."""
+    """Drive ``d``'s motor and its three PI loops, named ``<d>_…``, one loop maybe broken.
+
+    ``open_loop`` (drive, loop) breaks that drive's loop (its PI reads ``w``); a loop name
+    alone breaks it on every drive (each PI reads ``<d>_w``).
+    """
 
     def err(loop: str) -> str:
-        return "w" if open_loop == (d, loop) else f"{d}_{ERRORS[loop]}"
+        if open_loop == (d, loop):
+            return "w"
+        return f"{d}_w" if open_loop == loop else f"{d}_{ERRORS[loop]}"
 
     # the drive's own names: voltage, axis_angle, axis_rate → reducer_torque, …
     return [
@@ -158,7 +165,7 @@ def closed_loop(
     outputs: Sequence[Output],
     servos: Mapping[str, tuple[DriveParameters, CascadeGains]],
     K_extra: np.ndarray | None = None,
-    open_loop: tuple[str, str] | None = None,
+    open_loop: tuple[str, str] | str | None = None,
 ) -> control.StateSpace:
     """The scene's drives with their PI cascades closed around the structure.
 
@@ -171,10 +178,11 @@ def closed_loop(
         (for the RT-70 :func:`rt70.telescope.scene_servo.scene_servos`, the gains
         :class:`rt70.telescope.scene_servo.SceneServoFactory` simulates with). The clamps are left
         out (a linear analysis).
-    open_loop : (drive, loop), optional
+    open_loop : (drive, loop) or loop, optional
         Break one drive's ``"position"``, ``"rate"`` or ``"current"`` loop at its error:
         its PI reads the input ``w`` instead, and the error ``<drive>_e_p|e_v|e_i`` is
-        the last output (:func:`loop_gain`).
+        the last output (:func:`loop_gain`); a loop name alone breaks it on every drive,
+        each PI reading ``<drive>_w``, the errors the last outputs.
 
     Returns
     -------
@@ -196,7 +204,11 @@ def closed_loop(
             f"{scene.name}: servos for {', '.join(sorted(servos)) or 'no drive'}, the scene's "
             f"drives are {', '.join(sorted(names)) or 'none'}"
         )
-    if open_loop is not None and (open_loop[0] not in names or open_loop[1] not in ERRORS):
+    every = isinstance(open_loop, str)
+    if open_loop is not None and not (
+        (every and open_loop in ERRORS)
+        or (not every and open_loop[0] in names and open_loop[1] in ERRORS)
+    ):
         raise Rt70Error(f"{scene.name}: no loop {open_loop} to break (drives {sorted(names)})")
     couplings = [SceneCoupling(scene, d, "textbook") for d in drives]
     blocks = [structure_system(scene, lm, couplings, disturbances, outputs, K_extra)]
@@ -206,7 +218,10 @@ def closed_loop(
         extra_out += [f"{c.drive.name}_{s}" for s in ("encoder", "current", "voltage")]
     inputs = [f"{c.drive.name}_reference" for c in couplings] + list(disturbances)
     outs = [label for y in outputs for label in _labels(y)] + extra_out
-    if open_loop is not None:
+    if every:
+        inputs += [f"{c.drive.name}_w" for c in couplings]
+        outs += [f"{c.drive.name}_{ERRORS[open_loop]}" for c in couplings]
+    elif open_loop is not None:
         inputs.append("w")
         outs.append(f"{open_loop[0]}_{ERRORS[open_loop[1]]}")
     return control.interconnect(
@@ -238,3 +253,48 @@ def loop_gain(
     """
     sys = closed_loop(scene, lm, {}, [], servos, open_loop=(drive, loop))
     return -sys[f"{drive}_{ERRORS[loop]}", "w"]
+
+
+def driven_plant(
+    scene: Scene,
+    lm: lin.Linearization,
+    outputs: Sequence[Output],
+    disturbances: Mapping[str, np.ndarray] | None = None,
+) -> control.StateSpace:
+    """The structure with every ``<rt70:drive>`` on it, the armature voltages as inputs.
+
+    The plant a servo is designed around, through the same drive elements as the
+    nonlinear model (each drive's reducer acting through its own angle θ_d, gear sector
+    included: :func:`structure_system`), with no loop closed.
+
+    Parameters
+    ----------
+    scene, lm, outputs
+        As :func:`structure_system`.
+    disturbances : mapping name → (nv,) array, optional
+        Generalised-force columns of unit disturbance inputs.
+
+    Returns
+    -------
+    control.StateSpace
+        Inputs ``<drive>_voltage`` (V) then the disturbances; outputs each drive's
+        ``encoder`` (rad, its joint's coordinate about q0), ``current`` (A) and
+        ``motor_speed`` (rad/s), then the outputs' components.
+    """
+    drives = scene.description.drives
+    if not drives:
+        raise Rt70Error(f"{scene.name}: no <rt70:drive>: no driven plant")
+    disturbances = dict(disturbances or {})
+    couplings = [SceneCoupling(scene, d, "textbook") for d in drives]
+    blocks = [structure_system(scene, lm, couplings, disturbances, outputs)]
+    for c in couplings:
+        blocks.append(
+            _renamed(drive_block(drive_parameters(c.drive)), f"{c.drive.name}_", c.drive.name)
+        )
+    inputs = [f"{c.drive.name}_voltage" for c in couplings] + list(disturbances)
+    outs = [
+        f"{c.drive.name}_{s}" for c in couplings for s in ("encoder", "current", "motor_speed")
+    ] + [label for y in outputs for label in _labels(y)]
+    return control.interconnect(
+        blocks, inplist=inputs, outlist=outs, inputs=inputs, outputs=outs, check_unused=False
+    )

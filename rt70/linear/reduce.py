@@ -24,6 +24,13 @@ costs:
   logarithmic grid made denser at every lightly damped pole of both plants, its peak
   then refined by a bounded scalar search.
 
+Every function here takes rt70's :class:`~rt70.linear.responses.StateSpace` or
+python-control's (:func:`rt70.linear.responses.as_state_space`). python-control's carries
+no second-order model, so the additive split works on the physical ``A``: on the RT-70
+with its axes free the truncation to 12 states is then 3.3e-8 of ‖G‖∞ from the plant,
+against 6.2e-9 from rt70's own type (tests/test_control_interop.py); modal truncation
+needs that model and says so.
+
 Balanced truncation weighs the outputs in their units: give the outputs comparable units
 first (:func:`rescaled`: angles in arc seconds and points in mm, say), or the radians
 of an axis angle count for nothing against the arc seconds of a pointing correction.
@@ -40,7 +47,7 @@ import scipy.optimize
 
 from rt70.errors import Rt70Error
 from rt70.linear import modal
-from rt70.linear.responses import StateSpace, state_space
+from rt70.linear.responses import StateSpace, as_state_space, state_space
 
 #: A pole λ of a plant without a second-order model is marginal (rigid, kept with the
 #: unstable part) when ``|λ|² ≤ MARGINAL_RTOL · max|λ|²``; with one, when
@@ -99,6 +106,7 @@ def rescaled(
     input_scale : float or sequence of float
         ``S_u``: one factor for all inputs or m of them (finite, non-zero).
     """
+    ss = as_state_space(ss)
     sy = np.broadcast_to(np.asarray(output_scale, dtype=float), (ss.n_outputs,))
     su = np.broadcast_to(np.asarray(input_scale, dtype=float), (ss.n_inputs,))
     if not (np.all(np.isfinite(sy)) and np.all(np.isfinite(su)) and np.all(sy) and np.all(su)):
@@ -172,6 +180,7 @@ def modal_truncation(ss: StateSpace, n_modes: int) -> Reduction:
         If ``ss`` has no second-order model, or ``n_modes`` is out of range or would drop
         a rigid or unstable mode.
     """
+    ss = as_state_space(ss)
     so = ss.second_order
     if so is None:
         raise Rt70Error("modal truncation needs a plant built from M, K, D (second_order)")
@@ -258,6 +267,7 @@ def additive_split(ss: StateSpace, offset: float = 0.0) -> AdditiveSplit:
     then kept whole instead of balanced (its Gramians are of order 1/ζ and their
     rounding sets a floor on the error of the rest).
     """
+    ss = as_state_space(ss)
     if not (np.isfinite(offset) and offset >= 0.0):
         raise Rt70Error(f"offset must be a finite non-negative number, got {offset!r}")
     limit = _marginal_limit(ss)
@@ -301,6 +311,7 @@ def hankel_singular_values(ss: StateSpace, offset: float = 0.0) -> tuple[np.ndar
     ``σ_i = sqrt(λ_i(P Q))`` with the Gramians ``A P + P Aᵀ + B Bᵀ = 0`` and
     ``Aᵀ Q + Q A + Cᵀ C = 0`` of the stable part (:func:`additive_split`).
     """
+    ss = as_state_space(ss)
     split = additive_split(ss, offset)
     if split.A_s.shape[0] == 0:
         return np.zeros(0), split.A_u.shape[0]
@@ -335,6 +346,7 @@ def balanced_truncation(ss: StateSpace, order: int, offset: float = 0.0) -> Redu
         singular values include zeros (an unobservable or uncontrollable part: choose a
         smaller order).
     """
+    ss = as_state_space(ss)
     split = additive_split(ss, offset)
     n_u, n_s = split.A_u.shape[0], split.A_s.shape[0]
     if not max(1, n_u) <= order <= n_u + n_s:
@@ -451,6 +463,7 @@ def hinf_error(
     n_grid : int
         Number of log-spaced grid points.
     """
+    full, reduced = as_state_space(full), as_state_space(reduced)
     if not (np.isfinite(f_min) and f_min > 0):
         raise Rt70Error(f"f_min must be a positive frequency, got {f_min!r}")
     if f_max is None:

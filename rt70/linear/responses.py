@@ -83,6 +83,31 @@ class StateSpace:
         return self.C.shape[0]
 
 
+def as_state_space(sys) -> StateSpace:
+    """rt70's :class:`StateSpace` of ``sys``: itself, or a python-control ``StateSpace``.
+
+    A python-control system (anything with ``A``, ``B``, ``C``, ``D`` and
+    ``state_labels``, ``input_labels``, ``output_labels``) keeps its matrices and names;
+    it has no second-order model unless it carries one as ``second_order`` (so the
+    functions that need one, modal truncation, say so).
+
+    Raises
+    ------
+    Rt70Error
+        If ``sys`` is neither.
+    """
+    if isinstance(sys, StateSpace):
+        return sys
+    try:
+        A, B, C, D = (np.asarray(getattr(sys, k), dtype=float) for k in "ABCD")
+        names = [tuple(getattr(sys, k)) for k in ("state_labels", "input_labels", "output_labels")]
+    except AttributeError:
+        raise Rt70Error(
+            f"expected a state space (rt70's or python-control's), got {type(sys).__name__}"
+        ) from None
+    return StateSpace(A, B, C, D, *names, second_order=getattr(sys, "second_order", None))
+
+
 def _assemble(
     M: np.ndarray,
     chol: tuple[np.ndarray, bool],
@@ -348,6 +373,7 @@ def frequency_response(
         frequencies (a free structure at 0 Hz). Near such a pole scipy may warn that
         the system is ill-conditioned; evaluate rigid-body systems at f > 0.
     """
+    ss = as_state_space(ss)
     f = np.asarray(freq_hz, dtype=float)
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)):
         raise Rt70Error("freq_hz must be a non-empty 1-D array of finite frequencies")
@@ -397,6 +423,7 @@ def step_response(ss: StateSpace, t: np.ndarray) -> tuple[np.ndarray, np.ndarray
     y : ndarray, shape (nt, p, m)
         ``y[k, i, j]``: output i at ``t[k]`` for a unit step on input j.
     """
+    ss = as_state_space(ss)
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
         raise Rt70Error("t must be a non-empty 1-D array of finite times")
