@@ -165,6 +165,14 @@ def run(args: argparse.Namespace) -> int:
         out["audit"] = audit.to_dict()
     options.check_finite(out, f"{scene.name}: impact")
     if args.json:
+        out["units"] = {
+            "q": "rad or m (each coordinate's)",
+            "qd_before, qd_after": "rad/s or m/s",
+            "impulses": "N·s or N·m·s (each lock's row)",
+            "joint_impulses": "N·s, N·m·s",
+            "kinetic_before, kinetic_after, energy_lost": "J",
+            "max_rel_err_*": "1",
+        }
         print(json.dumps(out, indent=2))
         return 0
     _print_text(args, out, (impact, ref), shock, audit)

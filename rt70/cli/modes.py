@@ -58,6 +58,14 @@ def run(args: argparse.Namespace) -> int:
             **({"constraints": constraints} if constraints is not None else {}),
             "modes": rows,
             "damped": damped_summary,
+            "units": {
+                "held": "rad (m for a prismatic coordinate)",
+                "freq_hz": "Hz",
+                "divergence_rate": "1/s",
+                "zeta": "1",
+                "shape": "mass-normalised: each coordinate's unit per sqrt(kg·m²)",
+                "real_eigenvalues": "1/s",
+            },
         }
         print(json.dumps(out, indent=2))
         return 0

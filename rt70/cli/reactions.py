@@ -100,7 +100,12 @@ def run(args: argparse.Namespace) -> int:
     if out is not None:
         bl.write_output(out, rows)
     if args.json:
-        print(json.dumps({"scene": scene.name, "rows": [b.to_dict() for b in rows]}, indent=2))
+        units = (
+            "row keys by suffix: _kN kN, _kNm kN·m, _deg degrees, wind_speed m/s; *_wrench "
+            "[Fx, Fy, Fz, Mx, My, Mz] N and N·m; mesh_force N; torques N·m; seconds_* s"
+        )
+        rows_out = [b.to_dict() for b in rows]
+        print(json.dumps({"scene": scene.name, "units": units, "rows": rows_out}, indent=2))
     else:
         print(bl.format_table(scene.name, rows, bl.bearing_joints(scene)))
         seconds_tb = sum(b.seconds_textbook for b in rows) / len(rows)
