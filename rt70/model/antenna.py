@@ -347,3 +347,44 @@ def sky_frame(scene: Scene) -> SkyFrame:
     if np.linalg.norm(horizontal) <= 1e-9:
         raise SceneError(f"{scene.name}: at azimuth 0 the antenna looks at the zenith")
     return SkyFrame(up, axis, horizontal / np.linalg.norm(horizontal), az.sign)
+
+
+#: How far (a unit vector's components) a mount's azimuth directions may lie from the
+#: wind's convention (:func:`check_wind_convention`).
+WIND_CONVENTION_TOLERANCE = 1e-6
+
+
+def check_wind_convention(scene: Scene) -> None:
+    """Refuse a mount whose azimuths are not the wind's compass.
+
+    A wind's direction is an azimuth on the same compass as the pointing's
+    (:func:`rt70.physics.aerodynamics.horizontal_direction`): azimuth 0
+    looks along −y and azimuth 90° along +x (z up). A mount that counts its azimuth
+    otherwise would put a "front" wind anywhere else, so it is refused, saying where its
+    azimuths 0 and 90° look.
+
+    Raises
+    ------
+    SceneError
+        If the horizontal directions of the undeformed antenna at azimuths 0 and 90°
+        are not the wind's.
+    """
+    from rt70.physics.aerodynamics import horizontal_direction
+
+    frame = sky_frame(scene)
+    el = mount_of(scene).axis("elevation")
+    elevation = min(max(0.0, math.degrees(el.lower)), math.degrees(el.upper))
+    looks = []
+    for azimuth in (0.0, 90.0):
+        d = source(scene, elevation, azimuth)
+        h = d - (d @ frame.up) * frame.up
+        looks.append(h / np.linalg.norm(h))
+    wanted = [horizontal_direction(0.0), horizontal_direction(90.0)]
+    if max(float(np.max(np.abs(a - b))) for a, b in zip(looks, wanted, strict=True)) > (
+        WIND_CONVENTION_TOLERANCE
+    ):
+        raise SceneError(
+            f"{scene.name}: its azimuths 0° and 90° look along {np.round(looks[0], 3)} and "
+            f"{np.round(looks[1], 3)}; the wind's compass has them along -y and +x: set "
+            "<rt70:axis name='azimuth'> zero_deg and sign so (docs/urdf-extensions.md)"
+        )

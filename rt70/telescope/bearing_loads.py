@@ -168,6 +168,10 @@ def check_scene(scene: Scene, wind: bool) -> None:
         )
     if wind and not scene.description.winds:
         raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (docs/wind.md)")
+    if wind:
+        from rt70.model.antenna import check_wind_convention
+
+        check_wind_convention(scene)  # the wind's directions are azimuths of the mount
 
 
 def check_case(case: LoadCase) -> None:

@@ -145,16 +145,18 @@ def check_case(case: PointingCase) -> None:
 def check_scene(scene: Scene) -> None:
     """Refuse a scene that cannot give a budget, before any work.
 
-    It needs a ``<rt70:mount>``, an ``<rt70:optics>``, a ``<rt70:drive>`` on each
-    axis and at least one ``<rt70:wind>`` element.
+    It needs a ``<rt70:mount>`` whose azimuths are the wind's
+    (:func:`rt70.model.antenna.check_wind_convention`), an ``<rt70:optics>``, a
+    ``<rt70:drive>`` on each axis and at least one ``<rt70:wind>`` element.
     """
-    from rt70.model.antenna import mirror_system
+    from rt70.model.antenna import check_wind_convention, mirror_system
     from rt70.telescope.scene_servo import check_scene_drives
 
     mirror_system(scene)  # raises naming the missing <rt70:mount> or <rt70:optics>
     check_scene_drives(scene)
     if not scene.description.winds:
         raise Rt70Error(f"{scene.name}: no <rt70:wind> element: no wind load (see docs/wind.md)")
+    check_wind_convention(scene)
 
 
 class WindyScene:
