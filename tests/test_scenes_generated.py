@@ -31,6 +31,8 @@ EXPECTED_NV = {
     "gear_reducer": 5,
     "four_bar": 3,
     "crank_slider": 3,
+    "antenna_12m": 6,
+    "antenna_34m": 6,
 }
 
 RT70_BODIES = (
