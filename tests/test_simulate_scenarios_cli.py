@@ -76,3 +76,11 @@ def test_bad_options_are_refused_in_one_line(args, message, capsys):
     captured = capsys.readouterr()
     assert message in one_error_line(captured.err)
     assert captured.out == ""  # refused before any work
+
+
+def test_a_pointing_error_that_has_not_settled_is_not_reported_settled(capsys):
+    """5 s into a 1° elevation step the RT-70 is still slewing (final error 413″): the
+    cross-elevation error settled at t = 0 must not make the pointing error 'inside 1″'."""
+    assert main(["simulate", "rt70_servo", "--scenario", "step-elevation", "--t-end", "5"]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if "pointing error" in s)
+    assert "not inside 1″ by the end of the run" in line, line

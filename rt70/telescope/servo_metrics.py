@@ -113,7 +113,8 @@ def measure(run: ScenarioRun) -> dict[str, float]:
     m: dict[str, float] = {
         "pointing_drift_arcsec": float(run.pointing_error_total.max()),
         "final_pointing_arcsec": float(run.pointing_error_total[-1]),
-        "settle_s": max(settling_time(t, err[:, 0]), settling_time(t, err[:, 1])),
+        # NaN (never settled) wins: Python's max(0.0, nan) is 0.0
+        "settle_s": float(np.max([settling_time(t, err[:, 0]), settling_time(t, err[:, 1])])),
         "static_misalignment_arcsec": run.static_misalignment,
         "wall_s": run.result.wall_time_s,
         "energy_drift": run.result.relative_drift,
