@@ -11,6 +11,7 @@ subject is the RT-70 itself (:data:`RT70_OWN`).
 from __future__ import annotations
 
 import ast
+from functools import cache
 from pathlib import Path
 
 from rt70.model.scene import load_scene
@@ -27,14 +28,15 @@ RT70_OWN = {
 }
 
 
-def _rt70_names() -> set[str]:
+@cache
+def _rt70_names() -> frozenset[str]:
     """Links, joints and optical points of the RT-70 scenes (``world`` is anyone's)."""
     names: set[str] = set()
     for scene in ("rt70", "rt70_servo", "rt70_jack"):
         d = load_scene(scene).description
         names |= set(d.links) | {j.name for j in d.joints} | {p.name for p in d.optical_points}
         names |= {b.name for b in d.bushings} | {s.name for s in d.joint_springs}
-    return names - {"world"}
+    return frozenset(names - {"world"})
 
 
 def _docstrings(tree: ast.AST) -> set[int]:
