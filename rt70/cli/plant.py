@@ -100,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
             from rt70.model.antenna import mount_of
 
             mount_of(scene)  # one line naming the element
-        return run_drives(args, scene, elevation, azimuth, held)
+        outputs = _mirror_outputs(scene, elevation, azimuth)
+        return run_drives(args, scene, (elevation, azimuth), held, outputs)
     inputs, outputs = _signals(scene, has_axes, elevation, azimuth, held)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
@@ -163,13 +164,20 @@ def _signals(scene, has_axes: bool, elevation: float, azimuth: float, held: dict
     inputs = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
     outputs = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
     outputs += optical_point_outputs(scene)
-    # at the zenith Δα, Δβ are undefined (4.160)
-    if scene.description.optics is not None and elevation < ZENITH_KEYHOLE_DEG:
-        from rt70.model.antenna import pointing_outputs
+    return inputs, outputs + _mirror_outputs(scene, elevation, azimuth)
 
-        mirror = pointing_outputs(scene, elevation, azimuth)
-        outputs += [o for o in mirror if o.name in ("focal_offset", "pointing_correction")]
-    return inputs, outputs
+
+def _mirror_outputs(scene, elevation: float, azimuth: float) -> list:
+    """The focal offset and pointing corrections, when the scene declares ``<rt70:optics>``.
+
+    None above :data:`ZENITH_KEYHOLE_DEG`: at the zenith Δα, Δβ are undefined (4.160).
+    """
+    if scene.description.optics is None or elevation >= ZENITH_KEYHOLE_DEG:
+        return []
+    from rt70.model.antenna import pointing_outputs
+
+    wanted = ("focal_offset", "pointing_correction")
+    return [o for o in pointing_outputs(scene, elevation, azimuth) if o.name in wanted]
 
 
 def _reduce(args: argparse.Namespace, scene, method: str, full, info: dict):

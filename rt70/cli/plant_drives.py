@@ -51,7 +51,9 @@ def unit_of(name: str, drives: list[str], loop: str = "position") -> str:
     return SIGNAL_UNITS[name.split(":")[0]]
 
 
-def run_drives(args: argparse.Namespace, scene, elevation: float, azimuth: float, held: dict):
+def run_drives(
+    args: argparse.Namespace, scene, pointing: tuple[float, float], held: dict, outputs: list
+):
     """Build, print and write the plant with drives (module docstring).
 
     Parameters
@@ -60,29 +62,24 @@ def run_drives(args: argparse.Namespace, scene, elevation: float, azimuth: float
         ``rt70 plant``'s options (``loop``, ``at``, ``json``, ``out``).
     scene : rt70.model.scene.Scene
         The scene, with its drives.
-    elevation, azimuth : float
-        The pointing, degrees.
+    pointing : (float, float)
+        The elevation and azimuth, degrees.
     held : dict of str to float
         Its held axis coordinates (:func:`rt70.model.antenna.pointing`).
+    outputs : list of rt70.model.outputs.Output
+        The mirror outputs beside the drives' own (``rt70 plant``'s, zenith keyhole
+        applied).
     """
     import control
     import numpy as np
 
     from rt70.control.scene_loop import ERRORS, closed_loop, driven_plant
-    from rt70.linear import linearize as lin
-    from rt70.model.antenna import pointing_outputs
-    from rt70.model.couplings import SceneCoupling
-    from rt70.telescope.drive_equilibrium import scene_equilibrium
+    from rt70.telescope.drive_equilibrium import drive_held_linearization
 
     if not scene.description.drives:
         raise Rt70Error(f"{scene.name}: --drives/--loop need the scene's <rt70:drive> elements")
-    couplings = [SceneCoupling(scene, d, "reference") for d in scene.description.drives]
-    q0, _, _ = scene_equilibrium(scene, couplings, held)
-    lm = lin.linearize(scene, q0)
-    outputs = []
-    if scene.description.optics is not None and elevation < 89.0:  # Δα, Δβ undefined at the zenith
-        wanted = ("focal_offset", "pointing_correction")
-        outputs = [o for o in pointing_outputs(scene, elevation, azimuth) if o.name in wanted]
+    lm = drive_held_linearization(scene, held)
+    elevation, azimuth = pointing
     if args.loop is None:
         sys_, what = driven_plant(scene, lm, outputs), "open loops: the voltages in"
     else:

@@ -91,6 +91,19 @@ def servo_parameters(scene: Scene, declared: DeclaredServo) -> DriveParameters:
     return drive_parameters(declared.drive, design_inertia(scene, declared))
 
 
+def drive_servos(scene: Scene, tuning: Tuning) -> dict[str, tuple[DriveParameters, CascadeGains]]:
+    """Each servo drive's parameters and cascade gains at a full ``tuning``, by drive name.
+
+    What :func:`rt70.control.scene_loop.closed_loop` takes; ``tuning`` gives every axis
+    (:func:`rt70.telescope.scene_servo.scene_servos` fills it from the scene's design).
+    """
+    out = {}
+    for name, declared in axis_servos(scene).items():
+        p = servo_parameters(scene, declared)
+        out[declared.drive.name] = (p, servo_gains(p, declared.servo, *tuning[name]))
+    return out
+
+
 def servo_gains(
     p: DriveParameters, servo: AxisServo, position_hz: float, ratio: float
 ) -> CascadeGains:

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from rt70.errors import Rt70Error
+from rt70.linear import linearize as lin
 from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
@@ -169,3 +170,14 @@ def _newton_step(scene: Scene, J: np.ndarray, R: np.ndarray) -> np.ndarray:
             "(a coordinate nothing holds?)"
         ) from None
     return step
+
+
+def drive_held_linearization(scene: Scene, held: dict[str, float]) -> lin.Linearization:
+    """The structure linearised, every coordinate free, at the equilibrium its drives hold.
+
+    :func:`scene_equilibrium` with every ``<rt70:drive>`` (reference side) and the
+    encoders at ``held``; the starting point of the servo's linear loops.
+    """
+    couplings = [SceneCoupling(scene, d, "reference") for d in scene.description.drives]
+    q0, _, _ = scene_equilibrium(scene, couplings, held)
+    return lin.linearize(scene, q0)

@@ -47,6 +47,7 @@ from rt70.simulation.states import StateComponent
 from rt70.telescope.axis_servos import (
     Tuning,
     axis_servos,
+    drive_servos,
     friction_of,
     servo_gains,
     servo_parameters,
@@ -81,12 +82,7 @@ def scene_servos(
     For the linear closed loop (:func:`rt70.control.scene_loop.closed_loop`); ``tuning``
     overrides the scene's (:func:`rt70.telescope.servo_design.declared_tuning`).
     """
-    design = {**declared_tuning(scene), **(tuning or {})}
-    out = {}
-    for name, declared in axis_servos(scene).items():
-        p = servo_parameters(scene, declared)
-        out[declared.drive.name] = (p, servo_gains(p, declared.servo, *design[name]))
-    return out
+    return drive_servos(scene, {**declared_tuning(scene), **(tuning or {})})
 
 
 class SceneServoFactory:

@@ -37,10 +37,9 @@ from rt70.control.scene_loop import closed_loop, loop_gain
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.model.antenna import mount_of, pointing
-from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
-from rt70.telescope.axis_servos import Tuning, axis_servos, servo_gains, servo_parameters
-from rt70.telescope.drive_equilibrium import scene_equilibrium
+from rt70.telescope.axis_servos import Tuning, axis_servos, drive_servos
+from rt70.telescope.drive_equilibrium import drive_held_linearization
 
 #: Bracket of the position-loop bandwidth search, Hz.
 LOW_HZ, HIGH_HZ = 0.01, 5.0
@@ -158,18 +157,7 @@ def _design(scene: Scene) -> ServoDesign:
 
 def _plant(scene: Scene, elevation_deg: float) -> lin.Linearization:
     """The structure linearised at the drive-held equilibrium of a pointing."""
-    couplings = [SceneCoupling(scene, d, "reference") for d in scene.description.drives]
-    q0, _, _ = scene_equilibrium(scene, couplings, pointing(scene, elevation_deg, 0.0))
-    return lin.linearize(scene, q0)
-
-
-def _servos(scene: Scene, tuning: Tuning) -> dict:
-    """Every drive's (parameters, gains) at a tuning."""
-    out = {}
-    for name, declared in axis_servos(scene).items():
-        p = servo_parameters(scene, declared)
-        out[declared.drive.name] = (p, servo_gains(p, declared.servo, *tuning[name]))
-    return out
+    return drive_held_linearization(scene, pointing(scene, elevation_deg, 0.0))
 
 
 def _adequate(scene: Scene, plants: list, tuning: Tuning, axes: tuple[str, ...]) -> bool:
@@ -177,7 +165,7 @@ def _adequate(scene: Scene, plants: list, tuning: Tuning, axes: tuple[str, ...])
 
     Stops at the first failing margin; the closed loop's stability is checked last.
     """
-    servos = _servos(scene, tuning)
+    servos = drive_servos(scene, tuning)
     declared = axis_servos(scene)
     for lm in plants:
         for axis in axes:
@@ -230,7 +218,7 @@ def _highest(
 
 def _check(scene: Scene, plants: list, result: ServoDesign) -> None:
     """Fill in the least margins of every loop and the closed-loop bandwidths."""
-    servos = _servos(scene, result.tuning)
+    servos = drive_servos(scene, result.tuning)
     declared = axis_servos(scene)
     for axis, d in declared.items():
         drive = d.drive.name

@@ -18,11 +18,10 @@ import control
 import numpy as np
 
 from rt70.control.scene_loop import closed_loop
-from rt70.linear import linearize as lin
 from rt70.model.antenna import pointing
-from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
 from rt70.telescope.axis_servos import axis_servos
+from rt70.telescope.drive_equilibrium import drive_held_linearization
 from rt70.telescope.scenario import scenario
 from rt70.telescope.servo_metrics import settling_time
 
@@ -80,7 +79,7 @@ def small_step(
         The step, arc seconds.
     """
     from rt70.telescope.scenarios import run_scenario
-    from rt70.telescope.scene_servo import SceneServoFactory, scene_equilibrium, scene_servos
+    from rt70.telescope.scene_servo import SceneServoFactory, scene_servos
 
     deg = step_arcsec / 3600.0
     base = scenario(f"step-{axis}", elevation_deg, 0.0, t_end)
@@ -89,9 +88,8 @@ def small_step(
     run = run_scenario(scene, sc, drives=SceneServoFactory())
     t = run.result.t
     nonlinear = step_arcsec - run.axis_error[axis]
-    couplings = [SceneCoupling(scene, d, "reference") for d in scene.description.drives]
-    q0, _, _ = scene_equilibrium(scene, couplings, pointing(scene, elevation_deg, 0.0))
-    loop = closed_loop(scene, lin.linearize(scene, q0), {}, [], scene_servos(scene))
+    lm = drive_held_linearization(scene, pointing(scene, elevation_deg, 0.0))
+    loop = closed_loop(scene, lm, {}, [], scene_servos(scene))
     drive = axis_servos(scene)[axis].drive.name
     response = control.step_response(loop[f"{drive}_encoder", f"{drive}_reference"], T=t)
     linear = step_arcsec * np.asarray(response.outputs, dtype=float).reshape(-1)
