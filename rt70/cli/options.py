@@ -322,7 +322,7 @@ def asked_pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, fl
         If the scene has no degree of freedom, or a pointing is given for a scene
         without a mount, or lies outside an axis's range.
     """
-    from rt70.model.antenna import mount_of, pointing
+    from rt70.model.antenna import mount_of, pointing, range_deg
 
     names = scene.textbook.coordinate_names
     if not names:
@@ -336,7 +336,8 @@ def asked_pointing(args: argparse.Namespace, scene, what: str) -> tuple[bool, fl
     elevation = args.elevation
     if elevation is None:
         axis = mount_of(scene).axis("elevation")
-        elevation = min(max(90.0, math.degrees(axis.lower)), math.degrees(axis.upper))
+        low, high = range_deg(axis)
+        elevation = min(max(90.0, low), high)
     with option_at_fault(f"--elevation {elevation:g} --azimuth {azimuth:g}"):
         held = pointing(scene, elevation, azimuth)
     return True, elevation, azimuth, held

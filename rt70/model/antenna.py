@@ -22,7 +22,7 @@ from rt70.errors import SceneError
 from rt70.model.optics import MirrorSystem, mirror_outputs
 from rt70.model.outputs import Output, Point, evaluate
 from rt70.physics.rotations import rpy_matrix
-from rt70.urdf.description import Mount, Optics
+from rt70.urdf.description import Mount, MountAxis, Optics
 
 if TYPE_CHECKING:
     from rt70.model.scene import Scene
@@ -30,6 +30,17 @@ if TYPE_CHECKING:
 #: Rounding allowed at the ends of an axis's range, degrees (its bounds are read in
 #: degrees and kept in radians).
 RANGE_ROUNDING_DEG = 1e-9
+
+
+def range_deg(axis: MountAxis) -> tuple[float, float]:
+    """An axis's pointing range, degrees."""
+    return math.degrees(axis.lower), math.degrees(axis.upper)
+
+
+def within_range(axis: MountAxis, angle_deg: float) -> bool:
+    """Whether ``angle_deg`` lies in the axis's range, to :data:`RANGE_ROUNDING_DEG`."""
+    low, high = range_deg(axis)
+    return low - RANGE_ROUNDING_DEG <= angle_deg <= high + RANGE_ROUNDING_DEG
 
 
 def mount_of(scene: Scene) -> Mount:
@@ -79,8 +90,8 @@ def pointing(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> di
     for name, angle_deg in (("azimuth", azimuth_deg), ("elevation", elevation_deg)):
         axis = mount.axis(name)
         angle = math.radians(angle_deg)
-        low, high = math.degrees(axis.lower), math.degrees(axis.upper)
-        if not low - RANGE_ROUNDING_DEG <= angle_deg <= high + RANGE_ROUNDING_DEG:
+        if not within_range(axis, angle_deg):
+            low, high = range_deg(axis)
             raise SceneError(
                 f"{scene.name}: {name} {angle_deg:g}° lies outside its axis's range "
                 f"{low:g}…{high:g}° (<rt70:axis "
@@ -341,7 +352,7 @@ def sky_frame(scene: Scene) -> SkyFrame:
     g = np.asarray(scene.description.gravity, dtype=float)
     up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else axis
     el = mount.axis("elevation")
-    low, high = math.degrees(el.lower), math.degrees(el.upper)
+    low, high = range_deg(el)
     look = source(scene, min(max(0.0, low), high), 0.0)
     horizontal = look - (look @ up) * up
     if np.linalg.norm(horizontal) <= 1e-9:
@@ -373,7 +384,8 @@ def check_wind_convention(scene: Scene) -> None:
 
     frame = sky_frame(scene)
     el = mount_of(scene).axis("elevation")
-    elevation = min(max(0.0, math.degrees(el.lower)), math.degrees(el.upper))
+    low, high = range_deg(el)
+    elevation = min(max(0.0, low), high)
     looks = []
     for azimuth in (0.0, 90.0):
         d = source(scene, elevation, azimuth)

@@ -274,7 +274,7 @@ def plan(
 
 def _check_pointings(name: str, scene, grid: Grid) -> None:
     """Refuse a scene without a mount, or a grid elevation or azimuth outside its ranges."""
-    from rt70.model.antenna import mount_of
+    from rt70.model.antenna import mount_of, range_deg, within_range
 
     try:
         mount = mount_of(scene)
@@ -282,10 +282,10 @@ def _check_pointings(name: str, scene, grid: Grid) -> None:
         raise SweepError(f"no pointing axes to sweep: {exc}") from None
     for axis_name in ("elevation", "azimuth"):
         axis = mount.axis(axis_name)
-        low, high = math.degrees(axis.lower), math.degrees(axis.upper)
         values = next(a.values for a in grid.axes if a.name == axis_name)
-        outside = [v for v in values if not low - 1e-9 <= v <= high + 1e-9]
+        outside = [v for v in values if not within_range(axis, v)]
         if outside:
+            low, high = range_deg(axis)
             raise SweepError(
                 f"--{axis_name} {outside[0]:g}: {name} points its {axis_name} axis from "
                 f"{low:g}° to {high:g}° (<rt70:axis name='{axis_name}'>)"

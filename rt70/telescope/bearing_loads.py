@@ -36,7 +36,6 @@ weight, and the two sides agree.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import asdict, dataclass
 
@@ -293,10 +292,10 @@ def _side_loads(scene: Scene, side: str, q: np.ndarray, condition, drives: dict,
 
 def default_elevations(scene: Scene) -> tuple[float, ...]:
     """:data:`N_ELEVATIONS` elevations evenly over the scene's elevation range, degrees."""
-    from rt70.model.antenna import mount_of
+    from rt70.model.antenna import mount_of, range_deg
 
     axis = mount_of(scene).axis("elevation")
-    low, high = math.degrees(axis.lower), math.degrees(axis.upper)
+    low, high = range_deg(axis)
     return tuple(float(round(e, 9)) for e in np.linspace(low, high, N_ELEVATIONS))
 
 

@@ -36,7 +36,7 @@ from rt70.control.loop_measures import Margins, bandwidth_hz, margins, stable
 from rt70.control.scene_loop import closed_loop, loop_gain
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
-from rt70.model.antenna import mount_of, pointing
+from rt70.model.antenna import mount_of, pointing, range_deg
 from rt70.model.scene import Scene
 from rt70.telescope.axis_servos import Tuning, axis_servos, drive_servos
 from rt70.telescope.drive_equilibrium import drive_held_linearization
@@ -115,7 +115,7 @@ class ServoDesign:
 def design_elevations(scene: Scene) -> tuple[float, ...]:
     """The elevations a design is checked at: the range's ends and middle, degrees."""
     axis = mount_of(scene).axis("elevation")
-    low, high = math.degrees(axis.lower), math.degrees(axis.upper)
+    low, high = range_deg(axis)
     return (low, 0.5 * (low + high), high)
 
 
