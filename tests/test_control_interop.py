@@ -1,13 +1,15 @@
-"""rt70.linear takes python-control's StateSpace as readily as its own.
+"""rt70's plants are python-control systems, and rt70.linear takes any python-control one.
 
-The plant of the RT-70 with its axes free, as rt70's StateSpace and as python-control's
-(:func:`rt70.linear.plant.to_control`): balanced truncation, its H∞ error and the
+The plant of the RT-70 with its axes free, as rt70 builds it (a python-control
+``StateSpace`` that keeps its second-order model) and as a plain python-control system
+with the same matrices (``control.ss``): balanced truncation, its H∞ error and the
 frequency response give the same numbers from either; modal truncation, which needs the
-second-order model python-control's type does not carry, says so.
+second-order model, says so.
 """
 
 from __future__ import annotations
 
+import control
 import numpy as np
 import pytest
 
@@ -16,6 +18,7 @@ from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
 from rt70.linear import reduce as rd
 from rt70.linear import responses as rs
+from rt70.linear.state_space import as_state_space
 from rt70.model.scene import load_scene
 from rt70.testing import assert_close
 
@@ -28,7 +31,7 @@ def plants():
     ins = [pl.CoordinateInput(f"torque:{a}", a) for a in held]
     outs = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
     ss = pl.plant(scene, q0, ins, outs)
-    return ss, pl.to_control(ss)
+    return ss, control.ss(ss)
 
 
 def test_balanced_truncation_and_its_error_take_either_type(plants):
@@ -62,5 +65,5 @@ def test_what_needs_the_second_order_model_says_so(plants):
     _, sys = plants
     with pytest.raises(Rt70Error, match="needs a plant built from M, K, D"):
         rd.modal_truncation(sys, 5)
-    with pytest.raises(Rt70Error, match="expected a state space"):
-        rs.as_state_space(np.eye(2))
+    with pytest.raises(Rt70Error, match="expected a python-control StateSpace"):
+        as_state_space(np.eye(2))

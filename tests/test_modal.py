@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 
 from rt70.errors import Rt70Error
 from rt70.linear import modal, responses
+from rt70.linear.state_space import StateSpace
 from rt70.plotting import modal as plots
 from rt70.testing import MIN_REL, assert_close
 
@@ -230,8 +231,8 @@ def test_state_space_matrices():
     np.testing.assert_array_equal(ss.A[:6, 6:], np.eye(6))  # the identity block, placed
     assert_close(ss.B[6:], Minv @ B_in, rel=1e-14)
     assert ss.D.shape == (2, 1) and not ss.D.any()
-    assert ss.state_names[0] == "q1" and ss.state_names[6] == "q1_dot"
-    assert ss.output_names == ("mirror", "cr") and ss.input_names == ("u1",)
+    assert ss.state_labels[0] == "q1" and ss.state_labels[6] == "q1_dot"
+    assert ss.output_labels == ["mirror", "cr"] and ss.input_labels == ["u1"]
     # eigenvalues of A: ±jω for the undamped model
     ss0 = responses.state_space(M, K, None, B_in, np.eye(6)[0])
     lam = np.sort(np.abs(np.linalg.eigvals(ss0.A).imag))[::2]
@@ -262,7 +263,7 @@ def test_modal_state_space_matches_full_and_truncates():
     f = np.geomspace(0.5, 30.0, 200)
     full = responses.frequency_response(responses.state_space(M, K, D, B_in, C_out), f)
     ms = responses.modal_state_space(md, B_in, C_out)
-    assert ms.n_states == 12 and ms.state_names[0] == "z1"
+    assert ms.nstates == 12 and ms.state_labels[0] == "z1"
     mod = responses.frequency_response(ms, f)
     # entry by entry: each frequency on its own |H| (which spans decades)
     assert_close_complex(mod.H, full.H, rel=1e-9, scale=np.abs(full.H))
@@ -271,7 +272,7 @@ def test_modal_state_space_matches_full_and_truncates():
     # truncation to the lowest 4 modes (rigid, 3.27, 4.24, 6.30 Hz) keeps the response
     # below 5 Hz to 0.5 %; 3 modes do not (mode 4 carries 8 % at 3 Hz)
     tr = responses.modal_state_space(md, B_in, C_out, n_modes=4)
-    assert tr.n_states == 8
+    assert tr.nstates == 8
     low = f < 5.0
     truncated = responses.frequency_response(tr, f[low]).H
     assert_close_complex(truncated, full.H[low], rel=5e-3, scale=np.abs(full.H[low]))
@@ -430,7 +431,9 @@ def test_bad_inputs_elsewhere_raise():
     with pytest.raises(Rt70Error, match="increasing"):
         responses.step_response(ss, [0.0, 1.0, 1.0])
     with pytest.raises(Rt70Error, match="second_order|M, K, D"):
-        bare = responses.StateSpace(ss.A, ss.B, ss.C, ss.D, ss.state_names, ("u",), ("y",))
+        bare = StateSpace(
+            ss.A, ss.B, ss.C, ss.D, states=ss.state_labels, inputs=["u"], outputs=["y"]
+        )
         responses.frequency_response(bare, [1.0], method="second_order")
     with pytest.raises(Rt70Error, match="elastic"):
         modal.stiffness_proportional_damping(

@@ -117,7 +117,7 @@ def test_plant_wind_inputs_give_disturbance_to_pointing_transfer_functions(scene
     import control
 
     from rt70.linear import linearize as lin
-    from rt70.linear.plant import plant, to_control
+    from rt70.linear.plant import plant
     from rt70.scenes.rt70_state import rt70_pointing
     from rt70.telescope.pointing import budget_outputs, wind_inputs
 
@@ -132,7 +132,7 @@ def test_plant_wind_inputs_give_disturbance_to_pointing_transfer_functions(scene
     terms = np.abs(columns).sum(axis=0).max()
     assert_close(columns.sum(axis=0), inputs[-1].column, rel=1e-12, scale=terms)
     outputs = [o for o in budget_outputs(scene, case) if o.name == "main_mirror_error"]
-    ss = to_control(plant(scene, q0, inputs, outputs, locked=tuple(held)))
+    ss = plant(scene, q0, inputs, outputs, locked=tuple(held))
     dc = control.dcgain(ss)
     k = ss.output_labels.index("main_mirror_error:y")
     gains = np.array([dc[k, ss.input_labels.index(n)] for n in names[:-1]])

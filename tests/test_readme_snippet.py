@@ -90,5 +90,5 @@ def test_readme_example_runs_as_printed(capsys):
     assert out[0] == f"True {len(ns['records'])} quantities agree"
     assert all(r.passed() for r in ns["records"])
     assert out[1].endswith(" Hz") and ns["lm"].coordinates
-    assert ns["ss"].n_states == 84 and out[2].startswith("84 states")
+    assert ns["ss"].nstates == 84 and out[2].startswith("84 states")
     assert ns["run"].success and not ns["run"].drift_flagged

@@ -156,8 +156,8 @@ def test_reduction_keeps_the_low_frequency_response(azimuth45):
     red = lqg.reduce_plant(azimuth45.system)
     f = np.array([0.01, 0.1, 0.5, 1.0, 2.0])
     for out in ("axis_angle", "motor_speed"):
-        full = loop_measures.frequency_response(azimuth45.system[out, "voltage"], f)
-        reduced = loop_measures.frequency_response(red[out, "voltage"], f)
+        full = loop_measures.siso_response(azimuth45.system[out, "voltage"], f)
+        reduced = loop_measures.siso_response(red[out, "voltage"], f)
         # complex, frequency by frequency: each response on its own modulus
         error = np.abs(reduced - full)
         assert_close(error, np.zeros_like(error), rel=3e-3, scale=np.abs(full), what=out)

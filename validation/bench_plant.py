@@ -58,7 +58,7 @@ def main() -> None:
             cpu.append(time.process_time() - c)
             wall.append(time.perf_counter() - w)
         print(
-            f"side={side:9s}: {ss.n_states} states, {ss.n_inputs} inputs, {ss.n_outputs} "
+            f"side={side:9s}: {ss.nstates} states, {ss.ninputs} inputs, {ss.noutputs} "
             f"outputs; median {np.median(cpu):.3f} s CPU, {np.median(wall):.3f} s wall "
             f"(of {args.repeat})"
         )

@@ -31,7 +31,8 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.guards.atomic import atomic_write_all
 from rt70.linear import reduce as rd
-from rt70.linear.responses import StateSpace, frequency_response
+from rt70.linear.responses import frequency_response
+from rt70.linear.state_space import StateSpace
 from rt70.reports.reduction_plants import reduction_plants
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -49,7 +50,7 @@ def plants() -> dict[str, StateSpace]:
 def sweep(name: str, ss: StateSpace, say) -> list[dict]:
     """H∞ errors of both methods over the orders."""
     rows = []
-    n_modes = ss.n_states // 2
+    n_modes = ss.nstates // 2
     for r in [*range(1, 21), *range(22, n_modes, 4)]:
         try:
             red = rd.modal_truncation(ss, r)
@@ -59,7 +60,7 @@ def sweep(name: str, ss: StateSpace, say) -> list[dict]:
         rows.append(_row(name, red, err, np.nan, np.nan))
     hsv, n_u = rd.hankel_singular_values(ss)
     significant = int(np.sum(hsv > np.finfo(float).eps * hsv[0]))
-    for order in range(max(2, n_u), min(ss.n_states, n_u + significant) + 1, 2):
+    for order in range(max(2, n_u), min(ss.nstates, n_u + significant) + 1, 2):
         red = rd.balanced_truncation(ss, order)
         err = rd.hinf_error(ss, red.ss)
         rows.append(_row(name, red, err, red.bound, hsv[order - n_u]))
@@ -78,9 +79,9 @@ def split_floor(ss: StateSpace) -> rd.HinfError:
         np.vstack([split.B_s, split.B_u]),
         np.hstack([split.C_s, split.C_u]),
         split.D,
-        tuple(f"x{i + 1}" for i in range(A.shape[0])),
-        ss.input_names,
-        ss.output_names,
+        states=[f"x{i + 1}" for i in range(A.shape[0])],
+        inputs=ss.input_labels,
+        outputs=ss.output_labels,
     )
     return rd.hinf_error(ss, whole)
 
@@ -148,18 +149,18 @@ def figure(rows: list[dict], full: dict[str, StateSpace], floors: dict[str, rd.H
         )
         ax.set_xlabel("order of the reduced plant (states)")
         ax.set_ylabel(f"‖G − G_r‖∞ ({UNITS[name]})")
-        n = full[name].n_states
+        n = full[name].nstates
         what = "axes locked, wind in" if name == "locked" else "axes free, axis torques in"
         ax.set_title(f"rt70_servo, {what}: {n} states")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     plant, u, y, r, order = BODE
     ss = full[plant]
-    j, i = ss.input_names.index(u), ss.output_names.index(y)
+    j, i = ss.input_labels.index(u), ss.output_labels.index(y)
     f = np.geomspace(0.05, 50.0, 1500)
     ax = axes[2]
     curves = [
-        (ss, f"full ({ss.n_states} states)", "k-"),
+        (ss, f"full ({ss.nstates} states)", "k-"),
         (rd.modal_truncation(ss, r).ss, f"modal, {r} modes ({2 * r} states)", "C0--"),
         (rd.balanced_truncation(ss, order).ss, f"balanced, {order} states", "C1:"),
     ]

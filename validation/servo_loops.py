@@ -40,7 +40,7 @@ def _figures(scene, axis: str) -> dict[str, object]:
     ctrl = lqg.design(ap, weights=rs.LQG_WEIGHTS)
     open_loops = {f"cascade {k} loop": loops.loop_transfer(ap, gains, k) for k in loops.LOOPS}
     open_loops["LQG at the plant input"] = lqg.input_loop(ap, ctrl)
-    responses = {k: loop_measures.frequency_response(L) for k, L in open_loops.items()}
+    responses = {k: loop_measures.siso_response(L) for k, L in open_loops.items()}
     margins = {k: loop_measures.margins(L) for k, L in open_loops.items()}
     where = f"RT-70 {axis}, elevation {FIGURE_ELEVATION:.0f}°"
     fig_open = plot_open_loops(
@@ -60,7 +60,7 @@ def _figures(scene, axis: str) -> dict[str, object]:
         f"cascade: reference → −{sym} (pointing)": -cascade[name, "reference"] / ARCSEC_PER_RAD,
         f"LQG: reference → −{sym} (pointing)": -closed[name, "reference"] / ARCSEC_PER_RAD,
     }
-    curves = {k: loop_measures.frequency_response(T) for k, T in curves.items()}
+    curves = {k: loop_measures.siso_response(T) for k, T in curves.items()}
     fig_closed = plot_closed_loops(
         f, curves, f"{where}: closed loops, PI cascade against LQG (full plant)"
     )

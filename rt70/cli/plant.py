@@ -35,7 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "scenes a force on and the value of every coordinate. --drives: the structure with "
         "its <rt70:drive> elements, the armature voltages in; --loop closed|open: their "
         "declared servos closed, or one loop broken. --out writes A, B, C, D and the names "
-        "(.npz, or .mat for MATLAB with the units); in Python, rt70.linear.plant.to_control "
+        "(.npz, or .mat for MATLAB with the units); in Python, rt70.plant "
         "gives python-control's StateSpace.",
     )
     pla.add_argument("scene", metavar="SCENE", help="scene name or URDF path")
@@ -116,9 +116,9 @@ def run(args: argparse.Namespace) -> int:
     info = {
         "scene": scene.name,
         "pointing": {"elevation_deg": elevation, "azimuth_deg": azimuth} if has_axes else None,
-        "states": list(ss.state_names),
-        "inputs": list(ss.input_names),
-        "outputs": list(ss.output_names),
+        "states": list(ss.state_labels),
+        "inputs": list(ss.input_labels),
+        "outputs": list(ss.output_labels),
         "unstable_modes": int(spectrum.negative.sum()),
         "rigid_modes": int(spectrum.rigid.sum()),
         "units": UNITS,
@@ -191,11 +191,11 @@ def _reduce(args: argparse.Namespace, scene, method: str, full, info: dict):
             else rd.balanced_truncation(full, args.reduce)
         )
     ss, err = red.ss, rd.hinf_error(full, red.ss)
-    info["states"] = list(ss.state_names)
+    info["states"] = list(ss.state_labels)
     info["reduced"] = {
         "method": method,
         "order": red.order,
-        "full_order": full.n_states,
+        "full_order": full.nstates,
         "hinf_error": err.peak,
         "hinf_error_relative": err.relative,
         "peak_hz": err.freq_hz,
@@ -217,12 +217,12 @@ def _write(args: argparse.Namespace, scene, ss, info: dict) -> None:
 def _print_text(args: argparse.Namespace, title: str, ss, info: dict) -> None:
     """The plant's summary: its size, unstable and rigid modes, signals, reduction."""
     print(
-        f"{title}: {ss.n_states} states, {ss.n_inputs} inputs, "
-        f"{ss.n_outputs} outputs; {info['unstable_modes']} unstable and "
+        f"{title}: {ss.nstates} states, {ss.ninputs} inputs, "
+        f"{ss.noutputs} outputs; {info['unstable_modes']} unstable and "
         f"{info['rigid_modes']} rigid mode(s) (the loops the drives must close)"
     )
-    print("  inputs:  " + ", ".join(ss.input_names))
-    print("  outputs: " + ", ".join(ss.output_names))
+    print("  inputs:  " + ", ".join(ss.input_labels))
+    print("  outputs: " + ", ".join(ss.output_labels))
     if args.reduce is not None:
         r = info["reduced"]
         bound = "" if r["bound_2sum_hsv"] is None else f" (bound 2Σσ {r['bound_2sum_hsv']:.3g})"

@@ -28,7 +28,7 @@ import numpy as np
 
 from rt70.bondgraph.parameters import DriveParameters
 from rt70.errors import Rt70Error
-from rt70.linear.plant import CoordinateInput, CoordinateOutput, LoadInput, plant, to_control
+from rt70.linear.plant import CoordinateInput, CoordinateOutput, LoadInput, plant
 from rt70.model.outputs import Output
 from rt70.model.scene import Scene
 from rt70.physics.loads import Wrench
@@ -119,20 +119,19 @@ def structure_plant(
         outputs=[CoordinateOutput("axis_angle", coordinate), pointing],
         locked=locked,
     )
-    n = ss.n_states // 2
-    k = list(ss.state_names).index(coordinate)
+    n = ss.nstates // 2
+    k = ss.state_labels.index(coordinate)
     rate = np.zeros((1, 2 * n))
     rate[0, n + k] = 1.0
-    sys = to_control(ss)
-    C = np.vstack([sys.C[:1], rate, sys.C[1:]])
-    D = np.vstack([sys.D[:1], np.zeros((1, 2)), sys.D[1:]])
-    load_inertia = float(ss.second_order.M[k, k]) if ss.second_order is not None else np.nan
+    C = np.vstack([ss.C[:1], rate, ss.C[1:]])
+    D = np.vstack([ss.D[:1], np.zeros((1, 2)), ss.D[1:]])
+    load_inertia = float(ss.second_order.M[k, k])
     structure = control.ss(
-        sys.A,
-        sys.B,
+        ss.A,
+        ss.B,
         C,
         D,
-        states=list(ss.state_names),
+        states=ss.state_labels,
         inputs=["reducer_torque", "wind_torque"],
         outputs=["axis_angle", "axis_rate", *POINTING],
         name="structure",

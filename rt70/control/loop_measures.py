@@ -2,11 +2,11 @@
 
 One job: the numbers a servo engineer reads off a loop, the same for any controller
 (the PI cascade of :mod:`rt70.control.loops`, the LQG of :mod:`rt70.control.lqg`): the
-complex frequency response of a SISO state space (:func:`frequency_response`, through
-its Schur form), the gain and phase margins of a loop transfer (:func:`margins`:
-python-control's ``stability_margins`` on an ``FRD`` on :data:`FREQ_HZ` — never a
-transfer-function conversion of a high-order, lightly damped plant, see
-:mod:`rt70.linear.plant`), the −3 dB bandwidth of a closed loop (:func:`bandwidth_hz`)
+complex frequency response of a SISO state space (:func:`siso_response`, through rt70's
+one :func:`rt70.linear.responses.frequency_response`), the gain and phase margins of a
+loop transfer (:func:`margins`: python-control's ``stability_margins`` on an ``FRD`` on
+:data:`FREQ_HZ` — never a transfer-function conversion of a high-order, lightly damped
+plant, see :mod:`rt70.linear.plant`), the −3 dB bandwidth of a closed loop (:func:`bandwidth_hz`)
 and its stability (:func:`stable`).
 """
 
@@ -16,7 +16,9 @@ from dataclasses import dataclass
 
 import control
 import numpy as np
-import scipy.linalg
+
+from rt70.errors import Rt70Error
+from rt70.linear.responses import frequency_response
 
 #: Frequencies of the margins and bandwidths, Hz: 200 points per decade, a step of 1.2 %,
 #: a third of the half-power width 2ζ of the plant's least damped resonance (ζ ≈ 0.03).
@@ -26,22 +28,17 @@ MIN_GM_DB = 6.0
 MIN_PM_DEG = 30.0
 
 
-def frequency_response(sys: control.StateSpace, freq_hz: np.ndarray = FREQ_HZ) -> np.ndarray:
+def siso_response(sys: control.StateSpace, freq_hz: np.ndarray = FREQ_HZ) -> np.ndarray:
     """Complex frequency response of a SISO state space at ``freq_hz`` (no TF conversion).
 
-    ``C (jω − A)⁻¹ B + D`` through the complex Schur form ``A = Z T Zᴴ`` (backward
-    stable, like python-control's per-frequency LU solve, but one triangular solve of
-    O(n²) a frequency instead of a factorisation of O(n³)).
+    :func:`rt70.linear.responses.frequency_response` (python-control's evaluation), its
+    one input/output pair.
     """
-    f = np.asarray(freq_hz, dtype=float)
-    T, Z = scipy.linalg.schur(sys.A.astype(complex), output="complex")
-    b = Z.conj().T @ sys.B[:, 0]
-    c = sys.C[0] @ Z
-    eye = np.eye(T.shape[0])
-    H = np.empty(f.size, dtype=complex)
-    for k, fk in enumerate(f):
-        H[k] = c @ scipy.linalg.solve_triangular(2j * np.pi * fk * eye - T, b)
-    return H + sys.D[0, 0]
+    if sys.ninputs != 1 or sys.noutputs != 1:
+        raise Rt70Error(
+            f"a loop measure needs one input and one output, got {sys.ninputs} and {sys.noutputs}"
+        )
+    return frequency_response(sys, np.asarray(freq_hz, dtype=float)).H[:, 0, 0]
 
 
 @dataclass(frozen=True)
@@ -82,7 +79,7 @@ class Margins:
 
 def margins(L: control.StateSpace, freq_hz: np.ndarray = FREQ_HZ) -> Margins:
     """Margins of the loop ``L``: python-control's ``stability_margins`` on its ``FRD``."""
-    frd = control.frd(frequency_response(L, freq_hz), 2 * np.pi * freq_hz)
+    frd = control.frd(siso_response(L, freq_hz), 2 * np.pi * freq_hz)
     gm, pm, _, w_pc, w_gc, _ = (np.atleast_1d(x) for x in control.stability_margins(frd, True))
     up, down = gm > 1.0, gm < 1.0
     gm_db = float(20 * np.log10(gm[up].min())) if up.any() else np.inf
@@ -105,7 +102,7 @@ def bandwidth_hz(T: control.StateSpace, freq_hz: np.ndarray = FREQ_HZ) -> float:
     Linear interpolation in log frequency between the grid points around the crossing;
     NaN if it never falls.
     """
-    mag_db = 20 * np.log10(np.abs(frequency_response(T, freq_hz)))
+    mag_db = 20 * np.log10(np.abs(siso_response(T, freq_hz)))
     below = np.flatnonzero(mag_db < mag_db[0] - 3.0)
     if below.size == 0:
         return np.nan

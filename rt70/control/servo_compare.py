@@ -70,7 +70,7 @@ def performance(
         The time grid of the step responses, s, from 0.
     """
     T = closed["axis_angle", "reference"]
-    mag = np.abs(loop_measures.frequency_response(T))
+    mag = np.abs(loop_measures.siso_response(T))
     step = control.step_response(T, T=times)
     info = control.step_info(
         np.asarray(step.outputs).reshape(-1), times, SettlingTimeThreshold=0.02

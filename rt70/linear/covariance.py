@@ -16,8 +16,8 @@ frequency grid. This module gives:
   finite record, the statistical error to state when a simulation's rms is compared with
   the Lyapunov rms.
 
-The functions take a python-control ``StateSpace``, rt70's
-:class:`rt70.linear.responses.StateSpace`, or a tuple ``(A, B, C)`` / ``(A, B, C, D)``.
+The functions take a python-control ``StateSpace`` (rt70's plants are ones) or a tuple
+``(A, B, C)`` / ``(A, B, C, D)``.
 See docs/wind-gusts.md for the formulas and the checks.
 """
 
@@ -32,25 +32,24 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.linear.checks import _matrix, _square
-from rt70.linear.responses import StateSpace
+from rt70.linear.state_space import StateSpace
 
 #: Largest condition number of the eigenvector matrix V for which :func:`mode_contributions`
 #: splits a variance over modes (beyond it A is numerically defective and the split is noise).
 MAX_EIGENVECTOR_CONDITION = 1e10
 
 
-def _labels(sys: Any, names: Sequence[str], count: int, prefix: str) -> tuple[str, ...]:
-    for attribute in names:
-        labels = getattr(sys, attribute, None)
-        if labels is not None:
-            return tuple(str(s) for s in labels)
+def _labels(sys: Any, attribute: str, count: int, prefix: str) -> tuple[str, ...]:
+    labels = getattr(sys, attribute, None)
+    if labels is not None:
+        return tuple(str(s) for s in labels)
     return tuple(f"{prefix}[{i}]" for i in range(count))
 
 
 def _system(sys: Any) -> StateSpace:
-    """Read ``sys`` (python-control or rt70 StateSpace, or a tuple of arrays), checked.
+    """Read ``sys`` (a python-control StateSpace or a tuple of arrays), checked.
 
-    Returned as rt70's own :class:`rt70.linear.responses.StateSpace` (labels included).
+    Returned as a :class:`rt70.linear.state_space.StateSpace` (labels included).
     """
     if isinstance(sys, tuple):
         if len(sys) not in (3, 4):
@@ -75,9 +74,9 @@ def _system(sys: Any) -> StateSpace:
         B,
         C,
         D,
-        state_names=_labels(sys, ("state_labels", "state_names"), n, "x"),
-        input_names=_labels(sys, ("input_labels", "input_names"), B.shape[1], "u"),
-        output_names=_labels(sys, ("output_labels", "output_names"), C.shape[0], "y"),
+        states=_labels(sys, "state_labels", n, "x"),
+        inputs=_labels(sys, "input_labels", B.shape[1], "u"),
+        outputs=_labels(sys, "output_labels", C.shape[0], "y"),
     )
 
 
@@ -126,7 +125,7 @@ def state_covariance(sys: Any, W: float | np.ndarray = 1.0) -> np.ndarray:
 
     Parameters
     ----------
-    sys : control.StateSpace, rt70 StateSpace or tuple (A, B, C[, D])
+    sys : control.StateSpace or tuple (A, B, C[, D])
         A stable system.
     W : float or ndarray
         Intensity of the white noise on the inputs, ``E[w(t) w(s)ᵀ] = W δ(t − s)``
@@ -151,7 +150,7 @@ def output_covariance(sys: Any, W: float | np.ndarray = 1.0) -> np.ndarray:
 
     Parameters
     ----------
-    sys : control.StateSpace, rt70 StateSpace or tuple (A, B, C[, D])
+    sys : control.StateSpace or tuple (A, B, C[, D])
         A stable, strictly proper system (D = 0).
     W : float or ndarray
         Intensity of the white noise (see :func:`state_covariance`).
@@ -175,14 +174,14 @@ def output_covariance(sys: Any, W: float | np.ndarray = 1.0) -> np.ndarray:
 
 def _output_row(s: StateSpace, output: str | int) -> tuple[int, str]:
     if isinstance(output, str):
-        if output not in s.output_names:
-            raise Rt70Error(f"no output named '{output}' (outputs: {', '.join(s.output_names)})")
-        index = s.output_names.index(output)
+        if output not in s.output_labels:
+            raise Rt70Error(f"no output named '{output}' (outputs: {', '.join(s.output_labels)})")
+        index = s.output_labels.index(output)
     else:
         index = int(output)
-        if not 0 <= index < len(s.output_names):
-            raise Rt70Error(f"output index {output} out of range (0…{len(s.output_names) - 1})")
-    return index, s.output_names[index]
+        if not 0 <= index < len(s.output_labels):
+            raise Rt70Error(f"output index {output} out of range (0…{len(s.output_labels) - 1})")
+    return index, s.output_labels[index]
 
 
 def cascade_with_filter(
@@ -199,9 +198,9 @@ def cascade_with_filter(
 
     Parameters
     ----------
-    plant : control.StateSpace, rt70 StateSpace or tuple
+    plant : control.StateSpace or tuple
         The plant, with named inputs and outputs.
-    filter : control.StateSpace, rt70 StateSpace or tuple
+    filter : control.StateSpace or tuple
         The shaping filter (one output), e.g. ``rt70.wind.gusts.GustFilter(...).system``.
     input_name : str or sequence of str
         The plant input(s) the filter output feeds.
@@ -226,17 +225,17 @@ def cascade_with_filter(
     names = [input_name] if isinstance(input_name, str) else [str(n) for n in input_name]
     if not names:
         raise Rt70Error("no plant input named for the filter output")
-    missing = [n for n in names if n not in p.input_names]
+    missing = [n for n in names if n not in p.input_labels]
     if missing:
         raise Rt70Error(
             f"the plant has no input {', '.join(repr(n) for n in missing)} "
-            f"(inputs: {', '.join(p.input_names)})"
+            f"(inputs: {', '.join(p.input_labels)})"
         )
     g = np.broadcast_to(np.asarray(gain, dtype=float), (len(names),)).reshape(-1, 1)
     if not np.all(np.isfinite(g)):
         raise Rt70Error("the filter-to-plant gain contains NaN or infinite values")
-    Bp = p.B[:, [p.input_names.index(n) for n in names]] @ g  # n_p × 1
-    Dp = p.D[:, [p.input_names.index(n) for n in names]] @ g  # p_p × 1
+    Bp = p.B[:, [p.input_labels.index(n) for n in names]] @ g  # n_p × 1
+    Dp = p.D[:, [p.input_labels.index(n) for n in names]] @ g  # p_p × 1
     nf, np_ = f.A.shape[0], p.A.shape[0]
     A = np.block([[f.A, np.zeros((nf, np_))], [Bp @ f.C, p.A]])
     B = np.vstack([f.B, Bp @ f.D])
@@ -247,9 +246,9 @@ def cascade_with_filter(
         B,
         C,
         D,
-        states=[f"filter.{s}" for s in f.state_names] + [f"plant.{s}" for s in p.state_names],
-        inputs=list(f.input_names),
-        outputs=list(p.output_names),
+        states=[f"filter.{s}" for s in f.state_labels] + [f"plant.{s}" for s in p.state_labels],
+        inputs=list(f.input_labels),
+        outputs=list(p.output_labels),
     )
 
 
@@ -314,7 +313,7 @@ def mode_contributions(
 
     Parameters
     ----------
-    sys : control.StateSpace, rt70 StateSpace or tuple
+    sys : control.StateSpace or tuple
         A stable, strictly proper system (e.g. a plant cascaded with its disturbance
         filter, :func:`cascade_with_filter`), diagonalisable.
     output : str or int, or a sequence of them
@@ -356,7 +355,7 @@ def mode_contributions(
         terms += np.real(c * (Pz @ c.conj()))
     total = float(np.sum(terms))
     if not rows or total <= 0.0:
-        names = ", ".join(s.output_names[r] for r in rows) or "none"
+        names = ", ".join(s.output_labels[r] for r in rows) or "none"
         raise Rt70Error(f"output(s) {names} have zero variance: nothing to split")
     shares = []
     for group in _pairs(eigenvalues):
@@ -404,7 +403,7 @@ def sample_variance_error(
 
     Parameters
     ----------
-    sys : control.StateSpace, rt70 StateSpace or tuple
+    sys : control.StateSpace or tuple
         A stable, strictly proper system driven by white noise.
     output : str or int, or a sequence of them
         The output (name or index), or the components of a vector output.

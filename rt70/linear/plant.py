@@ -15,8 +15,9 @@ One call, :func:`plant`, linearises a scene about a static equilibrium
   linearised on the textbook side by :func:`rt70.model.outputs.output_matrix` (the exact point
   Jacobians through the output's formula).
 
-:func:`to_control` hands the result to python-control as a ``StateSpace`` with its
-state, input and output names, for Bode plots, margins and loop design there. Do not
+The result is a python-control ``StateSpace`` (:class:`rt70.linear.state_space.StateSpace`,
+which also keeps the second-order model) with its state, input and output names, for
+Bode plots, margins and loop design there. Do not
 convert a high-order, lightly damped plant to a transfer function (``ss2tf``): the
 polynomial coefficients lose the resonances (``scipy.signal.bode`` via ``ss2tf`` is off
 by 24 dB at 1 Hz on the RT-70); evaluate the state space
@@ -28,16 +29,20 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
-from rt70.linear.responses import StateSpace, state_space
+from rt70.linear.responses import state_space
 from rt70.model.outputs import Output, column_labels, output_matrix
 from rt70.model.scene import Scene
 from rt70.physics.loads import Wrench
 from rt70.textbook import points
+
+if TYPE_CHECKING:
+    from rt70.linear.state_space import StateSpace
 
 
 @dataclass(frozen=True)
@@ -144,9 +149,9 @@ def plant(
     Returns
     -------
     StateSpace
-        States ``q…`` and ``q…_dot`` named by coordinate; frequency responses by
-        :func:`rt70.linear.responses.frequency_response`; python-control by
-        :func:`to_control`.
+        A python-control ``StateSpace`` with its second-order model; states ``q…`` and
+        ``q…_dot`` named by coordinate; frequency responses by
+        :func:`rt70.linear.responses.frequency_response`.
 
     Raises
     ------
@@ -175,23 +180,4 @@ def plant(
         coord_names=lm.coordinates,
         input_names=input_names,
         output_names=output_names,
-    )
-
-
-def to_control(ss: StateSpace):
-    """The plant as a python-control ``StateSpace``, with its state, input and output names.
-
-    python-control (``control``) is the project's library for state-space objects, Bode
-    plots, margins and LQG; it is imported here, only when asked for.
-    """
-    import control
-
-    return control.ss(
-        ss.A,
-        ss.B,
-        ss.C,
-        ss.D,
-        states=list(ss.state_names),
-        inputs=list(ss.input_names),
-        outputs=list(ss.output_names),
     )

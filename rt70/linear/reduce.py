@@ -2,7 +2,7 @@
 
 A controller (LQG, an observer, a notch set) is designed on a plant of a few states, not
 on the 84 of the RT-70's linearisation (:func:`rt70.linear.plant.plant`). This module
-reduces a :class:`~rt70.linear.responses.StateSpace` and measures what the reduction
+reduces a :class:`~rt70.linear.state_space.StateSpace` and measures what the reduction
 costs:
 
 - :func:`modal_truncation` keeps the r lowest modes of the second-order model
@@ -24,12 +24,12 @@ costs:
   logarithmic grid made denser at every lightly damped pole of both plants, its peak
   then refined by a bounded scalar search.
 
-Every function here takes rt70's :class:`~rt70.linear.responses.StateSpace` or
-python-control's (:func:`rt70.linear.responses.as_state_space`). python-control's carries
-no second-order model, so the additive split works on the physical ``A``: on the RT-70
-with its axes free the truncation to 12 states is then 3.3e-8 of ‖G‖∞ from the plant,
-against 6.2e-9 from rt70's own type (tests/test_control_interop.py); modal truncation
-needs that model and says so.
+Every function here takes any python-control ``StateSpace``; rt70's plants
+(:class:`~rt70.linear.state_space.StateSpace`) also carry their second-order model. A
+system without one (built by python-control) is split on its physical ``A``: on the
+RT-70 with its axes free the truncation to 12 states is then 3.3e-8 of ‖G‖∞ from the
+plant, against 6.2e-9 with the second-order model (tests/test_control_interop.py);
+modal truncation needs that model and says so.
 
 Balanced truncation weighs the outputs in their units: give the outputs comparable units
 first (:func:`rescaled`: angles in arc seconds and points in mm, say), or the radians
@@ -47,7 +47,8 @@ import scipy.optimize
 
 from rt70.errors import Rt70Error
 from rt70.linear import modal
-from rt70.linear.responses import StateSpace, as_state_space, state_space
+from rt70.linear.responses import frequency_response, state_space
+from rt70.linear.state_space import StateSpace, as_state_space, second_order_of
 
 #: A pole λ of a plant without a second-order model is marginal (rigid, kept with the
 #: unstable part) when ``|λ|² ≤ MARGINAL_RTOL · max|λ|²``; with one, when
@@ -107,11 +108,11 @@ def rescaled(
         ``S_u``: one factor for all inputs or m of them (finite, non-zero).
     """
     ss = as_state_space(ss)
-    sy = np.broadcast_to(np.asarray(output_scale, dtype=float), (ss.n_outputs,))
-    su = np.broadcast_to(np.asarray(input_scale, dtype=float), (ss.n_inputs,))
+    sy = np.broadcast_to(np.asarray(output_scale, dtype=float), (ss.noutputs,))
+    su = np.broadcast_to(np.asarray(input_scale, dtype=float), (ss.ninputs,))
     if not (np.all(np.isfinite(sy)) and np.all(np.isfinite(su)) and np.all(sy) and np.all(su)):
         raise Rt70Error("scales must be finite and non-zero")
-    so = ss.second_order
+    so = second_order_of(ss)
     if so is not None:
         so = replace(
             so,
@@ -120,11 +121,14 @@ def rescaled(
             C_vel=sy[:, None] * so.C_vel,
             D_ff=sy[:, None] * so.D_ff * su,
         )
-    return replace(
-        ss,
-        B=ss.B * su,
-        C=sy[:, None] * ss.C,
-        D=sy[:, None] * ss.D * su,
+    return StateSpace(
+        ss.A,
+        ss.B * su,
+        sy[:, None] * ss.C,
+        sy[:, None] * ss.D * su,
+        states=ss.state_labels,
+        inputs=ss.input_labels,
+        outputs=ss.output_labels,
         second_order=so,
     )
 
@@ -135,13 +139,13 @@ def _sym(X: np.ndarray) -> np.ndarray:
 
 def _named(ss: StateSpace, A, B, C, D, prefix: str) -> StateSpace:
     return StateSpace(
-        A=A,
-        B=B,
-        C=C,
-        D=D,
-        state_names=tuple(f"{prefix}{i + 1}" for i in range(A.shape[0])),
-        input_names=ss.input_names,
-        output_names=ss.output_names,
+        A,
+        B,
+        C,
+        D,
+        states=[f"{prefix}{i + 1}" for i in range(A.shape[0])],
+        inputs=ss.input_labels,
+        outputs=ss.output_labels,
     )
 
 
@@ -181,7 +185,7 @@ def modal_truncation(ss: StateSpace, n_modes: int) -> Reduction:
         a rigid or unstable mode.
     """
     ss = as_state_space(ss)
-    so = ss.second_order
+    so = second_order_of(ss)
     if so is None:
         raise Rt70Error("modal truncation needs a plant built from M, K, D (second_order)")
     md = modal.modes(so.M, so.K, so.D)
@@ -203,10 +207,10 @@ def modal_truncation(ss: StateSpace, n_modes: int) -> Reduction:
         so.C_vel @ Vr,
         so.D_ff + so.C_out @ flexibility @ so.B_in,
         coord_names=[f"z{i + 1}" for i in range(n_modes)],
-        input_names=ss.input_names,
-        output_names=ss.output_names,
+        input_names=ss.input_labels,
+        output_names=ss.output_labels,
     )
-    return Reduction(reduced, "modal", reduced.n_states, 2 * n_marginal)
+    return Reduction(reduced, "modal", reduced.nstates, 2 * n_marginal)
 
 
 # ------------------------------------------------------------------- balanced truncation
@@ -227,7 +231,7 @@ class AdditiveSplit:
 
 def _marginal_limit(ss: StateSpace) -> float:
     """``|λ|²`` below which a pole counts as rigid: the modes' rigid tolerance on ω²."""
-    so = ss.second_order
+    so = second_order_of(ss)
     if so is not None:  # the stiffness scale, not the (larger) overdamped real poles
         return modal.modes(so.M, so.K).rigid_tol
     lam = np.linalg.eigvals(ss.A)
@@ -244,8 +248,8 @@ def _conditioned(ss: StateSpace) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     2e-10 of ‖G‖∞: the physical ``A`` (‖A‖ ≈ 9e7) places that pole only to about
     1e-12 rad/s, a tenth of a millionth of its half-power bandwidth ζω ≈ 9e-6 rad/s.
     """
-    if ss.second_order is not None:
-        so = ss.second_order
+    so = second_order_of(ss)
+    if so is not None:
         ss = modal_truncation(ss, so.M.shape[0]).ss
     _, (s, _) = scipy.linalg.matrix_balance(ss.A, permute=False, separate=True)
     return (ss.A * s) / s[:, None], ss.B / s[:, None], ss.C * s
@@ -413,24 +417,9 @@ def _poles_grid(ss_list: Sequence[StateSpace], f_min: float, f_max: float) -> np
     return f[(f >= f_min) & (f <= f_max)]
 
 
-def _response(ss: StateSpace, f: np.ndarray, chunk: int = 256) -> np.ndarray:
-    """``G(j2πf)``, shape (nf, p, m): batched solves, by the second-order model if any."""
-    so = ss.second_order
-    out = np.empty((f.size, ss.n_outputs, ss.n_inputs), dtype=complex)
-    for start in range(0, f.size, chunk):
-        w = 2.0 * np.pi * f[start : start + chunk, None, None]
-        if so is not None:
-            X = np.linalg.solve(so.K - w * w * so.M + 1j * w * so.D, so.B_in)
-            out[start : start + chunk] = (so.C_out + 1j * w * so.C_vel) @ X + so.D_ff
-        else:
-            X = np.linalg.solve(1j * w * np.eye(ss.n_states) - ss.A, ss.B)
-            out[start : start + chunk] = ss.C @ X + ss.D
-    return out
-
-
 def _sigma_max(full: StateSpace, reduced: StateSpace, f: np.ndarray) -> tuple:
-    H = _response(full, f)
-    E = H - _response(reduced, f)
+    H = frequency_response(full, f).H
+    E = H - frequency_response(reduced, f).H
     return np.linalg.norm(E, ord=2, axis=(1, 2)), np.linalg.norm(H, ord=2, axis=(1, 2))
 
 

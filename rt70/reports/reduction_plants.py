@@ -16,7 +16,7 @@ from __future__ import annotations
 from rt70.linear import linearize as lin
 from rt70.linear import plant as pl
 from rt70.linear import reduce as rd
-from rt70.linear.responses import StateSpace
+from rt70.linear.state_space import StateSpace
 from rt70.model.scene import load_scene
 from rt70.physics.loads import Wrench
 from rt70.scenes.rt70_optics import rt70_mirror_outputs
@@ -43,5 +43,5 @@ def reduction_plants(elevation: float = 45.0, azimuth: float = 0.0) -> dict[str,
     angles = [pl.CoordinateOutput(f"angle:{a}", a) for a in held]
     free = pl.plant(scene, q0, torques, angles + mirror)
     per_rad = 1.0 / RAD_PER_ARCSEC  # rad → arcsec
-    free = rd.rescaled(free, [per_rad, per_rad] + [1.0] * (free.n_outputs - 2), 1e6)
+    free = rd.rescaled(free, [per_rad, per_rad] + [1.0] * (free.noutputs - 2), 1e6)
     return {"locked": locked, "free": free}

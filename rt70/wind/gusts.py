@@ -376,7 +376,7 @@ def realise(filter: Any, t_end: float, dt: float, seed: int) -> GustSeries:
 
     Parameters
     ----------
-    filter : GustFilter, control.StateSpace, rt70 StateSpace or tuple (A, B, C)
+    filter : GustFilter, control.StateSpace or tuple (A, B, C)
         A stable, strictly proper filter driven by unit-intensity white noise on each
         input (independent).
     t_end : float
