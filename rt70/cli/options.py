@@ -207,10 +207,13 @@ def elevation(text: str) -> float:
     The scene's own range (``<rt70:axis name="elevation" min_deg max_deg>``) is checked
     once the scene is read (:func:`rt70.model.antenna.pointing`).
     """
+    from rt70.model.antenna import ELEVATION_SPAN_DEG
+
     value = _number(text)
-    if not -90.0 <= value <= 180.0:
+    low, high = ELEVATION_SPAN_DEG
+    if not low <= value <= high:
         raise argparse.ArgumentTypeError(
-            f"an elevation lies between -90 and 180 degrees, got {text}"
+            f"an elevation lies between {low:g} and {high:g} degrees, got {text}"
         )
     return value
 

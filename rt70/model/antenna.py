@@ -30,6 +30,10 @@ if TYPE_CHECKING:
 #: Rounding allowed at the ends of an axis's range, degrees (its bounds are read in
 #: degrees and kept in radians).
 RANGE_ROUNDING_DEG = 1e-9
+#: The elevations any mount may be asked for, degrees: a quarter turn below the horizon
+#: to the opposite horizon over the zenith. A scene's own range (:func:`range_deg`) is
+#: checked once the scene is read; this bounds an option before then.
+ELEVATION_SPAN_DEG = (-90.0, 180.0)
 
 
 def range_deg(axis: MountAxis) -> tuple[float, float]:
@@ -157,6 +161,18 @@ def _joint_axis(scene: Scene, joint: str) -> tuple[str, tuple[float, float, floa
     return link, tuple(float(x) for x in axis)
 
 
+def _value(scene: Scene, points, formula, q: np.ndarray | None = None) -> np.ndarray:
+    """``formula`` of the ground positions of ``points``, textbook side, at ``q`` (or q = 0)."""
+    q = np.zeros(len(scene.coordinate_names)) if q is None else q
+    out = Output("value", "1", 3, tuple(points), formula)
+    return evaluate(scene, q, [out], "textbook")["value"]
+
+
+def _frame_points(link: str) -> list[Point]:
+    """A link's origin and the tips of its unit axes: columns of its rotation by difference."""
+    return [(link, (0.0, 0.0, 0.0))] + [(link, tuple(e)) for e in np.eye(3)]
+
+
 def mirror_system(scene: Scene) -> MirrorSystem:
     """The scene's :class:`~rt70.model.optics.MirrorSystem`, read from its declarations.
 
@@ -206,16 +222,12 @@ def _check_reference_frame(scene: Scene, system: MirrorSystem) -> None:
     The pointing corrections (4.159)–(4.163) solve the frame's x and y rows: they are
     the transverse components only when z is the focal axis.
     """
-    zero = (0.0, 0.0, 0.0)
-    frame = [(system.ok_link, zero)] + [(system.ok_link, tuple(e)) for e in np.eye(3)]
 
     def chord_in_frame(p: np.ndarray) -> np.ndarray:
         return (p[3:6] - p[2]) @ (p[0] - p[1])  # the frame's axes are the rows
 
-    points = (system.main_focus, system.main_vertex, *frame)
-    out = Output("focal_chord", "m", 3, points, chord_in_frame)
-    q0 = np.zeros(len(scene.coordinate_names))
-    chord = evaluate(scene, q0, [out], "textbook")["focal_chord"]
+    points = (system.main_focus, system.main_vertex, *_frame_points(system.ok_link))
+    chord = _value(scene, points, chord_in_frame)
     length = float(np.linalg.norm(chord))
     if not length > 0.0:
         return  # no focal axis: refused where one is needed (source, the sweep's check)
@@ -231,17 +243,12 @@ def _check_reference_frame(scene: Scene, system: MirrorSystem) -> None:
 
 def _design_offset(scene: Scene, system: MirrorSystem) -> tuple[float, float, float]:
     """Secondary focus − primary focus at construction (q = 0), m, reference-frame axes."""
-    zero = (0.0, 0.0, 0.0)
-    frame = [(system.ok_link, zero)] + [(system.ok_link, tuple(e)) for e in np.eye(3)]
 
     def offset(p: np.ndarray) -> np.ndarray:
-        R = (p[3:6] - p[2]).T  # columns: the frame's axes in ground axes
-        return R.T @ (p[1] - p[0])
+        return (p[3:6] - p[2]) @ (p[1] - p[0])  # the frame's axes are the rows
 
-    out = Output("design_offset", "m", 3, (system.main_focus, system.cr_focus, *frame), offset)
-    q0 = np.zeros(len(scene.coordinate_names))
-    value = evaluate(scene, q0, [out], "textbook")["design_offset"]
-    return tuple(float(x) for x in value)
+    points = (system.main_focus, system.cr_focus, *_frame_points(system.ok_link))
+    return tuple(float(x) for x in _value(scene, points, offset))
 
 
 def source(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> np.ndarray:
@@ -270,11 +277,7 @@ def source(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> np.n
     for joint, value in held.items():
         q[names.index(joint)] = value
     focus, vertex = _point(scene, optics.primary.focus), _point(scene, optics.primary.vertex)
-
-    def axis(p: np.ndarray) -> np.ndarray:
-        return p[0] - p[1]
-
-    chord = evaluate(scene, q, [Output("axis", "m", 3, (focus, vertex), axis)], "textbook")["axis"]
+    chord = _value(scene, (focus, vertex), lambda p: p[0] - p[1], q)
     length = float(np.linalg.norm(chord))
     if not length > 0.0:  # NaN or zero: no focal axis
         raise SceneError(
@@ -341,14 +344,7 @@ def sky_frame(scene: Scene) -> SkyFrame:
     mount = mount_of(scene)
     az = mount.axis("azimuth")
     axis_link, local = _joint_axis(scene, az.joint)
-    names = scene.coordinate_names
-    q = np.zeros(len(names))
-    frame = [(axis_link, (0.0, 0.0, 0.0)), (axis_link, local)]
-
-    def turn_axis(p: np.ndarray) -> np.ndarray:
-        return p[1] - p[0]
-
-    axis = evaluate(scene, q, [Output("axis", "1", 3, tuple(frame), turn_axis)], "textbook")["axis"]
+    axis = _value(scene, [(axis_link, (0.0, 0.0, 0.0)), (axis_link, local)], lambda p: p[1] - p[0])
     g = np.asarray(scene.description.gravity, dtype=float)
     up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0.0 else axis
     el = mount.axis("elevation")

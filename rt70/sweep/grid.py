@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from rt70.guards.resources import check_memory
+from rt70.model.antenna import ELEVATION_SPAN_DEG
 from rt70.sweep.errors import SweepError
 from rt70.sweep.quantities import PARAMETERS, SweepPoint
 
@@ -175,8 +176,9 @@ def make_grid(
             raise SweepError(f"--{axis.name}: no values")
         if len(set(axis.values)) != len(axis.values):
             raise SweepError(f"--{axis.name}: a value is repeated")
-    if any(not -90.0 <= e <= 180.0 for e in axes[0].values):
-        raise SweepError("--elevation: elevations lie between -90° and 180°")
+    low, high = ELEVATION_SPAN_DEG
+    if any(not low <= e <= high for e in axes[0].values):
+        raise SweepError(f"--elevation: elevations lie between {low:g}° and {high:g}°")
     if any(w < 0.0 for w in axes[2].values):
         raise SweepError("--wind: speeds must be at least 0 m/s")
     for axis in (axes[1], axes[3]):

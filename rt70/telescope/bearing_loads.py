@@ -42,6 +42,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.model.antenna import ELEVATION_SPAN_DEG
 from rt70.model.scene import Scene
 from rt70.model.sides import side_of
 from rt70.physics.loads import Wrench
@@ -182,8 +183,9 @@ def check_case(case: LoadCase) -> None:
     values = [case.elevation_deg, case.azimuth_deg, case.wind_speed, case.wind_from]
     if not np.isfinite(values).all():
         raise Rt70Error(f"load case must be finite, got {case}")
-    if not -90.0 <= case.elevation_deg <= 180.0:
-        raise Rt70Error(f"elevation {case.elevation_deg:g}° outside -90…180°")
+    low, high = ELEVATION_SPAN_DEG
+    if not low <= case.elevation_deg <= high:
+        raise Rt70Error(f"elevation {case.elevation_deg:g}° outside {low:g}…{high:g}°")
     if case.wind_speed < 0.0:
         raise Rt70Error(f"wind speed must not be negative, got {case.wind_speed:g} m/s")
 
