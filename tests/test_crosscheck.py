@@ -7,6 +7,7 @@ import pytest
 
 from rt70 import reference
 from rt70.cli.main import main
+from rt70.crosscheck import validate
 from rt70.crosscheck.validate import QUANTITIES, cross_check, quantities
 from rt70.model.scene import URDF_DIR, load_scene, scene_names
 from rt70.testing import MIN_REL, assert_close
@@ -134,12 +135,24 @@ def test_cli_validate_json(capsys):
         "t_textbook_s",
         "t_reference_s",
         "nonfinite",
+        "unit",
     }
     for r in records:
         assert set(r) == keys
+        assert r["unit"] == validate.QUANTITY_UNITS[r["quantity"]]
         assert r["nonfinite"] == ""
         assert r["target"] == "rt70" and r["nv"] == 42
         assert r["max_rel_err"] <= TOL
+
+
+def test_every_row_states_its_unit():
+    """Each row any scene can give (the loop and nonholonomic rows too) has a unit."""
+    from rt70.crosscheck.loop_check import LOOP_QUANTITIES
+    from rt70.crosscheck.samples import WIND
+    from rt70.mechanics.nonholonomic_scene import ROWS
+
+    rows = {*QUANTITIES, WIND, *LOOP_QUANTITIES, *ROWS}
+    assert set(validate.QUANTITY_UNITS) == rows
 
 
 def test_cli_validate_reports_disagreement(capsys):

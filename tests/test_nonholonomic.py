@@ -391,5 +391,7 @@ def test_cli_cart_json(capsys):
     )
     assert_close([r[0] for r in out["rows"]], [0.0, 0.1, 0.2], rel=1e-12)
     assert out["min_g"] > 0 and out["stopped_at"] is None
+    units = [out["units"][c] for c in out["columns"]]
+    assert units == ["s", "m", "m", "rad", "m/s", "m/s", "rad/s"]
     end = out["perturbations_end"]
     assert_close(end, np.zeros(len(end)), rel=1e-10, scale=START_SPEED)

@@ -76,6 +76,25 @@ def add_parser(sub) -> argparse.ArgumentParser:
     return car
 
 
+#: The units of ``--json``'s numbers: the columns, the initial torques and reaction, the
+#: obstacle function g (4.5) and the perturbations (c, f1, ḟ1, f4) of (4.3), (4.10), (4.13).
+UNITS = {
+    "t": "s",
+    "x": "m",
+    "y": "m",
+    "theta": "rad",
+    "xd": "m/s",
+    "yd": "m/s",
+    "thetad": "rad/s",
+    "M1": "N·m",
+    "M2": "N·m",
+    "lateral": "N",
+    "min_g": "m²",
+    "perturbations": ["m/s", "m/s", "m/s²", "m/s"],
+    "stopped_at": "s",
+}
+
+
 def run(args: argparse.Namespace) -> int:
     """Check the options and the scene, run the servo, print."""
     from rt70.mechanics import chaplygin_cart as cart
@@ -125,6 +144,7 @@ def run(args: argparse.Namespace) -> int:
         "perturbations_start": first.residuals.tolist(),
         "perturbations_end": end.tolist(),
         "stopped_at": float(sol.t_events[0][0]) if stopped else None,
+        "units": UNITS,
     }
     options.check_finite(out, f"{scene.name}: cart")
     if args.json:

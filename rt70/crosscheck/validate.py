@@ -67,6 +67,35 @@ QUANTITIES = (
 )
 
 
+#: The unit of each row's values and ``max_abs_err`` (``max_rel_err`` is a pure number,
+#: the times are seconds). "Per coordinate" rows mix the units of the coordinates' kinds:
+#: revolute (rad) and prismatic (m) coordinates give N·m and N, rad/s² and m/s², …
+QUANTITY_UNITS = {
+    "mass_matrix": "kg·m², kg·m or kg (per pair of coordinates)",
+    "bias": "N·m or N (per coordinate)",
+    "gravity": "N·m or N (per coordinate)",
+    "spring_force": "N·m or N (per coordinate)",
+    "damper_force": "N·m or N (per coordinate)",
+    "forward_dynamics": "rad/s² or m/s² (per coordinate)",
+    "kinetic_energy": "J",
+    "potential_energy": "J",
+    "points": "m",
+    "load_force": "N·m or N (per coordinate)",
+    "drives": "rad (drive angles), then N·m or N per N·m of reducer torque (per coordinate)",
+    "reactions": "N (forces) and N·m (moments)",
+    "impact": "rad/s or m/s (velocities after the impacts, per coordinate)",
+    "impulse": "N·s or N·m·s",
+    WIND: "N·m or N (per coordinate)",
+    "loop_residual": "m and rad",
+    "loop_jacobian": "1 or m per coordinate",
+    "loop_bias": "m/s² and rad/s²",
+    "loop_dynamics": "rad/s² or m/s² (per coordinate)",
+    "loop_reaction": "N·m or N (per coordinate)",
+    "no_slip": "1 or m per coordinate (A), then m/s² or rad/s² (Ȧq̇)",
+    "reduced_dynamics": "rad/s² or m/s² (per coordinate), then N or N·m (multipliers)",
+}
+
+
 def quantities(scene: Scene) -> tuple[str, ...]:
     """The rows of ``scene``'s report.
 
@@ -105,8 +134,12 @@ class Record:
         )
 
     def as_dict(self) -> dict:
-        """The record as a JSON-ready dict (infinite errors as the string ``"inf"``)."""
+        """The record as a JSON-ready dict, with the unit of its values.
+
+        Infinite errors are the string ``"inf"``; ``unit`` is from :data:`QUANTITY_UNITS`.
+        """
         out = asdict(self)
+        out["unit"] = QUANTITY_UNITS[self.quantity]
         for key in ("max_abs_err", "max_rel_err"):
             if not math.isfinite(out[key]):
                 out[key] = str(out[key])
