@@ -300,7 +300,7 @@ CASES = {
     "five-stiffness-values": Case(
         robot(*CHAIN, bushing("1 2 3 4 5")),
         ExtensionError,
-        ("<rt70:bushing", "1 2 3 4 5", "expected 6 numbers, got 5"),
+        ("<rt70:bushing", "1 2 3 4 5", "expected 6 numbers (the diagonal) or 36", "got 5"),
     ),
     "non-numeric-gravity": Case(
         robot(*CHAIN, '<rt70:gravity xyz="0 0 g"/>'),

@@ -56,8 +56,22 @@ SIBLINGS = """<?xml version="1.0"?>
     <rt70:frame1 link="world" xyz="0 0 1"/>
     <rt70:frame2 link="c"/>
   </rt70:bushing>
+  <rt70:bushing name="coupled" stiffness="{stiffness}" damping="{damping}">
+    <rt70:frame1 link="b" xyz="0.2 0 0.1" rpy="0.1 0.2 0"/>
+    <rt70:frame2 link="d" xyz="0 0 0.1"/>
+  </rt70:bushing>
 </robot>
 """
+
+
+def _coupled(scale: float, seed: int) -> str:
+    """A full symmetric positive definite 6 × 6, row by row: every axis coupled."""
+    L = np.random.default_rng(seed).uniform(-1.0, 1.0, (6, 6))
+    C = scale * (L @ L.T + np.eye(6))
+    return " ".join(f"{x:.17g}" for x in (0.5 * (C + C.T)).ravel())
+
+
+SIBLINGS = SIBLINGS.format(stiffness=_coupled(30.0, 1), damping=_coupled(2.0, 2))
 
 
 def _states(model, n: int, seed: int):
@@ -95,6 +109,7 @@ def test_kernels_equal_the_python_path_on_the_scenes(name):
 
 
 def test_kernels_on_siblings_through_unaligned_prismatic_and_continuous_joints():
+    """Also a bushing whose 6 × 6 gains couple every axis ("coupled")."""
     scene = scene_from_text(SIBLINGS, "siblings")
     kinds = set(ElementKernels.of(scene.reference).tables.kind.tolist())
     assert kinds == {0, 1, 2}  # revolute, prismatic and continuous all walked

@@ -11,6 +11,7 @@ import typing
 
 import numpy as np
 import pytest
+from scipy.linalg import block_diag
 
 import rt70.reference as reference
 from rt70.model.scene import load_scene, scene_from_text
@@ -23,6 +24,20 @@ from rt70.urdf.description import RobotDescription
 
 INERTIA = '<inertia ixx="0.1" iyy="0.2" izz="0.15" ixy="0.01" ixz="0" iyz="0.02"/>'
 LIMIT = '<limit lower="-3" upper="3" effort="1" velocity="1"/>'
+
+
+def _coupled(scale: float, seed: int) -> np.ndarray:
+    """A full symmetric positive definite 6 × 6: every axis coupled to every other."""
+    L = np.random.default_rng(seed).uniform(-1.0, 1.0, (6, 6))
+    C = scale * (L @ L.T + np.eye(6))
+    return 0.5 * (C + C.T)
+
+
+COUPLED_C, COUPLED_D = _coupled(80.0, 11), _coupled(0.5, 12)
+
+
+def _numbers(matrix: np.ndarray) -> str:
+    return " ".join(f"{x:.17g}" for x in matrix.ravel())
 
 
 def chain(mimic: bool, extra_spring: bool = False) -> str:
@@ -51,6 +66,10 @@ def chain(mimic: bool, extra_spring: bool = False) -> str:
         '<rt70:bushing name="b" stiffness="100 110 120 50 60 70" damping="1 2 3 0.4 0.5 0.6">'
         '<rt70:frame1 link="world" xyz="0.9 0 0.1" rpy="0 0.1 0"/>'
         '<rt70:frame2 link="l3" xyz="0 0 0.1"/></rt70:bushing>'
+        f'<rt70:bushing name="coupled" stiffness="{_numbers(COUPLED_C)}" '
+        f'damping="{_numbers(COUPLED_D)}">'
+        '<rt70:frame1 link="l1" xyz="0.3 0.1 0" rpy="0.2 0 0"/>'
+        '<rt70:frame2 link="l3" xyz="0 0.1 0"/></rt70:bushing>'
     )
     return (
         '<robot name="chain" xmlns:rt70="urn:rt70:urdf-extensions:1"><link name="world"/>'
@@ -80,8 +99,10 @@ def test_every_element_kind_of_the_description_is_implemented_on_both_sides():
     assert list(tb_forces.ELEMENTS) == list(ref_forces.ELEMENTS)  # same summation order
 
 
-def _flat(e, what):
-    return np.broadcast_to(getattr(e, what), np.shape(e.delta)).ravel()
+def _gain(e, what):
+    """The kind's gain as one matrix on its stacked δ: block-diagonal over its elements."""
+    w = np.asarray(getattr(e, what))
+    return np.diag(np.broadcast_to(w, np.shape(e.delta))) if w.ndim < 3 else block_diag(*w)
 
 
 def _textbook_kinds(scene, q):
@@ -128,9 +149,10 @@ def test_textbook_kinds_force_is_minus_jt_c_delta_of_their_own_delta(name):
     assert set(J_fd) == {k for k, e in kinds.items() if e is not None} and J_fd
     for kind, J in J_fd.items():
         e = kinds[kind]
-        f = _flat(e, "stiffness") * np.ravel(e.delta)
+        f = _gain(e, "stiffness") @ np.ravel(e.delta)
+        assert_close(np.ravel(e.weighted(e.stiffness, e.delta)), f, rel=1e-14, what=kind)
         Q = np.zeros(n)
-        e.subtract_jt(model, Q, (e.stiffness * e.delta))
+        e.subtract_jt(model, Q, e.weighted(e.stiffness, e.delta))
         # against central differences of δ (h = 1e-6: error ≈ ε/h ≈ 1e-10 of δ's scale)
         assert_close(Q, -J.T @ f, rel=1e-6, what=kind)
         assert_close(np.ravel(e.rate(model, qd)), J @ qd, rel=1e-6, what=kind)
@@ -149,15 +171,16 @@ def test_reference_kinds_products_are_those_of_the_jacobian_of_their_delta(name)
     assert J_fd
     for kind, J in J_fd.items():
         e = kinds[kind]
-        C, f = _flat(e, "stiffness"), _flat(e, "stiffness") * np.ravel(e.delta)
+        C = _gain(e, "stiffness")
+        f, terms = C @ np.ravel(e.delta), np.abs(C) @ np.abs(np.ravel(e.delta))
         Q, S, K = np.zeros(n), np.zeros(n), np.zeros((n, n))
-        e.subtract_jt(Q, e.stiffness * e.delta)
-        e.add_abs_jt(S, e.stiffness * e.delta)
+        e.subtract_jt(Q, e.weighted(e.stiffness, e.delta))
+        e.add_abs_jt(S, e.weighted_terms(e.stiffness, e.delta))
         e.add_jt_w_j(K, e.stiffness)
         # against central differences of δ, as on the textbook side
         assert_close(Q, -J.T @ f, rel=1e-6, what=kind)
-        assert_close(S, np.abs(J).T @ np.abs(f), rel=1e-6, what=kind)
-        assert_close(K, J.T @ (C[:, None] * J), rel=1e-6, what=kind)
+        assert_close(S, np.abs(J).T @ terms, rel=1e-6, what=kind)
+        assert_close(K, J.T @ C @ J, rel=1e-6, what=kind)
         assert_close(np.ravel(e.rate(v)), J @ v, rel=1e-6, what=kind)
 
 
@@ -174,7 +197,7 @@ def test_the_two_sides_agree_kind_by_kind(name):
         a, b = tb[kind], ref[kind]
         assert_close(np.ravel(a.delta), np.ravel(b.delta), rel=1e-12, what=kind)
         for gain in ("stiffness", "damping"):  # both read the one description: copies
-            assert np.array_equal(_flat(a, gain), _flat(b, gain)), (kind, gain)
+            assert np.array_equal(_gain(a, gain), _gain(b, gain)), (kind, gain)
 
 
 def test_two_springs_on_one_joint_add_up_in_the_gains():

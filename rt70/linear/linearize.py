@@ -135,7 +135,7 @@ def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
         e[i] = 1.0
         Qd = np.zeros(model.nv)
         for el in found:
-            el.subtract_jt(model, Qd, el.damping * el.rate(model, e))
+            el.subtract_jt(model, Qd, el.weighted(el.damping, el.rate(model, e)))
         D[:, i] = -Qd
     return 0.5 * (D + D.T)
 

@@ -113,9 +113,11 @@ def _torsion_links(
     stiffness: list[float] = []
     damping: list[float] = []
     for b in desc.bushings:
-        c = np.asarray(b.stiffness, dtype=float)
-        d = np.asarray(b.damping, dtype=float)
-        if np.any(c[:5] != 0) or np.any(d[:5] != 0):
+        c = np.asarray(b.stiffness, dtype=float).copy()
+        d = np.asarray(b.damping, dtype=float).copy()
+        rz = (c[5, 5], d[5, 5])
+        c[5, 5] = d[5, 5] = 0.0
+        if np.any(c != 0) or np.any(d != 0):
             raise LinearModelError(
                 f"{where}: bushing '{b.name}' is not a torsion spring about z "
                 "(only the rz stiffness and damping may be non-zero)"
@@ -129,6 +131,6 @@ def _torsion_links(
                     "which is neither a body nor the ground"
                 )
         edges.append((number[b.frame1.link], number[b.frame2.link]))
-        stiffness.append(float(c[5]))
-        damping.append(float(d[5]))
+        stiffness.append(float(rz[0]))
+        damping.append(float(rz[1]))
     return edges, stiffness, damping

@@ -49,7 +49,7 @@ class Tables:
     frame_R, frame_p : numpy.ndarray
         (n_b, 2, 3, 3), (n_b, 2, 3): each bushing's frames in their joints' frames.
     stiffness, damping : numpy.ndarray
-        (n_b, 6) diagonals of C and D.
+        (n_b, 6, 6): C and D of each bushing.
     spring_q, spring_v, spring_kind : numpy.ndarray
         int64 per joint spring: q index, v index, :data:`CONTINUOUS` or not.
     spring_k, spring_d : numpy.ndarray
@@ -172,8 +172,8 @@ def tables(model: ReferenceModel) -> Tables | None:
     i64 = np.int64
     return Tables(
         **found,
-        stiffness=np.ascontiguousarray(model.stiffness, dtype=float).reshape(n_b, 6),
-        damping=np.ascontiguousarray(model.damping, dtype=float).reshape(n_b, 6),
+        stiffness=np.ascontiguousarray(model.stiffness, dtype=float).reshape(n_b, 6, 6),
+        damping=np.ascontiguousarray(model.damping, dtype=float).reshape(n_b, 6, 6),
         spring_q=np.array(spring_q, dtype=i64),
         spring_v=np.array(model.spring_v, dtype=i64),
         spring_kind=np.array(spring_kind, dtype=i64),

@@ -77,11 +77,19 @@ class CoordinateElements:
         np.add.at(S, self.index, np.abs(f))
 
     def add_jt_w_j(self, K: np.ndarray, w: np.ndarray) -> None:
-        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: the diagonal weights).
+        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: one weight each).
 
         Unbuffered (``np.add.at``): two springs on one joint add up.
         """
         np.add.at(K, (self.index, self.index), w)
+
+    def weighted(self, w: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``W_e x_e`` of each element (``w``: one weight each)."""
+        return w * x
+
+    def weighted_terms(self, w: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``|W_e| |x_e|``: the sizes of the terms of :meth:`weighted`."""
+        return np.abs(w * x)
 
     def squares(self, w: np.ndarray) -> float:
         """``Σ_e δ_eᵀ W_e δ_e``."""
@@ -99,7 +107,7 @@ class GeneralElements:
     jacobian : numpy.ndarray or None
         ``∂δ/∂v`` of each element, shape (n_e, k, nv); None when not computed.
     stiffness, damping : numpy.ndarray
-        Diagonals of C and D of each element, shape (n_e, k).
+        C and D of each element, shape (n_e, k, k).
     """
 
     delta: np.ndarray
@@ -120,12 +128,20 @@ class GeneralElements:
         S += np.einsum("bin,bi->n", np.abs(self.jacobian), np.abs(f))
 
     def add_jt_w_j(self, K: np.ndarray, w: np.ndarray) -> None:
-        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: the diagonal weights)."""
-        K += np.einsum("bin,bi,bim->nm", self.jacobian, w, self.jacobian)
+        """``K += Σ_e (∂δ_e/∂v)ᵀ W_e (∂δ_e/∂v)`` in place (``w``: (n_e, k, k))."""
+        K += np.einsum("bin,bij,bjm->nm", self.jacobian, w, self.jacobian, optimize=True)
+
+    def weighted(self, w: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``W_e x_e`` of each element (``w``: (n_e, k, k), ``x``: (n_e, k))."""
+        return np.einsum("bij,bj->bi", w, x)
+
+    def weighted_terms(self, w: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``|W_e| |x_e|``: the sizes of the terms of :meth:`weighted`."""
+        return np.einsum("bij,bj->bi", np.abs(w), np.abs(x))
 
     def squares(self, w: np.ndarray) -> float:
         """``Σ_e δ_eᵀ W_e δ_e``."""
-        return float(np.sum(w * self.delta**2))
+        return float(np.einsum("bi,bi->", self.delta, self.weighted(w, self.delta)))
 
 
 Elements = CoordinateElements | GeneralElements
@@ -247,8 +263,8 @@ def element_torques(
     nv = model.pin_model.nv
     Qc, Qd = np.zeros(nv), np.zeros(nv)
     for e in elements(model, data, qp):  # τ_c = −Σ Jᵀ C δ, τ_d = −Σ Jᵀ D δ̇
-        e.subtract_jt(Qc, e.stiffness * e.delta)
-        e.subtract_jt(Qd, e.damping * e.rate(vp))
+        e.subtract_jt(Qc, e.weighted(e.stiffness, e.delta))
+        e.subtract_jt(Qd, e.weighted(e.damping, e.rate(vp)))
     return Qc, Qd
 
 
@@ -322,8 +338,8 @@ def spring_damper_magnitudes(
     nv = model.pin_model.nv
     Sc, Sd = np.zeros(nv), np.zeros(nv)
     for e in elements(model, data, qp):
-        e.add_abs_jt(Sc, e.stiffness * e.delta)
-        e.add_abs_jt(Sd, e.damping * e.rate(vp))
+        e.add_abs_jt(Sc, e.weighted_terms(e.stiffness, e.delta))
+        e.add_abs_jt(Sd, e.weighted_terms(e.damping, e.rate(vp)))
     return (Sc, Sd) if J is None else (np.abs(J).T @ Sc, np.abs(J).T @ Sd)
 
 

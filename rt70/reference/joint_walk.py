@@ -23,7 +23,7 @@ from rt70.reference.element_tables import CONTINUOUS, PRISMATIC
 from rt70.reference.forces import GIMBAL_LOCK_COS
 
 #: Size of the kernels' fixed scratch (3×3 and 3-, 6-vectors) after the per-entry part.
-WORK_SMALL = 93
+WORK_SMALL = 105
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,7 +152,7 @@ def _walk_scratch(work, n):
     ``work[:3n]`` origins, ``[3n:6n]`` axes (``[6n:12n]`` is :func:`evaluate`'s
     Jacobian), then :data:`WORK_SMALL` numbers: R, R1, R2 (and evaluate's c12) at 0,
     9, 18 (27); p, p1, p2 (d), w, lin at 36, 39, 42 (45), 48, 51; evaluate's δ, δ̇ and
-    J_W⁻¹ at 54, 60, 66; T, X at 75, 84.
+    J_W⁻¹ at 54, 60, 66; T, X at 75, 84; its bushing forces ``C δ``, ``D δ̇`` at 93.
     """
     origin = work[: 3 * n].reshape((n, 3))
     axis_w = work[3 * n : 6 * n].reshape((n, 3))
@@ -253,8 +253,8 @@ def evaluate(
         placement in its parent joint, (n, 3, 3) and (n, 3) m.
     frame_R, frame_p : numpy.ndarray
         Each bushing's two frames in their joints, (n_b, 2, 3, 3) and (n_b, 2, 3) m.
-    stiffness, damping : numpy.ndarray, shape (n_b, 6)
-        Diagonals of each bushing's C (N/m, N·m/rad) and D (N·s/m, N·m·s/rad).
+    stiffness, damping : numpy.ndarray, shape (n_b, 6, 6)
+        Each bushing's C (N/m, N·m/rad) and D (N·s/m, N·m·s/rad).
     spring_q, spring_v, spring_kind : numpy.ndarray
         int64 per joint spring: q index, v index, and
         :data:`~rt70.reference.element_tables.CONTINUOUS` for a continuous joint.
@@ -268,6 +268,7 @@ def evaluate(
     c12, d = small[27:36].reshape((3, 3)), small[45:48]
     delta, rate = small[54:60], small[60:66]
     inv = small[66:75].reshape((3, 3))
+    f = small[93:105].reshape((2, 6))
     inv[0, 2] = inv[1, 2] = 0.0
     U = 0.0
     for b in range(start.shape[0] - 1):
@@ -288,9 +289,9 @@ def evaluate(
             for i in range(6):
                 rate[i] += jac[k, i] * vk
         _add_bushing(b, lo, hi, gains, jac, delta, rate, stiffness, damping, v_index,
-                     tau_c, tau_d, K, D)  # fmt: skip
+                     tau_c, tau_d, K, D, f)  # fmt: skip
         for i in range(6):
-            U += 0.5 * stiffness[b, i] * delta[i] * delta[i]
+            U += 0.5 * delta[i] * f[0, i]
     U = _add_joint_springs(U, qp, vp, gains, tau_c, tau_d, K, D,
                            spring_q, spring_v, spring_kind, spring_k, spring_d)  # fmt: skip
     return U, -1
@@ -328,25 +329,52 @@ def _deformation(R1, R2, p1, p2, c12, d, delta, inv):
 
 @numba.njit(cache=True, inline="always")
 def _add_bushing(b, lo, hi, gains, jac, delta, rate, stiffness, damping, v_index,
-                 tau_c, tau_d, K, D):  # fmt: skip
-    """Bushing b's ``−Jᵀ C δ``, ``−Jᵀ D δ̇`` (and ``JᵀCJ``, ``JᵀDJ``) on its own joints."""
+                 tau_c, tau_d, K, D, f):  # fmt: skip
+    """Bushing b's ``−Jᵀ C δ``, ``−Jᵀ D δ̇`` (and ``JᵀCJ``, ``JᵀDJ``) on its own joints.
+
+    Leaves ``C δ`` in ``f[0]`` (for the potential); ``f`` (2, 6) is its scratch: ``C δ``,
+    ``D δ̇``, then with ``gains`` the columns ``C Jₖ``, ``D Jₖ`` of one joint entry at a
+    time.
+    """
+    C, Dm = stiffness[b], damping[b]
+    for i in range(6):
+        fc = 0.0
+        fd = 0.0
+        for j in range(6):
+            fc += C[i, j] * delta[j]
+            fd += Dm[i, j] * rate[j]
+        f[0, i], f[1, i] = fc, fd
     for k in range(lo, hi):
         fc = 0.0
         fd = 0.0
         for i in range(6):
-            fc += jac[k, i] * stiffness[b, i] * delta[i]
-            fd += jac[k, i] * damping[b, i] * rate[i]
+            fc += jac[k, i] * f[0, i]
+            fd += jac[k, i] * f[1, i]
         tau_c[v_index[k]] -= fc
         tau_d[v_index[k]] -= fd
-        if gains:
-            for m in range(lo, hi):
-                kc = 0.0
-                kd = 0.0
-                for i in range(6):
-                    kc += jac[k, i] * stiffness[b, i] * jac[m, i]
-                    kd += jac[k, i] * damping[b, i] * jac[m, i]
-                K[v_index[k], v_index[m]] += kc
-                D[v_index[k], v_index[m]] += kd
+    if not gains:
+        return
+    for k in range(lo, hi):
+        for i in range(6):  # (C Jₖ)ᵢ, (D Jₖ)ᵢ, C and D symmetric
+            kc = 0.0
+            kd = 0.0
+            for j in range(6):
+                kc += C[i, j] * jac[k, j]
+                kd += Dm[i, j] * jac[k, j]
+            f[0, i], f[1, i] = kc, kd
+        for m in range(lo, hi):
+            kc = 0.0
+            kd = 0.0
+            for i in range(6):
+                kc += jac[m, i] * f[0, i]
+                kd += jac[m, i] * f[1, i]
+            K[v_index[m], v_index[k]] += kc
+            D[v_index[m], v_index[k]] += kd
+    for i in range(6):  # C δ again, for the potential
+        fc = 0.0
+        for j in range(6):
+            fc += C[i, j] * delta[j]
+        f[0, i] = fc
 
 
 @numba.njit(cache=True, inline="always")
@@ -405,10 +433,10 @@ def evaluate_packed(qp, vp, gains, tau_c, tau_d, K, D, work, ints, floats, theta
     j += 18 * n_b
     frame_p = floats[j : j + 6 * n_b].reshape((n_b, 2, 3))
     j += 6 * n_b
-    stiffness = floats[j : j + 6 * n_b].reshape((n_b, 6))
-    j += 6 * n_b
-    damping = floats[j : j + 6 * n_b].reshape((n_b, 6))
-    j += 6 * n_b
+    stiffness = floats[j : j + 36 * n_b].reshape((n_b, 6, 6))
+    j += 36 * n_b
+    damping = floats[j : j + 36 * n_b].reshape((n_b, 6, 6))
+    j += 36 * n_b
     spring_k, spring_d = floats[j : j + ns], floats[j + ns : j + 2 * ns]
     return evaluate(
         qp, vp, gains, tau_c, tau_d, K, D, work,

@@ -27,7 +27,7 @@ from rt70.urdf.text import prepare_text
 
 @dataclass(frozen=True)
 class Bushing:
-    """A bushing's two frames, each as (parent joint, placement in it), and its gains."""
+    """A bushing's two frames, each as (parent joint, placement in it), and its 6 × 6 gains."""
 
     frame1: tuple[int, pin.SE3]
     frame2: tuple[int, pin.SE3]
@@ -149,8 +149,8 @@ class ReferenceModel:
         self.frames1 = [b.frame1 for b in self.bushings]
         self.frames2 = [b.frame2 for b in self.bushings]
         self.stack1, self.stack2 = FrameStack.of(self.frames1), FrameStack.of(self.frames2)
-        self.stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6)
-        self.damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6)
+        self.stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6, 6)
+        self.damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6, 6)
         self.coords, self.coordinate_names = _coordinates(model, desc)
         self.identity_map = all(c.kind == "1dof" and c.book == c.iv for c in self.coords)
         joint_id = {name: i for i, name in enumerate(model.names)}

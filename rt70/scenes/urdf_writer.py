@@ -347,6 +347,11 @@ def gravity(w: Writer, g: Sequence[float]) -> None:
     w.empty("rt70:gravity", ("xyz", fmt_vec(g)))
 
 
+def _flat(values) -> list[float]:
+    """The numbers of a sequence, or of a sequence of rows (a 6 × 6 matrix), in order."""
+    return [float(v) for row in values for v in (row if hasattr(row, "__len__") else [row])]
+
+
 def bushing(
     w: Writer,
     name: str,
@@ -359,7 +364,7 @@ def bushing(
     xyz2: Sequence[float] = ZERO3,
     rpy2: Sequence[float] = ZERO3,
 ) -> None:
-    """Write an ``<rt70:bushing>``: six stiffnesses and dampings between two link frames.
+    """Write an ``<rt70:bushing>``: its stiffness and damping between two link frames.
 
     Parameters
     ----------
@@ -367,9 +372,10 @@ def bushing(
         The scene being written.
     name : str
         Name of the bushing.
-    stiffness : sequence of float, length 6
-        Along x, y, z (N/m), then about x, y, z (N·m/rad) of the deformation.
-    damping : sequence of float, length 6
+    stiffness : sequence of float, length 6 or 36
+        Along x, y, z (N/m), then about x, y, z (N·m/rad) of the deformation: the
+        diagonal, or the symmetric 6 × 6 matrix row by row.
+    damping : sequence of float, length 6 or 36
         Likewise, N·s/m and N·m·s/rad.
     link1, link2 : str
         Links of frame 1 and frame 2.
@@ -381,10 +387,11 @@ def bushing(
     Raises
     ------
     ValueError
-        Without six values of each.
+        Without 6 or 36 values of each.
     """
-    if len(stiffness) != 6 or len(damping) != 6:
-        raise ValueError(f"bushing {name!r} needs six stiffness and six damping values")
+    stiffness, damping = _flat(stiffness), _flat(damping)
+    if len(stiffness) not in (6, 36) or len(damping) not in (6, 36):
+        raise ValueError(f"bushing {name!r} needs 6 or 36 stiffness and damping values")
     w.open(
         "rt70:bushing",
         ("name", check_name(name)),

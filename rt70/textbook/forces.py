@@ -2,9 +2,10 @@
 
 Every elastic element is defined by its deformation δ(q): its potential is
 ``U = ½ δᵀ C δ``, its force ``Q_c = −(∂δ/∂q)ᵀ C δ`` and its damper's force
-``Q_d = −(∂δ/∂q)ᵀ D δ̇`` with ``δ̇ = (∂δ/∂q) q̇`` — conservative by construction, so the
-energy audit (1.73) closes. The book's direct pair (4.83) and strut package
-(4.85)–(4.110) are both bushings between two frames.
+``Q_d = −(∂δ/∂q)ᵀ D δ̇`` with ``δ̇ = (∂δ/∂q) q̇`` (C and D symmetric positive
+semi-definite; a bushing's are 6 × 6 matrices, which may couple its axes) —
+conservative by construction, so the energy audit (1.73) closes. The book's direct
+pair (4.83) and strut package (4.85)–(4.110) are both bushings between two frames.
 
 The element kinds are listed once, in :data:`ELEMENTS`: the ``RobotDescription`` list
 each is read into, and the function giving the deformations of all its elements
@@ -113,8 +114,12 @@ class CoordinateElements:
         np.subtract.at(Q_full, self.coords, f)
         Q += model.reduce(Q_full)
 
+    def weighted(self, w: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``W_e x_e`` of each element (``w``: one weight each, shape (n_e,))."""
+        return w * x
+
     def squares(self, w: np.ndarray) -> list[float]:
-        """``Σ_e δ_eᵀ W_e δ_e`` (``w``: the diagonal weights), as a list of partial sums."""
+        """``Σ_e δ_eᵀ W_e δ_e`` (``w``: one weight each), as a list of partial sums."""
         return [float(np.sum(w * self.delta**2))]
 
 
@@ -129,7 +134,7 @@ class GeneralElements:
     jacobian : numpy.ndarray
         ``∂δ/∂q`` of each element, shape (n_e, k, nv).
     stiffness, damping : numpy.ndarray
-        Diagonals of C and D of each element, shape (n_e, k).
+        C and D of each element, shape (n_e, k, k).
     """
 
     delta: np.ndarray
@@ -147,8 +152,8 @@ class GeneralElements:
         ----------
         deformations : list of Deformation
             One per element: δ (k,) and ∂δ/∂q (k, nv).
-        stiffness, damping : numpy.ndarray, shape (n_e, k)
-            Diagonals of each element's C (N/m, N·m/rad) and D (N·s/m, N·m·s/rad).
+        stiffness, damping : numpy.ndarray, shape (n_e, k, k)
+            Each element's C (N/m, N·m/rad) and D (N·s/m, N·m·s/rad).
         """
         return cls(
             np.array([d.delta for d in deformations]),
@@ -175,9 +180,13 @@ class GeneralElements:
         """
         Q -= np.einsum("ekn,ek->n", self.jacobian, f)
 
+    def weighted(self, w: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """``W_e x_e`` of each element (``w``: (n_e, k, k), ``x``: (n_e, k))."""
+        return np.einsum("ekl,el->ek", w, x)
+
     def squares(self, w: np.ndarray) -> list[float]:
-        """``δ_eᵀ W_e δ_e`` of each element (``w``: the diagonal weights, (n_e, k))."""
-        return np.einsum("ek,ek->e", self.delta, w * self.delta).tolist()
+        """``δ_eᵀ W_e δ_e`` of each element (``w``: (n_e, k, k))."""
+        return np.einsum("ek,ek->e", self.delta, self.weighted(w, self.delta)).tolist()
 
 
 Elements = CoordinateElements | GeneralElements
@@ -341,8 +350,8 @@ def spring_damper_force(
     Qc = np.zeros(model.nv)
     Qd = np.zeros(model.nv)
     for e in elements(model, data, q):
-        e.subtract_jt(model, Qc, e.stiffness * e.delta)
-        e.subtract_jt(model, Qd, e.damping * e.rate(model, qd))
+        e.subtract_jt(model, Qc, e.weighted(e.stiffness, e.delta))
+        e.subtract_jt(model, Qd, e.weighted(e.damping, e.rate(model, qd)))
     return Qc, Qd
 
 

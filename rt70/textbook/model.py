@@ -79,7 +79,9 @@ class LoopModel:
 class BushingModel:
     """A 6-D spring/damper between frame 1 on ``body1`` and frame 2 on ``body2``.
 
-    Bodies are pair indices (−1 = ground); ``r``/``c`` place each frame in its body.
+    Bodies are pair indices (−1 = ground); ``r``/``c`` place each frame in its body;
+    ``stiffness`` and ``damping`` are the 6 × 6 matrices C and D of the deformation
+    (frame 2's position in frame 1 and its 1–2–3 angles).
     """
 
     name: str

@@ -108,7 +108,8 @@ class Bushing:
     Attributes
     ----------
     stiffness, damping : numpy.ndarray
-        Diagonals of C and D, order x, y, z, rx, ry, rz, shape (6,).
+        C and D, symmetric positive semi-definite, shape (6, 6), rows and columns in the
+        order x, y, z, rx, ry, rz of the deformation; given as 6 numbers, the diagonal.
     package : str or None
         Name of the strut package this bushing is a strut of, if any.
     """
@@ -119,6 +120,16 @@ class Bushing:
     stiffness: np.ndarray
     damping: np.ndarray
     package: str | None = None
+
+    def __post_init__(self) -> None:
+        for attr in ("stiffness", "damping"):
+            value = np.asarray(getattr(self, attr), dtype=float)
+            object.__setattr__(self, attr, np.diag(value) if value.shape == (6,) else value)
+
+    @property
+    def diagonal(self) -> bool:
+        """Whether C and D are both diagonal (each axis on its own)."""
+        return all(not np.any(m - np.diag(np.diag(m))) for m in (self.stiffness, self.damping))
 
 
 @dataclass(frozen=True)

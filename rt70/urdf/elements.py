@@ -16,6 +16,11 @@ from rt70.errors import ExtensionError, MagnitudeError, NonFiniteError, UrdfErro
 from rt70.urdf.description import Joint, RobotDescription
 from rt70.urdf.text import RT70_NS
 
+#: Relative tolerance of a six-axis element's 6 × 6 matrices: asymmetry against the
+#: largest entry, a negative eigenvalue against the largest eigenvalue
+#: (:meth:`ElementReader.gain_matrices`).
+GAIN_MATRIX_RTOL = 1e-9
+
 #: Largest magnitude of any number rt70 reads from a URDF (docs/urdf-reader.md): a product
 #: of ten such numbers stays below the largest double (1.8e308), far more factors than
 #: any term of the equations of motion multiplies, so no evaluation can overflow.
@@ -168,6 +173,69 @@ class ElementReader:
                 raise self.fail(ExtensionError, f"{where}: negative {attr}")
             out.append(values)
         return out[0], out[1]
+
+    def gain_matrices(self, elem: ET.Element, where: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(C, D)`` of a six-axis element: 6 numbers (the diagonal) or 36 (the matrix).
+
+        The 36 numbers are the symmetric positive semi-definite 6 × 6 matrix row by row,
+        in the order x, y, z, rx, ry, rz of the element's deformation. Symmetry is
+        checked to :data:`GAIN_MATRIX_RTOL` of the largest entry (then the mean of the
+        two triangles is kept) and semi-definiteness to the same fraction of the largest
+        eigenvalue: a file printed with ten digits passes, a sign slip does not.
+
+        Parameters
+        ----------
+        elem : xml.etree.ElementTree.Element
+            The element with the ``stiffness`` and ``damping`` attributes.
+        where : str
+            The element as messages name it.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            C (N/m, N·m/rad and N/rad off the diagonal blocks) and D (the same per
+            second), shape (6, 6) each; zero where the attribute is absent.
+        """
+        out = []
+        for attr in ("stiffness", "damping"):
+            raw = elem.get(attr)
+            count = len(raw.split()) if raw is not None else 6
+            if count not in (6, 36):
+                raise self.fail(
+                    ExtensionError,
+                    f'{where} {attr}="{raw}": expected 6 numbers (the diagonal) or 36 (the '
+                    f"symmetric 6×6 matrix, row by row), got {count}",
+                )
+            values = self.numbers(elem, attr, count, np.zeros(count))
+            if count == 6:
+                if np.any(values < 0.0):
+                    raise self.fail(ExtensionError, f"{where}: negative {attr}")
+                out.append(np.diag(values))
+            else:
+                out.append(self._semidefinite(values.reshape(6, 6), attr, where))
+        return out[0], out[1]
+
+    def _semidefinite(self, matrix: np.ndarray, attr: str, where: str) -> np.ndarray:
+        """``matrix`` checked symmetric and positive semi-definite, symmetrised."""
+        scale = float(np.max(np.abs(matrix)))
+        asym = np.abs(matrix - matrix.T)
+        if np.max(asym) > GAIN_MATRIX_RTOL * scale:
+            i, j = np.unravel_index(int(np.argmax(asym)), asym.shape)
+            raise self.fail(
+                ExtensionError,
+                f"{where}: {attr} is not symmetric: entry ({i + 1}, {j + 1}) is "
+                f"{matrix[i, j]:g}, entry ({j + 1}, {i + 1}) is {matrix[j, i]:g}",
+            )
+        symmetric = 0.5 * (matrix + matrix.T)
+        eigenvalues = np.linalg.eigvalsh(symmetric)
+        if eigenvalues[0] < -GAIN_MATRIX_RTOL * max(float(eigenvalues[-1]), 0.0):
+            raise self.fail(
+                ExtensionError,
+                f"{where}: {attr} is not positive semi-definite: its smallest eigenvalue is "
+                f"{eigenvalues[0]:g} (the largest {eigenvalues[-1]:g}): the element would "
+                "give energy instead of storing it",
+            )
+        return symmetric
 
     def one_dof_joint(self, elem: ET.Element, joints: dict[str, Joint], where: str) -> Joint:
         """The 1-DOF joint an extension element names in its ``joint`` attribute.

@@ -160,7 +160,7 @@ def _bushing(reader: ElementReader, elem: ET.Element, desc: RobotDescription) ->
     where = f"<rt70:bushing name='{name}'>"
     f1 = _frame(reader, elem, "frame1", desc, where)
     f2 = _frame(reader, elem, "frame2", desc, where)
-    k, d = reader.gains(elem, 6, where)
+    k, d = reader.gain_matrices(elem, where)
     return Bushing(name, f1, f2, k, d)
 
 
@@ -205,7 +205,7 @@ def _strut_package(
         sname = reader.name_of(sub)
         r_s = reader.numbers(sub, "xyz", 3, ZERO3)
         rpy_s = reader.numbers(sub, "rpy", 3, ZERO3)
-        k, d = reader.gains(sub, 6, f"{where} <rt70:strut name='{sname}'>")
+        k, d = reader.gain_matrices(sub, f"{where} <rt70:strut name='{sname}'>")
         # frame 1 = package origin ∘ (r_s, c_s), expressed in the parent link
         f1_xyz = origin_xyz + origin_rot @ r_s
         f1_rpy = rpy_of_matrix(origin_rot @ rpy_matrix(rpy_s))

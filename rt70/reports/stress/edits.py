@@ -146,7 +146,7 @@ def set_spring_entry(text: str, name: str, index: int, stiffness: float, damping
     elem = _named(root, name)
     for attr, value in (("stiffness", stiffness), ("damping", damping)):
         values = _numbers(elem, attr)
-        values[index] = value
+        values[index * 7 if values.size == 36 else index] = value  # a 6 × 6's diagonal
         elem.set(attr, fmt_vec(values))
     return _serialize(root)
 
@@ -176,9 +176,10 @@ def convert_units(text: str, length: float = 1.0, mass: float = 1.0) -> str:
     metre: 1e3 for mm) or ``mass`` (new mass units per kg: 1e3 for g, 1/9.80665 for the
     technical unit kgf·s²/m). From the dimensions: lengths, gravity × λ; masses × μ;
     inertias × μλ²; translational stiffness (N/m = kg/s²) and damping (kg/s) × μ;
-    torsional stiffness (N·m/rad = kg·m²/s²) and damping × μλ²; a force × μλ, a torque
-    × μλ². So mm/g/s: lengths × 1e3, masses × 1e3, inertias × 1e9, N/m × 1e3,
-    N·m/rad × 1e9; m/kgf/s: every mass, inertia, stiffness and damping ÷ 9.80665.
+    torsional stiffness (N·m/rad = kg·m²/s²) and damping × μλ²; the coupling terms of a
+    6 × 6 (N/rad, N·m/m) × μλ; a force × μλ, a torque × μλ². So mm/g/s: lengths × 1e3,
+    masses × 1e3, inertias × 1e9, N/m × 1e3, N·m/rad × 1e9; m/kgf/s: every mass,
+    inertia, stiffness and damping ÷ 9.80665.
     Joint ``<dynamics>`` and mesh files are not touched (rt70 uses neither).
 
     Parameters
@@ -233,13 +234,16 @@ def convert_units(text: str, length: float = 1.0, mass: float = 1.0) -> str:
     for elem, kind in _gain_elements(root):
         if kind == "joint_spring":
             factor = mu if joint_type.get(elem.get("joint")) == "prismatic" else mu * lam**2
-        else:
-            factor = six
-            _scale_attr(elem, "xyz", lam)
-            for frame in ("frame1", "frame2"):
-                _scale_attr(elem.find(_q(frame)), "xyz", lam)
-        _scale_attr(elem, "stiffness", factor)
-        _scale_attr(elem, "damping", factor)
+            _scale_attr(elem, "stiffness", factor)
+            _scale_attr(elem, "damping", factor)
+            continue
+        _scale_attr(elem, "xyz", lam)
+        for frame in ("frame1", "frame2"):
+            _scale_attr(elem.find(_q(frame)), "xyz", lam)
+        for attr in ("stiffness", "damping"):  # a 6 × 6's coupling (N/rad, N) scales by μλ
+            count = len((elem.get(attr) or "").split())
+            half = np.sqrt(six)
+            _scale_attr(elem, attr, np.outer(half, half).ravel() if count == 36 else six)
     for elem in [*root.findall(_q("strut_package")), *root.findall(_q("optical_point"))]:
         _scale_attr(elem, "xyz", lam)
     return _serialize(root)

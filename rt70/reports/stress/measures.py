@@ -58,7 +58,7 @@ def spring_stiffness(scene: Scene, q: np.ndarray) -> np.ndarray:
         K += G.T @ K_full @ G
     for b in model.bushings:
         jac = forces.bushing_deformation(data, b).jacobian
-        K += jac.T @ (b.stiffness[:, None] * jac)
+        K += jac.T @ b.stiffness @ jac
     return 0.5 * (K + K.T)
 
 
