@@ -10,7 +10,7 @@ neither side of the rigid-body cross-check; numpy only. See docs/bond-graphs.md.
 
 from rt70.bondgraph.causality import Causality, assign_causality
 from rt70.bondgraph.drive import DRIVE_OUTPUTS, dc_motor_reducer_load
-from rt70.bondgraph.equations import PowerBalance, StateSpace, state_equations
+from rt70.bondgraph.equations import PowerBalance, StateEquations, state_equations
 from rt70.bondgraph.graph import BondGraph, BondGraphError, CausalityError
 from rt70.bondgraph.lagrange import SecondOrder, drive_lagrange, reducer_lagrange
 from rt70.bondgraph.parameters import DriveParameters, GearReducerParameters, ParameterError
@@ -27,7 +27,7 @@ __all__ = [
     "ParameterError",
     "PowerBalance",
     "SecondOrder",
-    "StateSpace",
+    "StateEquations",
     "assign_causality",
     "dc_motor_reducer_load",
     "drive_lagrange",

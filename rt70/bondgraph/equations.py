@@ -54,7 +54,7 @@ class PowerBalance:
 
 
 @dataclass
-class StateSpace:
+class StateEquations:
     """The linear state equations of a bond graph, with names and its energy.
 
     Attributes
@@ -244,7 +244,7 @@ class _Former:
 
 def state_equations(
     graph: BondGraph | Causality, outputs: list[tuple[str, str, str]] | None = None
-) -> StateSpace:
+) -> StateEquations:
     """Form ``ẋ = A x + B u`` and the named outputs ``y = C x + D u`` of a bond graph.
 
     Parameters
@@ -256,7 +256,7 @@ def state_equations(
 
     Returns
     -------
-    StateSpace
+    StateEquations
 
     Raises
     ------
@@ -298,7 +298,7 @@ def state_equations(
     n = len(states)
     M = np.array(rows).reshape(n, former.n)
     Y = np.array(out_rows).reshape(len(out_names), former.n)
-    return StateSpace(
+    return StateEquations(
         A=M[:, :n],
         B=M[:, n:],
         C=Y[:, :n],
