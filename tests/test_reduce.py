@@ -31,8 +31,8 @@ def test_balanced_truncation_error_lies_between_its_bounds(plants, which, order)
     Measured, locked (mm or arcsec per kN): order 4: 0.60 (σ_5 = 0.30, bound 1.59);
     8: 0.0249 (0.0122, 0.112); 16: 2.58e-3 (1.35e-3, 8.09e-3). Free (arcsec or mm per
     MN·m; the rigid azimuth's 2 states kept whole): 8: 12.7 (5.65, 55.1); 16: 0.553
-    (0.343, 2.75); 24: 0.0403 (0.0111, 0.0490) — above the split's own floor of 0.040
-    (1.6e-10 of ‖G‖∞) only because of the principal coordinates of ``_conditioned``:
+    (0.343, 2.75); 24: 0.0278 (0.0111, 0.0490) — above the split's own floor of 0.028
+    (1.15e-10 of ‖G‖∞) only because of the principal coordinates of ``_conditioned``:
     in the physical ones the floor was 24.7 and the bound failed from order 12 on.
     """
     ss = plants[which]
