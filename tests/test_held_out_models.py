@@ -346,10 +346,13 @@ def test_textbook_bushings_as_arrays_equal_the_plain_loop(name):
 
         def force(e: tb_forces.GeneralElements, qd: np.ndarray = qd) -> np.ndarray:
             Q = np.zeros(model.nv)
-            e.subtract_jt(model, Q, e.stiffness * e.delta + e.damping * e.rate(model, qd))
+            f = e.weighted(e.stiffness, e.delta) + e.weighted(e.damping, e.rate(model, qd))
+            e.subtract_jt(model, Q, f)
             return Q
 
-        f = vectorised.stiffness * delta + vectorised.damping * (jac @ qd)
+        f = np.einsum("ekl,el->ek", vectorised.stiffness, delta) + np.einsum(
+            "ekl,el->ek", vectorised.damping, jac @ qd
+        )
         terms = np.einsum("ekn,ek->n", np.abs(jac), np.abs(f))  # Σ |J|ᵀ|f| before cancelling
         assert_close(force(stacked), force(vectorised), rel=8 * EPS, scale=terms)
 

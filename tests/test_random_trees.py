@@ -132,7 +132,7 @@ def test_elastic_chain_bushing_deformation_is_the_pair_coordinates():
     for b in scene.description.bushings:
         names = [f"{b.frame2.link}_{s}" for s in ("x", "y", "z", "rx", "ry", "rz")]
         qj = q[[index[n] for n in names]]
-        expected += 0.5 * float(qj @ (b.stiffness * qj))
+        expected += 0.5 * float(qj @ b.stiffness @ qj)
     assert len(scene.description.bushings) == 3
     assert_close(forces.spring_potential(tm, td, q), expected, rel=1e-12)
 

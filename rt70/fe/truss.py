@@ -21,7 +21,17 @@ from rt70.fe.neutral import FEModel
 
 
 def bar_matrices(p1: np.ndarray, p2: np.ndarray, EA: float, rho_A: float):
-    """``(K_e, M_e)`` of one bar on ``[u₁; u₂]`` (6 × 6 each), N/m and kg."""
+    """``(K_e, M_e)`` of one bar on ``[u₁; u₂]`` (6 × 6 each), N/m and kg.
+
+    Parameters
+    ----------
+    p1, p2 : array_like, shape (3,)
+        The bar's end nodes, m.
+    EA : float
+        Axial stiffness, N.
+    rho_A : float
+        Mass per length, kg/m.
+    """
     d = np.asarray(p2, dtype=float) - np.asarray(p1, dtype=float)
     L = float(np.linalg.norm(d))
     if not L > 0.0:
@@ -79,6 +89,19 @@ def space_frame(
     six rigid-body modes when free. Steel tubes by default: EA = 2e8 N (≈ 10 cm²,
     E = 200 GPa), 20 kg/m. The interface nodes are the four bottom corners
     (``corner_1`` … ``corner_4``).
+
+    Parameters
+    ----------
+    nx, ny : int
+        Nodes a layer along x and y (at least 2 each).
+    spacing : float
+        Distance between neighbouring nodes of a layer, m.
+    depth : float
+        Distance between the layers, m.
+    EA : float
+        Axial stiffness of every bar, N.
+    rho_A : float
+        Mass per length of every bar, kg/m.
     """
     if nx < 2 or ny < 2:
         raise Rt70Error(f"a space frame needs at least 2 × 2 nodes a layer, got {nx} × {ny}")
