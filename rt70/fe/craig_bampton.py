@@ -133,8 +133,8 @@ def craig_bampton(M: sp.sparray, K: sp.sparray, boundary, n_modes: int) -> Craig
     Psi = -lu.solve(K_ib.toarray())
     omega2, Phi = _fixed_interface_modes(M_ii, K_ii, n_modes)
     K_red = K_bb.toarray() + (K_ib.T @ Psi)
-    M_ib_psi = M_ii @ Psi
-    M_red = M_bb.toarray() + M_ib.T @ Psi + Psi.T @ M_ib.toarray() + Psi.T @ M_ib_psi
+    M_ii_psi = M_ii @ Psi
+    M_red = M_bb.toarray() + M_ib.T @ Psi + Psi.T @ M_ib.toarray() + Psi.T @ M_ii_psi
     M_b_eta = (M_ib.T @ Phi) + Psi.T @ (M_ii @ Phi)
     nb, k = b.size, omega2.size
     Mcb = np.zeros((nb + k, nb + k))

@@ -23,7 +23,7 @@ from rt70.reference.element_tables import CONTINUOUS, PRISMATIC
 from rt70.reference.forces import GIMBAL_LOCK_COS
 
 #: Size of the kernels' fixed scratch (3×3 and 3-, 6-vectors) after the per-entry part.
-WORK_SMALL = 105
+WORK_SMALL = 117
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,7 +152,8 @@ def _walk_scratch(work, n):
     ``work[:3n]`` origins, ``[3n:6n]`` axes (``[6n:12n]`` is :func:`evaluate`'s
     Jacobian), then :data:`WORK_SMALL` numbers: R, R1, R2 (and evaluate's c12) at 0,
     9, 18 (27); p, p1, p2 (d), w, lin at 36, 39, 42 (45), 48, 51; evaluate's δ, δ̇ and
-    J_W⁻¹ at 54, 60, 66; T, X at 75, 84; its bushing forces ``C δ``, ``D δ̇`` at 93.
+    J_W⁻¹ at 54, 60, 66; T, X at 75, 84; its bushing scratch ``C δ``, ``D δ̇``, ``C Jₖ``,
+    ``D Jₖ`` at 93.
     """
     origin = work[: 3 * n].reshape((n, 3))
     axis_w = work[3 * n : 6 * n].reshape((n, 3))
@@ -268,7 +269,7 @@ def evaluate(
     c12, d = small[27:36].reshape((3, 3)), small[45:48]
     delta, rate = small[54:60], small[60:66]
     inv = small[66:75].reshape((3, 3))
-    f = small[93:105].reshape((2, 6))
+    f = small[93:117].reshape((4, 6))
     inv[0, 2] = inv[1, 2] = 0.0
     U = 0.0
     for b in range(start.shape[0] - 1):
@@ -332,8 +333,8 @@ def _add_bushing(b, lo, hi, gains, jac, delta, rate, stiffness, damping, v_index
                  tau_c, tau_d, K, D, f):  # fmt: skip
     """Bushing b's ``−Jᵀ C δ``, ``−Jᵀ D δ̇`` (and ``JᵀCJ``, ``JᵀDJ``) on its own joints.
 
-    Leaves ``C δ`` in ``f[0]`` (for the potential); ``f`` (2, 6) is its scratch: ``C δ``,
-    ``D δ̇``, then with ``gains`` the columns ``C Jₖ``, ``D Jₖ`` of one joint entry at a
+    Leaves ``C δ`` in ``f[0]`` (for the potential) and ``D δ̇`` in ``f[1]``; with
+    ``gains``, ``f[2]`` and ``f[3]`` hold ``C Jₖ`` and ``D Jₖ`` of one joint entry at a
     time.
     """
     C, Dm = stiffness[b], damping[b]
@@ -361,20 +362,15 @@ def _add_bushing(b, lo, hi, gains, jac, delta, rate, stiffness, damping, v_index
             for j in range(6):
                 kc += C[i, j] * jac[k, j]
                 kd += Dm[i, j] * jac[k, j]
-            f[0, i], f[1, i] = kc, kd
+            f[2, i], f[3, i] = kc, kd
         for m in range(lo, hi):
             kc = 0.0
             kd = 0.0
             for i in range(6):
-                kc += jac[m, i] * f[0, i]
-                kd += jac[m, i] * f[1, i]
+                kc += jac[m, i] * f[2, i]
+                kd += jac[m, i] * f[3, i]
             K[v_index[m], v_index[k]] += kc
             D[v_index[m], v_index[k]] += kd
-    for i in range(6):  # C δ again, for the potential
-        fc = 0.0
-        for j in range(6):
-            fc += C[i, j] * delta[j]
-        f[0, i] = fc
 
 
 @numba.njit(cache=True, inline="always")

@@ -20,6 +20,8 @@ from rt70.urdf.text import RT70_NS
 #: largest entry, a negative eigenvalue against the largest eigenvalue
 #: (:meth:`ElementReader.gain_matrices`).
 GAIN_MATRIX_RTOL = 1e-9
+#: The attributes of an element's gains, in the order they are returned.
+GAINS = ("stiffness", "damping")
 
 #: Largest magnitude of any number rt70 reads from a URDF (docs/urdf-reader.md): a product
 #: of ten such numbers stays below the largest double (1.8e308), far more factors than
@@ -162,17 +164,20 @@ class ElementReader:
         elem : xml.etree.ElementTree.Element
             The element with the ``stiffness`` and ``damping`` attributes.
         count : int
-            How many numbers each holds (1 for a joint spring, 6 for a bushing).
+            How many numbers each holds (1 for a joint spring; a six-axis element's are
+            read by :meth:`gain_matrices`).
         where : str
             The element as messages name it.
         """
-        out = []
-        for attr in ("stiffness", "damping"):
-            values = self.numbers(elem, attr, count, np.zeros(count))
-            if np.any(values < 0.0):
-                raise self.fail(ExtensionError, f"{where}: negative {attr}")
-            out.append(values)
-        return out[0], out[1]
+        stiffness, damping = (self._nonnegative(elem, a, count, where) for a in GAINS)
+        return stiffness, damping
+
+    def _nonnegative(self, elem: ET.Element, attr: str, count: int, where: str) -> np.ndarray:
+        """The ``count`` numbers of gain ``attr`` (zero when absent), none negative."""
+        values = self.numbers(elem, attr, count, np.zeros(count))
+        if np.any(values < 0.0):
+            raise self.fail(ExtensionError, f"{where}: negative {attr}")
+        return values
 
     def gain_matrices(self, elem: ET.Element, where: str) -> tuple[np.ndarray, np.ndarray]:
         """``(C, D)`` of a six-axis element: 6 numbers (the diagonal) or 36 (the matrix).
@@ -197,22 +202,20 @@ class ElementReader:
             second), shape (6, 6) each; zero where the attribute is absent.
         """
         out = []
-        for attr in ("stiffness", "damping"):
+        for attr in GAINS:
             raw = elem.get(attr)
             count = len(raw.split()) if raw is not None else 6
-            if count not in (6, 36):
+            if count == 6:
+                out.append(np.diag(self._nonnegative(elem, attr, 6, where)))
+            elif count == 36:
+                matrix = self.numbers(elem, attr, 36).reshape(6, 6)
+                out.append(self._semidefinite(matrix, attr, where))
+            else:
                 raise self.fail(
                     ExtensionError,
                     f'{where} {attr}="{raw}": expected 6 numbers (the diagonal) or 36 (the '
                     f"symmetric 6×6 matrix, row by row), got {count}",
                 )
-            values = self.numbers(elem, attr, count, np.zeros(count))
-            if count == 6:
-                if np.any(values < 0.0):
-                    raise self.fail(ExtensionError, f"{where}: negative {attr}")
-                out.append(np.diag(values))
-            else:
-                out.append(self._semidefinite(values.reshape(6, 6), attr, where))
         return out[0], out[1]
 
     def _semidefinite(self, matrix: np.ndarray, attr: str, where: str) -> np.ndarray:
