@@ -32,6 +32,7 @@ ELSEWHERE = {
     "no_slips": "constraints on a scene's velocities (rt70.mechanics, rt70.crosscheck)",
     "mount": "the pointing axes, read where a pointing is asked for (rt70.model.antenna)",
     "optics": "the reflector system: the pointing outputs (rt70.model.antenna)",
+    "beams": "the members written as rigid finite elements (rt70.scenes.beam_scenes)",
     "inertia_repairs": "the repairs the scene writes into the text both sides read (model.scene)",
 }
 

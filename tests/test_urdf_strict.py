@@ -187,6 +187,7 @@ def test_the_table_has_every_kind_the_reader_reads():
         "no_slip",
         "mount",
         "optics",
+        "beam",
     }
     assert set(KINDS) > {("bushing", "frame1"), ("strut_package", "strut"), ("drive", "sector")}
 

@@ -19,6 +19,7 @@ import pinocchio as pin
 from rt70.errors import Rt70Error
 from rt70.reference.limits import check_reference
 from rt70.reference.parse import parse_urdf
+from rt70.urdf.beams import expand_beams
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
 from rt70.urdf.inertia import balanced_text
@@ -122,7 +123,7 @@ class ReferenceModel:
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
         check_reference(desc)  # parser depth and memory, before Pinocchio sees the model
-        model = parse_urdf(urdf_text, desc.source)
+        model = parse_urdf(expand_beams(urdf_text, desc.source), desc.source)
         model.gravity.linear = np.asarray(desc.gravity, dtype=float)
         model.armature[:] = 0.0
         self.pin_model = model

@@ -17,6 +17,7 @@ import xml.etree.ElementTree as ET
 
 from rt70.errors import ExtensionError
 from rt70.physics.rotations import rpy_matrix, rpy_of_matrix
+from rt70.urdf.beams import read_beam
 from rt70.urdf.description import (
     Bushing,
     FrameRef,
@@ -69,6 +70,7 @@ def read_extensions(
     no_slips: list = []
     mount: list = []
     optics: list = []
+    beams: list = []
     joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
     for elem in root:
         if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
@@ -96,6 +98,8 @@ def read_extensions(
             mount.append(elem)  # read once every drive of the file is known
         elif kind == "optics":
             optics.append(elem)  # read once every optical point of the file is known
+        elif kind == "beam":
+            beams.append(read_beam(reader, elem))  # its elements read as any other
         elif kind == "optical_point":
             name = reader.name_of(elem)
             link = reader.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
@@ -103,7 +107,7 @@ def read_extensions(
         else:  # a kind declared in RT70 must be read here, never skipped
             raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
     _check_unique_names(reader, desc)
-    if not (winds or air or no_slips or mount or optics):
+    if not (winds or air or no_slips or mount or optics or beams):
         return desc
     return dataclasses.replace(
         desc,
@@ -112,6 +116,7 @@ def read_extensions(
         no_slips=tuple(no_slips),
         mount=read_mount(reader, mount[0], joints, desc.drives) if mount else None,
         optics=read_optics(reader, optics[0], desc) if optics else None,
+        beams=tuple(beams),
     )
 
 

@@ -99,6 +99,23 @@ RT70 = Spec(
             )
         ),
         "optical_point": Child(Spec(required=("name", "link", "xyz"))),
+        "beam": Child(
+            Spec(
+                required=("name", "parent", "length", "E", "rho", "A", "Iy", "Iz", "J"),
+                optional=(
+                    "child",
+                    "xyz",
+                    "rpy",
+                    "segments",
+                    "G",
+                    "nu",
+                    "Asy",
+                    "Asz",
+                    "axial",
+                    "damping",
+                ),
+            )
+        ),
         "drive": Child(
             Spec(
                 required=("name", "joint", *DRIVE_PARAMETERS),
