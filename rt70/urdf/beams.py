@@ -36,7 +36,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from rt70.errors import ExtensionError
-from rt70.urdf.description import Beam
+from rt70.urdf.beam_record import Beam
 from rt70.urdf.elements import ElementReader
 from rt70.urdf.schema import check_scene
 from rt70.urdf.text import RT70_NS, parse, refuse_entities, refuse_xacro
@@ -155,14 +155,26 @@ def expand_beams(text: str, source: str = "<string>") -> str:
     blocks = []
     for elem in pending:
         beam = read_beam(reader, elem)
-        blocks.append(beam_xml(beam, prefix, taken, reader))
+        blocks.append(_beam_xml(beam, prefix, taken, reader))
     end = [m.end() for m in re.finditer(r"</\s*robot\s*>", text)][-1]
     start = text.rindex("<", 0, end)
     return text[:start] + "".join(blocks) + text[start:]
 
 
-def beam_xml(beam: Beam, prefix: str, taken: set[str], reader: ElementReader) -> str:
-    """The URDF elements of one beam (links, joints, joint springs), after its comment."""
+def _beam_xml(beam: Beam, prefix: str, taken: set[str], reader: ElementReader) -> str:
+    """The URDF elements of one beam (links, joints, joint springs), after its comment.
+
+    Parameters
+    ----------
+    beam : Beam
+        The beam, its attributes checked.
+    prefix : str
+        The prefix the document binds to rt70's namespace (for the joint springs).
+    taken : set of str
+        The link and joint names already in the document; the beam's are added.
+    reader : ElementReader
+        The file's reader, for the error naming the file.
+    """
     where = f"<rt70:beam name='{beam.name}'>"
     out = [f"\n  <!-- {_MARK.format(name=beam.name)} (docs/beams.md) -->\n"]
     names: list[str] = []
