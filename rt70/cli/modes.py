@@ -12,7 +12,7 @@ import argparse
 import json
 
 from rt70.cli import options
-from rt70.errors import SingularConfigurationError
+from rt70.errors import SceneError, SingularConfigurationError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -34,6 +34,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="remove the azimuth and elevation coordinates (drives infinitely stiff)",
     )
     mod.add_argument("--json", action="store_true", help="print JSON")
+    mod.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="draw the modes on the structure, a 3-D panel each: FILE.png, .pdf or .svg, "
+        "or FILE.gif animated through a cycle",
+    )
+    mod.add_argument(
+        "--plot-modes",
+        type=options.positive_int,
+        default=6,
+        metavar="N",
+        help="how many modes --plot draws, the lowest elastic first (default 6)",
+    )
     mod.set_defaults(func=run)
     return mod
 
@@ -50,6 +63,8 @@ def run(args: argparse.Namespace) -> int:
     rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates)
     damped_summary = mode_table.damped_summary(result, damped)
     options.check_finite({"modes": rows, "damped": damped_summary}, f"{scene.name}: modes")
+    if args.plot is not None:
+        _plot(args, scene, model, result, shapes)
     if args.json:
         out = {
             "scene": scene.name,
@@ -75,6 +90,46 @@ def run(args: argparse.Namespace) -> int:
     _print_table(rows, result, damped)
     _print_unheld(rows, held, args.lock_axes)
     return 0
+
+
+#: Frames of one cycle in an animated mode plot.
+ANIMATION_FRAMES = 24
+
+
+def _plot(args: argparse.Namespace, scene, model, result, shapes) -> None:
+    """Draw the lowest elastic modes on the structure into ``args.plot`` (atomically).
+
+    ``shapes`` are the modes over ``model.coordinates`` (on a closed chain's manifold, its
+    tangent directions: drawn to first order, the loops opening by the square of the
+    drawn amplitude).
+    """
+    from pathlib import Path
+
+    import numpy as np
+
+    from rt70.guards.atomic import atomic_write
+    from rt70.linear.mode_shapes import draw_modes
+    from rt70.plotting.structure import animate_structure_modes, plot_structure_modes
+
+    elastic = np.flatnonzero(~result.rigid)[: args.plot_modes]
+    if elastic.size == 0:
+        raise SceneError(f"{scene.name}: no elastic mode to draw")
+    labels = [f"mode {k + 1}, {result.freq_hz[k]:.4g} Hz" for k in elastic]
+    out = Path(args.plot)
+    animated = out.suffix.lower() == ".gif"
+    phases = np.linspace(0.0, 2 * np.pi, ANIMATION_FRAMES, endpoint=False)
+    lines, rest, drawn = draw_modes(
+        scene, model.q0, model.coordinates, shapes[:, elastic], labels, phases
+    )
+    title = f"{scene.name}: mode shapes on the structure (grey: at rest)"
+    if animated:
+        animation = animate_structure_modes(lines, rest, drawn, title)
+        atomic_write(out, lambda tmp: animation.save(tmp, writer="pillow", fps=12))
+    else:
+        fig = plot_structure_modes(lines, rest, drawn, title)
+        fmt = out.suffix.lower().lstrip(".")
+        atomic_write(out, lambda tmp: fig.savefig(tmp, dpi=110, format=fmt))
+    print(f"wrote {out}")
 
 
 def _spectrum(args: argparse.Namespace, scene, held: dict) -> tuple:

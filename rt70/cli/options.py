@@ -424,11 +424,16 @@ def _non_finite(value: object, path: str) -> str | None:
 
 
 # --- output paths ------------------------------------------------------------------------
+#: The files ``modes --plot`` writes: still figures, or an animation (``.gif``).
+PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".gif")
+
+
 def check_outputs(args: argparse.Namespace) -> None:
     """Refuse output paths the command could not write, before it starts.
 
     ``simulate --out FILE`` (and the ``.png`` beside it unless ``--no-plot``),
-    ``bench --out DIRECTORY``, ``plant --out FILE.npz|FILE.mat`` and ``sweep --out FILE.npz``.
+    ``bench --out DIRECTORY``, ``plant --out FILE.npz|FILE.mat``, ``sweep --out FILE.npz``
+    and ``modes --plot FILE`` (:data:`PLOT_SUFFIXES`).
 
     Raises
     ------
@@ -453,6 +458,13 @@ def check_outputs(args: argparse.Namespace) -> None:
         out = Path(args.out)
         if out.suffix != ".npz" or out.is_dir():
             raise OutputError(f"{out}: --out must be a .npz file")
+        check_writable_directory(out.parent)
+    elif args.command == "modes" and args.plot is not None:
+        out = Path(args.plot)
+        if out.suffix.lower() not in PLOT_SUFFIXES or out.is_dir():
+            raise OutputError(
+                f"{out}: --plot must be a {', '.join(PLOT_SUFFIXES)} file (.gif: animated)"
+            )
         check_writable_directory(out.parent)
     elif args.command == "plant" and args.out is not None:
         out = Path(args.out)

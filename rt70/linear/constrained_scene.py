@@ -128,6 +128,11 @@ class SceneConstrainedModel:
     lock_held: bool = False
     locked_rotor: bool = False
 
+    @property
+    def q0(self) -> np.ndarray:
+        """The state linearised about, q* (as :attr:`rt70.linear.linearize.Linearization.q0`)."""
+        return self.equilibrium.q
+
 
 def constrained_linearize(
     scene: Scene,

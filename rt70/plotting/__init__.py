@@ -2,6 +2,8 @@
 
 - :mod:`rt70.plotting.modal` — Bode diagram, step responses and mode shapes of the
   linear analyses (:mod:`rt70.linear.modal`, :mod:`rt70.linear.responses`);
+- :mod:`rt70.plotting.structure` — mode shapes drawn on the structure in 3-D, still or
+  animated (:mod:`rt70.linear.mode_shapes`);
 - :mod:`rt70.plotting.simulation` — coordinates, energies and the energy-balance
   residual of a simulation (:mod:`rt70.simulation.simulate`).
 
