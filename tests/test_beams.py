@@ -170,3 +170,15 @@ def test_stubby_cantilever_converges_to_timoshenko():
     ]
     order = np.log2(np.abs(errors[0] / errors[1]))
     assert np.all(np.abs(errors[1]) < 5e-3) and np.all(order > 1.8), (errors, order)
+
+
+@pytest.mark.slow
+def test_spin_up_stiffens_the_rigid_elements_and_the_linear_modes_diverge():
+    """Ω_s = 6 rad/s, above the first frequency (3.8 rad/s): only the linear model runs away."""
+    from rt70.reports.spin_up import tip_linear_modes, tip_rigid_elements
+
+    times = np.linspace(0.0, 15.0, 31)
+    beam = tip_rigid_elements(3, 6.0, times)
+    linear = tip_linear_modes(3, 6.0, times)
+    assert np.all(np.isfinite(beam)) and 0.1 < np.abs(beam).max() < 1.0  # bends, stays bounded
+    assert np.abs(linear[~np.isnan(linear)]).max() > 100.0  # 10 m long: a runaway
