@@ -55,6 +55,13 @@ def test_expansion_writes_links_joints_and_springs():
     assert k["b_sde2_rx"] == pytest.approx(STEEL["G"] * STEEL["J"] / ell, rel=1e-15)
 
 
+def test_each_rigid_element_is_drawn_for_urdf_viewers():
+    text = expand_beams(beam_text(2))
+    radius = np.sqrt((STEEL["Iy"] + STEEL["Iz"]) / STEEL["A"])
+    assert text.count(f'<cylinder radius="{radius!r}" length="0.5"/>') == 2  # the half ends
+    assert text.count(f'<cylinder radius="{radius!r}" length="1.0"/>') == 1
+
+
 def test_expansion_is_idempotent_and_optional_coordinates_follow_the_attributes():
     text = beam_text(3, extra='Asy="8e-5" Asz="8e-5" axial="false" damping="1e-3"')
     once = expand_beams(text)

@@ -88,3 +88,20 @@ def test_the_kinetic_energy_is_the_nodes_own():
     node_velocity = v + np.cross(omega, r) + np.einsum("naj,j->na", shapes, eta_dot)
     energy = 0.5 * np.sum(masses * np.sum(node_velocity**2, axis=1))
     assert_close(0.5 * w @ body_mass_matrix(inv, eta) @ w, energy, rel=1e-14)
+
+
+def test_with_every_mode_the_body_has_its_fe_models_frequencies_and_fewer_lie_above():
+    from rt70.fe.truss import space_frame
+    from rt70.reports.modal_truncation import body_frequencies, held_modes, nodal_frequencies
+
+    fe = space_frame(3, 3)
+    index = {node: i for i, node in enumerate(fe.node_ids)}
+    held = held_modes(fe, tuple(index[fe.interfaces[f"corner_{c}"]] for c in (1, 2, 4)))
+    reference = nodal_frequencies(fe)
+    full = body_frequencies(held, held.omega2.size)
+    assert held.omega2.size == 3 * fe.node_xyz.shape[0] - 6
+    assert_close(full[6:], reference[6:], rel=1e-10, scale=np.abs(reference[6:]))
+    assert np.all(full[:6] == 0.0)  # the frame carries the rigid motion: no stiffness
+    errors = [body_frequencies(held, k)[6:11] / reference[6:11] - 1 for k in (8, 16, 32)]
+    assert all(np.all(e > -1e-12) for e in errors)  # a Ritz basis: from above
+    assert np.abs(errors[0]).max() > np.abs(errors[1]).max() > np.abs(errors[2]).max()

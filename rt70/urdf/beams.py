@@ -225,17 +225,25 @@ def _beam_xml(beam: Beam, prefix: str, taken: set[str], reader: ElementReader) -
 
 
 def _rfe_link(link: str, beam: Beam, ell: float) -> str:
-    """A rigid finite element of length ``ell``: its frame at its proximal end."""
+    """A rigid finite element of length ``ell``: its frame at its proximal end.
+
+    Its ``<visual>`` (for URDF viewers; neither side reads it) is a cylinder along the
+    element of radius ``sqrt((I_y + I_z)/A)``, the section's polar radius of gyration — a
+    thin tube's radius.
+    """
     ell = float(ell)
     m = beam.rho * beam.A * ell
     bending = m * ell**2 / 12.0
     ixx = beam.rho * (beam.Iy + beam.Iz) * ell
     iyy = beam.rho * beam.Iy * ell + bending
     izz = beam.rho * beam.Iz * ell + bending
+    radius = float(np.sqrt((beam.Iy + beam.Iz) / beam.A))
     return (
         f'  <link name="{link}"><inertial><origin xyz="{ell / 2!r} 0 0"/>'
         f'<mass value="{m!r}"/><inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" '
-        f'izz="{izz!r}"/></inertial></link>\n'
+        f'izz="{izz!r}"/></inertial><visual><origin xyz="{ell / 2!r} 0 0" '
+        f'rpy="0 {np.pi / 2!r} 0"/><geometry><cylinder radius="{radius!r}" length="{ell!r}"/>'
+        f"</geometry></visual></link>\n"
     )
 
 
