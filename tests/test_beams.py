@@ -57,7 +57,7 @@ def test_expansion_writes_links_joints_and_springs():
 
 def test_each_rigid_element_is_drawn_for_urdf_viewers():
     text = expand_beams(beam_text(2))
-    radius = np.sqrt((STEEL["Iy"] + STEEL["Iz"]) / STEEL["A"])
+    radius = float(np.sqrt((STEEL["Iy"] + STEEL["Iz"]) / STEEL["A"]))
     assert text.count(f'<cylinder radius="{radius!r}" length="0.5"/>') == 2  # the half ends
     assert text.count(f'<cylinder radius="{radius!r}" length="1.0"/>') == 1
 
