@@ -51,7 +51,17 @@ def scene_text(segments: int) -> str:
 
 
 def tip_rigid_elements(segments: int, speed: float, times: np.ndarray) -> np.ndarray:
-    """The RFEM beam's tip deflection in the hub frame at ``times``, m."""
+    """The RFEM beam's tip deflection in the hub frame at ``times``, m.
+
+    Parameters
+    ----------
+    segments : int
+        The beam's primary segments.
+    speed : float
+        Ω_s, the final spin rate, rad/s.
+    times : numpy.ndarray
+        Output times from 0, s (the last is the end of the run).
+    """
     scene = scene_from_text(scene_text(segments))
     s = side_of(scene, "reference")
     n = len(scene.coordinate_names)
@@ -86,7 +96,19 @@ def tip_rigid_elements(segments: int, speed: float, times: np.ndarray) -> np.nda
 
 
 def tip_linear_modes(segments: int, speed: float, times: np.ndarray) -> np.ndarray:
-    """The linear-modes model's tip deflection: ``M q̈ + (K − Ω² M) q = −m_θ θ̈``, m."""
+    """The linear-modes model's tip deflection: ``M q̈ + (K − Ω² M) q = −m_θ θ̈``, m.
+
+    NaN after the integrator gives up (the model runs away).
+
+    Parameters
+    ----------
+    segments : int
+        The beam's primary segments (M and K of that division at rest).
+    speed : float
+        Ω_s, the final spin rate, rad/s.
+    times : numpy.ndarray
+        Output times from 0, s.
+    """
     scene = scene_from_text(scene_text(segments))
     s = side_of(scene, "reference")
     n = len(scene.coordinate_names)
