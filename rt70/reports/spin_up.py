@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from rt70.linear.linearize import stiffness_matrix
 from rt70.model.scene import scene_from_text
 from rt70.model.sides import side_of
 
@@ -50,6 +51,14 @@ def scene_text(segments: int) -> str:
     )
 
 
+def _hub_and_beam(segments: int) -> tuple:
+    """The scene, its reference side, the hub's coordinate and the beam's coordinates."""
+    scene = scene_from_text(scene_text(segments))
+    hub = scene.coordinate_names.index("hub_joint")
+    rest = [i for i in range(len(scene.coordinate_names)) if i != hub]
+    return scene, side_of(scene, "reference"), hub, rest
+
+
 def tip_rigid_elements(segments: int, speed: float, times: np.ndarray) -> np.ndarray:
     """The RFEM beam's tip deflection in the hub frame at ``times``, m.
 
@@ -62,11 +71,8 @@ def tip_rigid_elements(segments: int, speed: float, times: np.ndarray) -> np.nda
     times : numpy.ndarray
         Output times from 0, s (the last is the end of the run).
     """
-    scene = scene_from_text(scene_text(segments))
-    s = side_of(scene, "reference")
+    scene, s, hub, rest = _hub_and_beam(segments)
     n = len(scene.coordinate_names)
-    hub = scene.coordinate_names.index("hub_joint")
-    rest = [i for i in range(n) if i != hub]
 
     def full(t: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
         theta, rate, accel = hub_motion(t, speed)
@@ -109,28 +115,17 @@ def tip_linear_modes(segments: int, speed: float, times: np.ndarray) -> np.ndarr
     times : numpy.ndarray
         Output times from 0, s.
     """
-    scene = scene_from_text(scene_text(segments))
-    s = side_of(scene, "reference")
-    n = len(scene.coordinate_names)
-    hub = scene.coordinate_names.index("hub_joint")
-    rest = [i for i in range(n) if i != hub]
-    zero = np.zeros(n)
+    scene, s, hub, rest = _hub_and_beam(segments)
+    zero = np.zeros(len(scene.coordinate_names))
     M = s.dynamics.mass_matrix(s.model, s.data, zero)
-    h = 1e-6
-    K = np.zeros((n, n))
-    for j in range(n):
-        e = np.zeros(n)
-        e[j] = h
-        plus = s.forces.spring_damper_force(s.model, s.data, e, zero)[0]
-        minus = s.forces.spring_damper_force(s.model, s.data, -e, zero)[0]
-        K[:, j] = -(plus - minus) / (2 * h)
+    K = stiffness_matrix(scene, zero)
     Mb, Kb, coupling = M[np.ix_(rest, rest)], K[np.ix_(rest, rest)], M[rest, hub]
-    # the tip's in-plane deflection per coordinate: rotations about z of each sde
+    # the tip's in-plane deflection: each sde's rotation about z times its lever to the tip
+    (beam,) = scene.description.beams
     tip_row = np.zeros(len(rest))
-    for k, name in enumerate(np.array(scene.coordinate_names)[rest]):
-        if name.endswith("_rz"):
-            i = int(name.split("_sde")[1].split("_")[0])
-            tip_row[k] = 10.0 - (i - 0.5) * 10.0 / segments
+    for i in range(1, beam.segments + 1):
+        column = rest.index(scene.coordinate_names.index(f"{beam.name}_sde{i}_rz"))
+        tip_row[column] = beam.length - (i - 0.5) * beam.step
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         _, rate, accel = hub_motion(t, speed)
