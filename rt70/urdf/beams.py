@@ -149,13 +149,8 @@ def expand_beams(text: str, source: str = "<string>") -> str:
     taken = {e.get("name") for e in root.findall("link")} | {
         e.get("name") for e in root.findall("joint")
     }
-    prefix = (
-        min(p for p in prefixes.get(RT70_NS, {"rt70"}) if p) if prefixes.get(RT70_NS) else "rt70"
-    )
-    blocks = []
-    for elem in pending:
-        beam = read_beam(reader, elem)
-        blocks.append(_beam_xml(beam, prefix, taken, reader))
+    prefix = min((p for p in prefixes.get(RT70_NS, ()) if p), default="rt70")
+    blocks = [_beam_xml(read_beam(reader, e), prefix, taken, reader) for e in pending]
     end = [m.end() for m in re.finditer(r"</\s*robot\s*>", text)][-1]
     start = text.rindex("<", 0, end)
     return text[:start] + "".join(blocks) + text[start:]
