@@ -24,7 +24,15 @@ PACKAGE = Path(__file__).resolve().parents[1] / "rt70"
 TREE = {"name", "source", "root", "links", "joints", "gravity"}
 
 #: Fields that change the equations of motion: used by both sides.
-DYNAMICS = {"bushings", "joint_springs", "drives", "winds", "air_density", "loops"}
+DYNAMICS = {
+    "bushings",
+    "joint_springs",
+    "drives",
+    "winds",
+    "air_density",
+    "loops",
+    "modal_bodies",
+}
 
 #: Fields used above the sides, each with where and why.
 ELSEWHERE = {

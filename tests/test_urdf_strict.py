@@ -188,6 +188,7 @@ def test_the_table_has_every_kind_the_reader_reads():
         "mount",
         "optics",
         "beam",
+        "modal_body",
     }
     assert set(KINDS) > {("bushing", "frame1"), ("strut_package", "strut"), ("drive", "sector")}
 

@@ -122,7 +122,9 @@ def stiffness_matrix(
 
 
 def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
-    """``D = −∂Q_d/∂q̇ = Σ Jᵀ D J``, exact: column i is ``−Q_d(q, e_i)``.
+    """``D = −∂Q_d/∂q̇ = Σ Jᵀ D J`` and the modal bodies' ``D_η``, exact.
+
+    Column i of the elements' part is ``−Q_d(q, e_i)``.
 
     The elements' deformation Jacobians are evaluated once; every column reuses them.
     """
@@ -137,6 +139,8 @@ def damping_matrix(scene: Scene, q: np.ndarray) -> np.ndarray:
         for el in found:
             el.subtract_jt(model, Qd, el.weighted(el.damping, el.rate(model, e)))
         D[:, i] = -Qd
+    for body in model.modal:  # the modal bodies' own D_η
+        D[body.coords, body.coords] += body.damping
     return 0.5 * (D + D.T)
 
 

@@ -5,7 +5,8 @@ of the structure's link frames, so a mode can be drawn on the structure as struc
 engineers look at it (:mod:`rt70.plotting.structure`, ``rt70 modes SCENE --plot FILE``).
 
 The structure is drawn as its tree: one line per joint, from the parent link's frame to
-the child link's (a beam's rigid elements form its centreline). A mode ``v`` moves the
+the child link's (a beam's rigid elements form its centreline), and each modal body as
+its nodes joined by the edges of its file, moved by its modes. A mode ``v`` moves the
 scene to ``q0 + a sin(φ) v`` (coordinates the linear model locked stay at ``q0``); the
 positions are the side's forward kinematics there (:func:`rt70.textbook.points.
 point_positions`), not a linear extrapolation, so large drawn amplitudes stay rigid where
@@ -15,7 +16,7 @@ fraction of the structure's size (the diagonal of its bounding box).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -43,11 +44,15 @@ class StructureLines:
         mass off its origin (link, point in the link's frame in m).
     segments : numpy.ndarray, shape (n, 2)
         Index pairs into :attr:`points`: each link's frame joined to its parent's, and to
-        its centre of mass.
+        its centre of mass; a modal body's edges between its nodes.
+    nodes : list of (int, int, int)
+        The points that are nodes of modal bodies: the point's index, the body's (in the
+        description's ``modal_bodies``) and the node's; they move by their mode shapes.
     """
 
     points: list[tuple[str, np.ndarray]]
     segments: np.ndarray
+    nodes: list[tuple[int, int, int]] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -97,11 +102,20 @@ def structure_lines(scene: Scene) -> StructureLines:
         if inertial is not None and inertial.mass > 0.0 and np.any(inertial.com != 0.0):
             segments.append((index[name], len(where)))
             where.append((name, np.asarray(inertial.com, dtype=float)))
-    return StructureLines(where, np.array(segments, dtype=int).reshape(-1, 2))
+    nodes = []
+    for b, body in enumerate(scene.description.modal_bodies):
+        first = len(where)
+        for n, x in enumerate(body.nodes):
+            nodes.append((len(where), b, n))
+            where.append((body.link, np.asarray(x, dtype=float)))
+        segments.extend((first + int(i), first + int(j)) for i, j in body.edges)
+    return StructureLines(where, np.array(segments, dtype=int).reshape(-1, 2), nodes)
 
 
-def link_positions(scene: Scene, q: np.ndarray, where: list[tuple[str, np.ndarray]]) -> np.ndarray:
-    """Ground-axis positions (n, 3) of the points ``(link, xyz)`` at q, m (textbook side).
+def link_positions(scene: Scene, q: np.ndarray, lines: StructureLines) -> np.ndarray:
+    """Ground-axis positions (n, 3) of the points of ``lines`` at q, m (textbook side).
+
+    A modal body's node is at ``x_n + Φ_n η`` in its link's frame.
 
     Parameters
     ----------
@@ -109,10 +123,18 @@ def link_positions(scene: Scene, q: np.ndarray, where: list[tuple[str, np.ndarra
         The scene.
     q : numpy.ndarray, shape (nv,)
         The state, in the scene's coordinates (rad or m).
-    where : list of (str, numpy.ndarray)
-        The points: a link and the point in its frame, m.
+    lines : StructureLines
+        The points: a link and the point in its frame, m (and which are modal nodes).
     """
-    return points.point_positions(scene.textbook, scene.textbook_data, q, where)
+    model, data = scene.textbook, scene.textbook_data
+    positions = points.point_positions(model, data, q, lines.points)
+    for i, b, n in lines.nodes:  # the forward pass above left the links' orientations
+        body = scene.description.modal_bodies[b]
+        mb = model.modal[b]
+        pair, _, c = model.link_frames[body.link]
+        rotation = c if pair < 0 else data.R[pair] @ c
+        positions[i] += rotation @ (body.shapes[n] @ q[mb.coords])
+    return positions
 
 
 def draw_modes(
@@ -154,7 +176,7 @@ def draw_modes(
         One per column of ``shapes``.
     """
     lines = structure_lines(scene)
-    rest = link_positions(scene, q0, lines.points)
+    rest = link_positions(scene, q0, lines)
     size = float(np.linalg.norm(np.ptp(rest, axis=0))) or 1.0
     where = {name: i for i, name in enumerate(scene.coordinate_names)}
     rows = [k for k, name in enumerate(coordinates) if name in where]
@@ -165,7 +187,7 @@ def draw_modes(
         full[columns] = v[rows]
         amplitude = _amplitude(scene, q0, full, lines, rest, fraction * size)
         positions = np.array(
-            [link_positions(scene, q0 + amplitude * np.sin(p) * full, lines.points) for p in phases]
+            [link_positions(scene, q0 + amplitude * np.sin(p) * full, lines) for p in phases]
         )
         peak = float(np.linalg.norm(positions - rest, axis=2).max())
         drawn.append(DrawnMode(label, amplitude, peak, positions, np.asarray(phases, dtype=float)))
@@ -187,13 +209,13 @@ def _amplitude(
     drawn displacement grows monotonically with ``a`` at drawing amplitudes).
     """
     probe = _PROBE / max(float(np.abs(full).max()), 1e-300)
-    moved = link_positions(scene, q0 + probe * full, lines.points) - rest
+    moved = link_positions(scene, q0 + probe * full, lines) - rest
     per_unit = float(np.linalg.norm(moved, axis=1).max()) / probe
     if per_unit <= 0.0:
         return 0.0
     amplitude = target / per_unit
     for _ in range(_MAX_CORRECTIONS):
-        drawn = link_positions(scene, q0 + amplitude * full, lines.points) - rest
+        drawn = link_positions(scene, q0 + amplitude * full, lines) - rest
         peak = float(np.linalg.norm(drawn, axis=1).max())
         if peak <= 0.0 or abs(peak / target - 1.0) <= DRAWN_RTOL:
             break

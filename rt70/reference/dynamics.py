@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+import rt70.reference.modal_nodes as modal_nodes
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.forces import element_torques
 from rt70.reference.model import ReferenceData, ReferenceModel
@@ -87,7 +88,8 @@ def forward_dynamics(
     Unlike the textbook side's ``forward_dynamics(model, data, q, q̇, Q)`` the spring
     and damper forces are the reference side's own (:func:`element_torques`, in
     Pinocchio's velocity space), so that the comparison checks them too. With mimic
-    joints (a constraint ABA cannot take) the reduced equations
+    joints (a constraint ABA cannot take) or modal bodies (nodes tied to the modes) the
+    reduced equations
     ``Jᵀ A J q̈ = Jᵀ (τ − rnea(q, v, J̇ q̇))`` are solved with Pinocchio's CRBA and RNEA.
 
     Parameters
@@ -106,11 +108,14 @@ def forward_dynamics(
     pm, pd = model.pin_model, data.pin_data
     if J is None:
         return pin.aba(pm, pd, qp, vp, tau)
-    if J.shape[0] == J.shape[1]:
+    if J.shape[0] == J.shape[1] and not model.modal_bodies:
         vdot = pin.aba(pm, pd, qp, vp, tau)
         return np.linalg.solve(J, vdot - Jdqd)
     A = _crba(model, data, qp)
     rhs = J.T @ (tau - pin.rnea(pm, pd, qp, vp, Jdqd))
+    if model.modal_bodies:  # their stiffness and damping act on η itself
+        Kc, Kd = modal_nodes.elastic_force(model, q, qd)
+        rhs += Kc + Kd
     return np.linalg.solve(J.T @ A @ J, rhs)
 
 

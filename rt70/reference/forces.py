@@ -24,6 +24,7 @@ from functools import cached_property
 import numpy as np
 import pinocchio as pin
 
+import rt70.reference.modal_nodes as modal_nodes
 from rt70.errors import SingularConfigurationError
 from rt70.guards.arrays import check_vector
 from rt70.reference.coordinates import to_pinocchio
@@ -237,7 +238,13 @@ def spring_damper_force(
     """
     qp, vp, J, _ = to_pinocchio(model, q, qd)
     Qc, Qd = element_torques(model, data, qp, vp)
-    return (Qc, Qd) if J is None else (J.T @ Qc, J.T @ Qd)
+    if J is None:
+        return Qc, Qd
+    Qc, Qd = J.T @ Qc, J.T @ Qd
+    if model.modal_bodies:  # their stiffness and damping act on η itself
+        Kc, Kd = modal_nodes.elastic_force(model, q, qd)
+        Qc, Qd = Qc + Kc, Qd + Kd
+    return Qc, Qd
 
 
 def element_torques(
@@ -311,7 +318,7 @@ def spring_potential(model: ReferenceModel, data: ReferenceData, q: np.ndarray) 
     U = 0.0
     for e in elements(model, data, qp, jacobian=False):
         U += 0.5 * e.squares(e.stiffness)
-    return U
+    return U + modal_nodes.elastic_potential(model, q)
 
 
 def spring_damper_magnitudes(

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import rt70.guards.resources as resources
 from rt70.errors import ResourceError
+from rt70.reference.modal_nodes import NODE_DOFS, node_count
 from rt70.urdf.description import RobotDescription
 
 _DOFS = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
@@ -18,11 +19,14 @@ _DOFS = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating"
 def pinocchio_size(desc: RobotDescription) -> tuple[int, int]:
     """``(nv, njoints)`` of the model Pinocchio's URDF parser will build from ``desc``.
 
-    Every non-fixed joint is a Pinocchio joint (mimic joints included); ``njoints``
+    Every non-fixed joint is a Pinocchio joint (mimic joints included), and so is every
+    node with mass of a modal body (:mod:`rt70.reference.modal_nodes`); ``njoints``
     counts the universe.
     """
     moving = [j for j in desc.joints if j.type != "fixed"]
-    return sum(_DOFS.get(j.type, 1) for j in moving), len(moving) + 1
+    nodes = sum(node_count(body) for body in desc.modal_bodies)
+    nv = sum(_DOFS.get(j.type, 1) for j in moving) + NODE_DOFS * nodes
+    return nv, len(moving) + nodes + 1
 
 
 def tree_depth(desc: RobotDescription) -> int:

@@ -214,6 +214,11 @@ def constrained_forward_dynamics(
         None: ``Φ̈ = 0``.
     """
     qp, vp, J, Jdqd = to_pinocchio(model, q, qd)
+    if model.modal_bodies:
+        raise Rt70Error(
+            f"{model.pin_model.name}: loops with modal bodies are not supported on the "
+            "reference side (Pinocchio's constraint dynamics would free their nodes)"
+        )
     if J is not None and J.shape[0] != J.shape[1]:
         raise Rt70Error(f"{model.pin_model.name}: loops with mimic joints are not supported")
     m, d = model.pin_model, data.pin_data

@@ -18,6 +18,7 @@ import pinocchio as pin
 
 from rt70.errors import Rt70Error
 from rt70.reference.limits import check_reference
+from rt70.reference.modal_nodes import add_nodes
 from rt70.reference.parse import parse_urdf
 from rt70.urdf.beams import expand_beams
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
@@ -77,13 +78,14 @@ class Coordinate:
     """One Pinocchio joint seen in book coordinates."""
 
     joint: int
-    kind: str  # "1dof", "continuous", "floating", "planar", "mimic", "mimic-continuous"
+    kind: str  # "1dof", "continuous", "floating", "planar", "mimic", "mimic-continuous", "modal"
     names: tuple[str, ...]
     iq: int
     iv: int
     book: int  # first book coordinate (for a mimic joint: the source's book coordinate)
     multiplier: float = 1.0
     offset: float = 0.0
+    shape: np.ndarray | None = None  # a modal body's node: u = shape @ q[book : book + k]
 
 
 class ReferenceModel:
@@ -119,21 +121,31 @@ class ReferenceModel:
         the same as :class:`FrameStack` arrays.
     loops : list of (int, (int, pinocchio.SE3), (int, pinocchio.SE3))
         Rows and the two frames (parent joint, placement) of every loop closure.
+    modal_bodies : tuple of rt70.urdf.ModalBody
+        The modal bodies, whose nodes are point masses on joints of their own
+        (:mod:`rt70.reference.modal_nodes`).
+    urdf_joints : list of int
+        Pinocchio's joints that are the file's, in Pinocchio's order (all but the nodes').
     """
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
         check_reference(desc)  # parser depth and memory, before Pinocchio sees the model
         model = parse_urdf(expand_beams(urdf_text, desc.source), desc.source)
-        model.gravity.linear = np.asarray(desc.gravity, dtype=float)
-        model.armature[:] = 0.0
-        self.pin_model = model
-        self.pin_model_no_gravity = model.copy()
-        self.pin_model_no_gravity.gravity.setZero()
         self.body_frames = {}  # Pinocchio's getBodyId, without its scan of every frame
         for index, frame in enumerate(model.frames):
             if frame.type == pin.BODY:
                 self.body_frames.setdefault(frame.name, index)
         bodies = {name: model.frames[i] for name, i in self.body_frames.items()}
+        nodes = [add_nodes(model, bodies, body) for body in desc.modal_bodies]
+        model.gravity.linear = np.asarray(desc.gravity, dtype=float)
+        model.armature[:] = 0.0
+        self.pin_model = model
+        self.pin_model_no_gravity = model.copy()
+        self.pin_model_no_gravity.gravity.setZero()
+        self.modal_bodies = desc.modal_bodies  # their stiffness and damping on η
+        self.urdf_joints = [  # Pinocchio's joints that are the file's (not modal nodes)
+            i for i in range(1, model.njoints) if i not in {j for a in nodes for j, _ in a}
+        ]
         self.bushings = [
             Bushing(
                 _attachment(bodies, b.frame1),
@@ -152,7 +164,7 @@ class ReferenceModel:
         self.stack1, self.stack2 = FrameStack.of(self.frames1), FrameStack.of(self.frames2)
         self.stiffness = np.array([b.stiffness for b in self.bushings]).reshape(-1, 6, 6)
         self.damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6, 6)
-        self.coords, self.coordinate_names = _coordinates(model, desc)
+        self.coords, self.coordinate_names = _coordinates(model, desc, nodes)
         self.identity_map = all(c.kind == "1dof" and c.book == c.iv for c in self.coords)
         joint_id = {name: i for i, name in enumerate(model.names)}
         self.spring_v = np.array(
@@ -216,20 +228,33 @@ def _attachment(bodies: dict, ref: FrameRef) -> tuple[int, pin.SE3]:
     return body.parentJoint, body.placement * offset
 
 
-def _coordinates(m: pin.Model, desc: RobotDescription) -> tuple[list[Coordinate], list[str]]:
+def _coordinates(
+    m: pin.Model, desc: RobotDescription, nodes: list[list[tuple[int, np.ndarray]]]
+) -> tuple[list[Coordinate], list[str]]:
     """Book coordinates of every Pinocchio joint, numbered in the user's order.
 
     Pinocchio numbers sibling joints its own way; every result of the reference side is
     in the order of :func:`rt70.urdf.coordinate_names` (the file's depth-first order,
     the same as the textbook side's), so ``c.book`` is the user index of the joint's
-    first coordinate.
+    first coordinate. The modal bodies' node joints (``nodes``: joint and shape of each,
+    per body) map to the body's modal coordinates.
     """
     mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
     names = coordinate_names(desc)
     user = {n: i for i, n in enumerate(names)}
     coords: list[Coordinate] = []
     seen: list[str] = []
+    node_of = {}
+    for body, added in zip(desc.modal_bodies, nodes, strict=True):
+        seen.extend(body.coordinate_names)
+        for joint, shape in added:
+            node_of[joint] = (user[body.coordinate_names[0]], shape)
     for i in range(1, m.njoints):
+        if i in node_of:
+            first, shape = node_of[i]
+            jm = m.joints[i]
+            coords.append(Coordinate(i, "modal", (), jm.idx_q, jm.idx_v, first, shape=shape))
+            continue
         name, jm = m.names[i], m.joints[i]
         short = jm.shortname()
         if short == "JointModelFreeFlyer":

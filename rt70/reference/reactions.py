@@ -63,7 +63,7 @@ def joint_reactions(
     pin.forwardKinematics(pm, pd, qp)
     fext = external_forces(model, pd, wrenches)
     pin.rnea(pm, pd, qp, vp, ap, fext)
-    return {pm.names[i]: pd.f[i].vector.copy() for i in range(1, pm.njoints)}
+    return {pm.names[i]: pd.f[i].vector.copy() for i in model.urdf_joints}
 
 
 def reaction_impulses(
@@ -144,5 +144,5 @@ def joint_frames(
     pin.forwardKinematics(pm, pd, qp)
     return {
         pm.names[i]: (pd.oMi[i].rotation.copy(), pd.oMi[i].translation.copy())
-        for i in range(1, pm.njoints)
+        for i in model.urdf_joints
     }

@@ -3,7 +3,8 @@
 Every scene is a function returning the URDF text (the RT-70 listing's in
 :mod:`rt70.scenes.rt70_scenes`, the chapter-2 models and mechanisms in
 :mod:`rt70.scenes.book_scenes`, the closed chains in :mod:`rt70.scenes.loop_scenes`, the
-two other antennas in :mod:`rt70.scenes.antenna_presets`);
+two other antennas in :mod:`rt70.scenes.antenna_presets`, the flexible members in
+:mod:`rt70.scenes.modal_scenes`);
 :data:`SCENES` maps scene names to them and :func:`write_all` writes ``<name>.urdf``
 files. The output is deterministic (:mod:`rt70.scenes.urdf_writer`: fixed element and
 attribute order, two-space indentation, numbers written as the shortest text that reads
@@ -35,7 +36,9 @@ from rt70.scenes.book_scenes import (
     two_body_gravity_scene,
 )
 from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene
+from rt70.scenes.modal_scenes import TRUSS_FILE, slewing_truss_scene, truss_arm
 from rt70.scenes.rt70_scenes import rt70_jack_scene, rt70_scene, rt70_servo_scene
+from rt70.urdf.modal_file import ModalArrays, write_modal_file
 
 #: Default output directory: ``urdf/`` at the repository root.
 DEFAULT_DIRECTORY = Path(__file__).resolve().parents[2] / "urdf"
@@ -56,11 +59,15 @@ SCENES: dict[str, Callable[[], str]] = {
     "four_bar": four_bar_scene,
     "crank_slider": crank_slider_scene,
     **{name: partial(antenna_urdf, spec) for name, spec in PRESETS.items()},
+    "slewing_truss": slewing_truss_scene,
 }
+
+#: The modal body files the scenes name (``rt70-modal/1``), by file name.
+MODAL_FILES: dict[str, Callable[[], ModalArrays]] = {TRUSS_FILE: truss_arm}
 
 
 def write_all(directory: Path) -> list[Path]:
-    """Write every scene as ``<name>.urdf`` into ``directory``.
+    """Write every scene as ``<name>.urdf`` into ``directory``, and the modal body files.
 
     Each file is written to a temporary file in the same directory and moved into place
     with :func:`os.replace`, so a reader never sees a partial file.
@@ -73,7 +80,7 @@ def write_all(directory: Path) -> list[Path]:
     Returns
     -------
     list of Path
-        The written files, in the order of :data:`SCENES`.
+        The written files, in the order of :data:`SCENES`, then :data:`MODAL_FILES`.
     """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -82,6 +89,8 @@ def write_all(directory: Path) -> list[Path]:
         path = directory / f"{name}.urdf"
         atomic_write_text(path, build())
         written.append(path)
+    for name, body in MODAL_FILES.items():
+        written.append(write_modal_file(directory / name, body()))
     return written
 
 

@@ -48,7 +48,7 @@ class Data:
         self.dMf_qd = np.zeros((nb, 6))
         self.L = np.zeros((6 * nb, 6 * nb))
         self.S_full = np.zeros((model.n_full, 6 * nb))
-        self.S = self.S_full if model.G is None else np.zeros((nv, 6 * nb))
+        self.S = self.S_full if model.G is None and not model.modal else np.zeros((nv, 6 * nb))
         self.q_full = np.zeros(model.n_full)
         self.Theta = np.zeros((6 * nb, 6 * nb))
         for j in range(nb):

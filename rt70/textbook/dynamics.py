@@ -3,7 +3,8 @@
 Every function takes the plain model, its work buffers and the state, in the manner of
 Pinocchio's ``crba(model, data, q)``. This is the dense, readable form of the book:
 L, S and Θ are assembled as full block matrices. The kinetic and gravity energies are
-here too, as on the reference side (:mod:`rt70.reference.dynamics`).
+here too, as on the reference side (:mod:`rt70.reference.dynamics`). The modal flexible
+bodies add their terms to each (:mod:`rt70.textbook.modal_bodies`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.guards.arrays import check_vector
+from rt70.textbook import modal_bodies
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import pair_motion_rate, update_structure
 from rt70.textbook.model import Model
@@ -33,6 +35,8 @@ def mass_matrix(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
     """
     S = update_structure(model, data, q)
     data.A = S @ data.Theta @ S.T
+    if model.modal:
+        data.A += modal_bodies.mass_matrix_terms(model, modal_bodies.dense_frames(model, data), q)
     return data.A
 
 
@@ -103,9 +107,19 @@ def bias_matrix(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.n
     q, qd : numpy.ndarray, shape (nv,)
         Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
         order (``Model.coordinate_names``).
+
+    Raises
+    ------
+    Rt70Error
+        For a model with modal bodies: their velocity terms are a vector, not
+        ``B q̇`` of one matrix (:func:`bias_force` gives them).
     """
     q = check_vector("q", q, model.nv)
     qd = check_vector("qd", qd, model.nv)
+    if model.modal:
+        raise Rt70Error(
+            f"{model.name}: B is not formed as a matrix with modal bodies; use bias_force"
+        )
     update_structure(model, data, q)
     return _bias_matrix(model, data, q, qd)
 
@@ -134,7 +148,19 @@ def bias_force(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.nd
         Generalised coordinates (rad or m) and velocities (rad/s or m/s) in the model's
         order (``Model.coordinate_names``).
     """
-    return bias_matrix(model, data, q, qd) @ qd
+    q = check_vector("q", q, model.nv)
+    qd = check_vector("qd", qd, model.nv)
+    update_structure(model, data, q)
+    return _bias_force(model, data, q, qd)
+
+
+def _bias_force(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``B q̇`` for the configuration already in ``data``, the modal bodies' terms added."""
+    force = _bias_matrix(model, data, q, qd) @ qd
+    if model.modal:
+        frames = modal_bodies.dense_frames(model, data, qd)
+        force += modal_bodies.bias_terms(model, frames, q, qd)
+    return force
 
 
 def gravity_force(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
@@ -152,7 +178,10 @@ def gravity_force(model: Model, data: Data, q: np.ndarray) -> np.ndarray:
         Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
     """
     update_structure(model, data, q)
-    return _gravity_force(model, data)
+    force = _gravity_force(model, data)
+    if model.modal:
+        force += modal_bodies.gravity_terms(model, modal_bodies.dense_frames(model, data), q)
+    return force
 
 
 def _gravity_force(model: Model, data: Data) -> np.ndarray:
@@ -190,8 +219,12 @@ def forward_dynamics(
     qd = check_vector("qd", qd, model.nv)
     check_euler_pairs(model, model.expand(q))
     update_structure(model, data, q)  # one forward pass for A, B q̇ and S G
-    rhs = Q + _gravity_force(model, data) - _bias_matrix(model, data, q, qd) @ qd
+    rhs = Q + _gravity_force(model, data) - _bias_force(model, data, q, qd)
     A = data.S @ data.Theta @ data.S.T
+    if model.modal:
+        frames = modal_bodies.dense_frames(model, data)
+        A += modal_bodies.mass_matrix_terms(model, frames, q)
+        rhs += modal_bodies.gravity_terms(model, frames, q)
     try:
         factor = scipy.linalg.cho_factor(A)
     except np.linalg.LinAlgError:
@@ -217,7 +250,12 @@ def gravity_potential(model: Model, data: Data, q: np.ndarray) -> float:
     update_structure(model, data, q)
     com_world = data.p + np.einsum("kij,kj->ki", data.R, model.com)
     moving = np.array([model.ndof[model.ancestors(j)].sum() > 0 for j in range(model.nb)])
-    return -float((model.mass * moving) @ (com_world @ model.gravity))
+    potential = -float((model.mass * moving) @ (com_world @ model.gravity))
+    if model.modal:
+        potential += modal_bodies.gravity_potential(
+            model, modal_bodies.dense_frames(model, data), q
+        )
+    return potential
 
 
 def kinetic_energy(model: Model, data: Data, q: np.ndarray, qd: np.ndarray) -> float:

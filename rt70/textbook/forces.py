@@ -26,6 +26,7 @@ import numpy as np
 
 from rt70.errors import SingularConfigurationError
 from rt70.guards.arrays import check_vector
+from rt70.textbook import modal_bodies
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import (
     frame_jacobian,
@@ -352,6 +353,10 @@ def spring_damper_force(
     for e in elements(model, data, q):
         e.subtract_jt(model, Qc, e.weighted(e.stiffness, e.delta))
         e.subtract_jt(model, Qd, e.weighted(e.damping, e.rate(model, qd)))
+    if model.modal:  # the modal bodies' own stiffness and damping on η
+        Kc, Kd = modal_bodies.elastic_force(model, q, qd)
+        Qc += Kc
+        Qd += Kd
     return Qc, Qd
 
 
@@ -372,4 +377,4 @@ def spring_potential(model: Model, data: Data, q: np.ndarray) -> float:
     for e in elements(model, data, q):
         for square in e.squares(e.stiffness):
             U += 0.5 * square
-    return U
+    return U + modal_bodies.elastic_potential(model, q)

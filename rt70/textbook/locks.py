@@ -34,12 +34,9 @@ def brake_row(model: Model, joint: str) -> np.ndarray:
     names = model.full_coordinate_names or model.coordinate_names
     if joint not in names:
         raise Rt70Error(f"{model.name}: no 1-DOF joint '{joint}' to brake")
-    k = names.index(joint)
-    if model.G is None:
-        row = np.zeros(model.nv)
-        row[k] = 1.0
-        return row
-    return np.array(model.G[k], dtype=float)
+    unit = np.zeros(model.n_full)
+    unit[names.index(joint)] = 1.0
+    return model.reduce(unit)  # the joint's row of G (no modal coordinate in it)
 
 
 def pin_rows(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> np.ndarray:

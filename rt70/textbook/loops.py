@@ -31,9 +31,10 @@ from scipy.spatial.transform import Rotation
 from rt70.guards.arrays import check_vector
 from rt70.physics.baumgarte import Baumgarte, consistent_rhs, constraint_rhs
 from rt70.physics.kkt import solve_kkt
+from rt70.textbook import modal_bodies
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import (
-    _bias_matrix,
+    _bias_force,
     _gravity_force,
     body_velocities,
     structure_matrix_rate,
@@ -204,10 +205,14 @@ def constrained_forward_dynamics(
     qd = check_vector("qd", qd, model.nv)
     Qc, Qd = spring_damper_force(model, data, q, qd)
     update_structure(model, data, q)
-    f = _gravity_force(model, data) + Qc + Qd - _bias_matrix(model, data, q, qd) @ qd
+    f = _gravity_force(model, data) + Qc + Qd - _bias_force(model, data, q, qd)
     if Q is not None:
         f = f + check_vector("Q", Q, model.nv)
     A = data.S @ data.Theta @ data.S.T
+    if model.modal:
+        frames = modal_bodies.dense_frames(model, data)
+        A += modal_bodies.mass_matrix_terms(model, frames, q)
+        f += modal_bodies.gravity_terms(model, frames, q)
     B_c = _jacobian_here(model, data)
     C = _bias_here(model, data, q, qd, S_dot=data.S_dot)  # Ṡ of the bias force above
     residual = np.concatenate([_residual(data, loop) for loop in model.loops] or [np.zeros(0)])

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from rt70.errors import Rt70Error
 from rt70.guards.arrays import check_vector
 from rt70.textbook.model import Model
 from rt70.textbook.structured import _check_batch, _data_for
@@ -312,7 +313,16 @@ class KernelModel:
 
     @classmethod
     def of(cls, model: Model) -> KernelModel:
-        """The arrays of ``model`` (contiguous, int64 / float64)."""
+        """The arrays of ``model`` (contiguous, int64 / float64).
+
+        Raises
+        ------
+        Rt70Error
+            For a model with modal bodies (the kernel knows rigid pairs only; the
+            structured form, :mod:`rt70.textbook.structured`, adds the bodies' terms).
+        """
+        if model.modal:
+            raise Rt70Error(f"{model.name}: the compiled mass kernel has no modal bodies")
         G = model.G
 
         def f64(x: np.ndarray) -> np.ndarray:

@@ -60,9 +60,11 @@ def _term_scale(model: Model, q: np.ndarray) -> np.ndarray:
     v2 = np.sum(sigma[:, :3] ** 2, axis=1)
     w2 = np.sum(sigma[:, 3:] ** 2, axis=1)
     full = 2.0 * (mass * v2 + w2 * rot_trace)
-    if model.G is None:
-        return full
-    return (np.abs(model.G).T @ np.sqrt(full)) ** 2
+    scale = full if model.G is None else (np.abs(model.G).T @ np.sqrt(full)) ** 2
+    if not model.modal:
+        return scale
+    modal = [np.diag(mb.invariants.modal_mass) for mb in model.modal]  # M_ηη's own terms
+    return np.concatenate([scale, *modal])
 
 
 def singular_coordinates(model: Model) -> tuple[list[str], list[str]]:

@@ -34,6 +34,7 @@ import numpy as np
 
 from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY
 from rt70.physics.constraints import mimic_map
+from rt70.textbook.modal_model import ModalModel, place_modal_bodies
 from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
 from rt70.urdf.description import Joint, RobotDescription, Wind
 
@@ -129,6 +130,9 @@ class Model:
     pair_joints : list of tuple of str
         The URDF joints of each pair: one, or the six of a merged euler6 chain
         (:mod:`rt70.textbook.reactions` reports the wrench across each).
+    modal : tuple of ModalModel
+        The modal flexible bodies; their coordinates η follow the pairs' independent
+        coordinates in q (``q = [q_pairs; η]``), and move no pair.
     """
 
     name: str
@@ -157,6 +161,7 @@ class Model:
     winds: tuple[Wind, ...] = ()
     air_density: float = DEFAULT_AIR_DENSITY
     pair_joints: list[tuple[str, ...]] = field(default_factory=list)
+    modal: tuple[ModalModel, ...] = ()
 
     @property
     def nb(self) -> int:
@@ -169,19 +174,38 @@ class Model:
         return int(self.ndof.sum())
 
     @property
-    def nv(self) -> int:
-        """Number of independent generalised coordinates."""
+    def n_pairs(self) -> int:
+        """Number of independent coordinates of the pairs (q without the modal ones)."""
         return self.n_full if self.G is None else self.G.shape[1]
 
+    @property
+    def n_modal(self) -> int:
+        """Number of modal coordinates of the modal bodies."""
+        return sum(body.modes for body in self.modal)
+
+    @property
+    def nv(self) -> int:
+        """Number of independent generalised coordinates."""
+        return self.n_pairs + self.n_modal
+
     def expand(self, q: np.ndarray, offset: bool = True) -> np.ndarray:
-        """``q_full = G q + q_offset`` (without the offset for velocities)."""
+        """``q_full = G q + q_offset`` (without the offset for velocities), pairs only."""
+        if self.modal:
+            q = q[..., : self.n_pairs]
         if self.G is None:
             return q
         return self.G @ q + self.q_offset if offset else self.G @ q
 
     def reduce(self, Q_full: np.ndarray) -> np.ndarray:
-        """Generalised force on the independent coordinates, ``Gᵀ Q_full``."""
-        return Q_full if self.G is None else self.G.T @ Q_full
+        """Generalised force on the independent coordinates, ``Gᵀ Q_full``.
+
+        ``Q_full`` (n_full, …) is on the pairs' coordinates; the modal coordinates' rows
+        are zero (no pair moves with them).
+        """
+        Q = Q_full if self.G is None else self.G.T @ Q_full
+        if not self.modal:
+            return Q
+        return np.concatenate([Q, np.zeros((self.n_modal,) + Q.shape[1:])])
 
     def coords(self, j: int) -> slice:
         """Slice of pair j's coordinates in q."""
@@ -253,7 +277,7 @@ def build_model(desc: RobotDescription) -> Model:
         q_start=np.concatenate([[0], np.cumsum(ndof_arr)[:-1]]).astype(int),
         ndof=ndof_arr,
         body_names=pairs.body_names,
-        coordinate_names=independent,
+        coordinate_names=independent + [n for b in desc.modal_bodies for n in b.coordinate_names],
         gravity=np.array(desc.gravity, dtype=float),
         full_coordinate_names=list(pairs.coord_names),
         link_frames=link_frames,
@@ -267,6 +291,7 @@ def build_model(desc: RobotDescription) -> Model:
         winds=desc.winds,
         air_density=desc.air_density,
         pair_joints=pairs.pair_joints,
+        modal=place_modal_bodies(desc.modal_bodies, link_frames, len(independent)),
     )
 
 

@@ -42,6 +42,7 @@ import numpy as np
 
 from rt70.guards.arrays import check_vector
 from rt70.physics.loads import Wrench
+from rt70.textbook import modal_bodies
 from rt70.textbook.data import Data
 from rt70.textbook.dynamics import body_velocities, structure_matrix_rate
 from rt70.textbook.kinematics import forward_kinematics, update_structure
@@ -191,7 +192,8 @@ def pair_reactions(
     Source 004 (9)–(10) with the book's matrices: the body wrenches
     ``W = Θ V̇ + Φ(V) Θ V − G − U`` (forward pass) summed over the subtrees,
     ``R = L W`` (:func:`subtree_sums`); :func:`projection` of R is the generalised force
-    ``S W`` (004 (11)).
+    ``S W`` (004 (11)). A modal body adds to its pair's W what its frame exerts on it
+    (:func:`rt70.textbook.modal_bodies.frame_wrenches`).
 
     Parameters
     ----------
@@ -216,8 +218,14 @@ def pair_reactions(
     moving = bool(qd.any())  # at rest (statics, impulses) Ṡᵀ q̇ and Φ(V) Θ V vanish
     Vdot = S.T @ qdd
     if moving:
-        Vdot += structure_matrix_rate(model, data, q, qd).T @ qd
+        data.S_dot = structure_matrix_rate(model, data, q, qd)
+        Vdot += data.S_dot.T @ qd
     W = np.einsum("kij,kj->ki", model.Theta, Vdot.reshape(model.nb, 6))
+    if model.modal:  # each modal body's wrench on its pair (its frame rows)
+        frames = modal_bodies.dense_frames(model, data, qd if moving else None)
+        for body, wrench in modal_bodies.frame_wrenches(model, frames, q, qd, qdd, gravity):
+            if body >= 0:
+                W[body] += wrench
     if moving:
         momentum = np.einsum("kij,kj->ki", model.Theta, V)
         W += np.array([crf(v) @ h for v, h in zip(V, momentum, strict=True)])

@@ -34,6 +34,7 @@ import numpy as np
 
 from rt70.errors import NonFiniteError, ShapeError
 from rt70.guards.arrays import check_vector
+from rt70.textbook import modal_bodies
 from rt70.textbook.model import Model
 from rt70.textbook.spatial_batch import crm_batch, euler123_batch, skew_batch
 from rt70.textbook.topology import Topology, topology
@@ -236,6 +237,8 @@ def ground_inertias(model: Model, data: Work) -> np.ndarray:
 
 
 def _expand_batch(model: Model, Q: np.ndarray, offset: bool = True) -> np.ndarray:
+    if model.modal:
+        Q = Q[:, : model.n_pairs]
     if model.G is None:
         return Q
     out = Q @ model.G.T
@@ -274,14 +277,52 @@ def mass_matrix_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarra
     Q = _check_batch("Q", Q, model.nv)
     data = _data_for(model, Q.shape[0], data)
     Qf = _expand_batch(model, Q)
+    direct = model.G is None and not model.modal
+    n = model.n_pairs
     for start in range(0, Q.shape[0], data.chunk):
         stop = min(start + data.chunk, Q.shape[0])
         work = data.work(stop - start)
-        out = data.A[start:stop] if model.G is None else np.empty_like(work.Gm)
+        out = data.A[start:stop] if direct else np.empty_like(work.Gm)
         _mass_matrix_chunk(model, work, Qf[start:stop], out)
-        if model.G is not None:
-            np.matmul(model.G.T @ out, model.G, out=data.A[start:stop])
+        if direct:
+            continue
+        A = data.A[start:stop]
+        A[:, :n, :n] = out if model.G is None else model.G.T @ out @ model.G
+        if model.modal:
+            A[:, n:, :], A[:, :n, n:] = 0.0, 0.0
+            for c in range(stop - start):
+                frames = _modal_frames(model, work, c)
+                A[c] += modal_bodies.mass_matrix_terms(model, frames, Q[start + c])
     return data.A
+
+
+def _modal_frames(
+    model: Model, work: Work, c: int, a0: np.ndarray | None = None
+) -> list[modal_bodies.Frame]:
+    """The modal bodies' frames at configuration ``c`` of ``work``'s forward pass.
+
+    Body h's velocity in its own axes is ``(L_0^h)ᵀ V⁰_h``, so its columns of S are
+    ``S_b = σ (L_0^h)`` on the coordinates of its ancestors (and zero elsewhere), and
+    ``Ṡ_bᵀ q̇ = (L_0^h)ᵀ a⁰_h`` (``L̇_0^h = L_0^h Φ(V_h)`` adds ``Φ(V)ᵀ V = 0``).
+    ``a0``: the bias accelerations ``a⁰`` of the state, (nb, 6); None leaves ``bias`` zero.
+    """
+    topo = work.topo
+    frames = []
+    for mb in model.modal:
+        h = mb.body
+        if h < 0:
+            frames.append(
+                modal_bodies.Frame(_E3, np.zeros(3), np.zeros((6, model.nv)), np.zeros(6))
+            )
+            continue
+        L0 = work.L0[c, h]  # [[c, 0], [<p> c, c]]
+        R = L0[:3, :3]
+        p_skew = L0[3:, :3] @ R.T
+        p = np.array([p_skew[2, 1], p_skew[0, 2], p_skew[1, 0]])
+        rows = (work.sigma[c] @ L0) * topo.anc[topo.dof_body, h][:, None]
+        bias = np.zeros(6) if a0 is None else L0.T @ a0[h]
+        frames.append(modal_bodies.Frame(R, p, model.reduce(rows).T, bias))
+    return frames
 
 
 def _mass_matrix_chunk(model: Model, work: Work, Qf: np.ndarray, out: np.ndarray) -> None:
@@ -382,7 +423,15 @@ def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarra
     f = (theta0 @ a[..., None] - np.swapaxes(crm, -1, -2) @ h)[..., 0]  # Θa + Φ(V) Θ V
     f_c = topo.anc @ f  # Σ_{j ⪰ k} f_j
     tau = np.sum(data.sigma * f_c[:, topo.dof_body], axis=-1)
-    return tau if model.G is None else tau @ model.G
+    tau = tau if model.G is None else tau @ model.G
+    if not model.modal:
+        return tau
+    out = np.zeros(Q.shape)
+    out[:, : model.n_pairs] = tau
+    for c in range(Q.shape[0]):
+        frames = _modal_frames(model, data, c, a[c])
+        out[c] += modal_bodies.bias_terms(model, frames, Q[c], Qd[c])
+    return out
 
 
 def bias_force(model: Model, data: BatchData, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
@@ -426,4 +475,11 @@ def gravity_force_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndar
     theta0 = ground_inertias(model, data)
     w = topo.anc @ (theta0[..., :, :3] @ model.gravity)  # Σ_{j ⪰ k} Θ⁰_j [g0; 0]
     tau = np.sum(data.sigma * w[:, topo.dof_body], axis=-1)
-    return tau if model.G is None else tau @ model.G
+    tau = tau if model.G is None else tau @ model.G
+    if not model.modal:
+        return tau
+    out = np.zeros(Q.shape)
+    out[:, : model.n_pairs] = tau
+    for c in range(Q.shape[0]):
+        out[c] += modal_bodies.gravity_terms(model, _modal_frames(model, data, c), Q[c])
+    return out

@@ -7,7 +7,9 @@ The order is the file's: a depth-first walk of the kinematic tree from the root 
 the child joints of a link in document order; every joint that moves contributes its
 coordinates (``joint`` for a 1-DOF joint, ``joint:x`` … ``joint:rz`` for a floating
 joint, ``joint:x``, ``joint:y``, ``joint:rz`` for a planar one); ``fixed`` joints and
-``<mimic>`` joints (which follow their source, ``q = k q_s + o``) have none.
+``<mimic>`` joints (which follow their source, ``q = k q_s + o``) have none. The modal
+coordinates of the modal bodies follow all of them, ``body:eta1`` … for each
+``<rt70:modal_body>`` in document order.
 
 The textbook side derives the same list itself while building its pairs (a test holds
 the two equal); the Pinocchio side, whose parser numbers sibling joints its own way,
@@ -48,4 +50,6 @@ def coordinate_names(desc: RobotDescription) -> list[str]:
         if joint.type != "fixed" and joint.mimic is None:
             names.extend(joint.name + sfx for sfx in SUFFIXES.get(joint.type, ("",)))
         stack.extend(reversed(children.get(joint.child, [])))
+    for body in desc.modal_bodies:
+        names.extend(body.coordinate_names)
     return names

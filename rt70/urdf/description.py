@@ -8,6 +8,7 @@ import numpy as np
 
 from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY, CoefficientTable
 from rt70.urdf.beam_record import Beam
+from rt70.urdf.modal_record import ModalBody
 
 #: Joint types of the URDF standard.
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -452,6 +453,9 @@ class RobotDescription:
         The reflector system (``<rt70:optics>``), if the file declares it.
     beams : tuple of Beam
         The members written as rigid finite elements (``<rt70:beam>``), in document order.
+    modal_bodies : tuple of ModalBody
+        The modal flexible bodies (``<rt70:modal_body>``), in document order; their modal
+        coordinates follow the joints' (:func:`rt70.urdf.coordinate_names`).
     """
 
     name: str
@@ -472,6 +476,7 @@ class RobotDescription:
     mount: Mount | None = None
     optics: Optics | None = None
     beams: tuple[Beam, ...] = ()
+    modal_bodies: tuple[ModalBody, ...] = ()
 
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""

@@ -3,8 +3,9 @@
 One job: once the links and joints of the tree are read (:mod:`rt70.urdf.reader`), turn
 the ``<rt70:...>`` elements at the top of ``<robot>`` into the description's gravity,
 joint springs, bushings and strut packages, loops, drives, winds, air density, no-slip
-constraints, the mount, the optics and optical points, refusing what is wrong with an
-:class:`~rt70.errors.ExtensionError` naming the file and the element. The drives, winds,
+constraints, the mount, the optics and optical points and the modal bodies, refusing
+what is wrong with an :class:`~rt70.errors.ExtensionError` naming the file and the
+element. The drives, winds,
 no-slip constraints, the mount and the optics have modules of their own
 (:mod:`rt70.urdf.drives`, :mod:`rt70.urdf.wind`, :mod:`rt70.urdf.no_slip`,
 :mod:`rt70.urdf.mount`, :mod:`rt70.urdf.optics`); the others are read here.
@@ -29,6 +30,7 @@ from rt70.urdf.description import (
 )
 from rt70.urdf.drives import read_drive
 from rt70.urdf.elements import ZERO3, ElementReader
+from rt70.urdf.modal_body import read_modal_body
 from rt70.urdf.mount import read_mount
 from rt70.urdf.no_slip import read_no_slip
 from rt70.urdf.optics import read_optics
@@ -45,8 +47,7 @@ def read_extensions(
     """The description with the rt70 extension elements of ``root`` read into it.
 
     The lists of ``desc`` (springs, bushings, loops, drives, optical points) and its
-    gravity are filled in place; the winds, the air density, the no-slip constraints and
-    the mount and the optics are set on a copy when the file has any.
+    gravity are filled in place; the other elements are set on a copy when the file has any.
 
     Parameters
     ----------
@@ -65,12 +66,7 @@ def read_extensions(
         number that is NaN, infinite or too large.
     """
     ns = "{" + RT70_NS + "}"
-    winds: list = []
-    air: list[float] = []
-    no_slips: list = []
-    mount: list = []
-    optics: list = []
-    beams: list = []
+    winds, air, no_slips, mount, optics, beams, modal = [], [], [], [], [], [], []  # copied
     joints = {j.name: j for j in desc.joints}  # one lookup per spring: linear time
     for elem in root:
         if not isinstance(elem.tag, str) or not elem.tag.startswith(ns):
@@ -100,6 +96,8 @@ def read_extensions(
             optics.append(elem)  # read once every optical point of the file is known
         elif kind == "beam":
             beams.append(read_beam(reader, elem))  # its elements read as any other
+        elif kind == "modal_body":
+            modal.append(read_modal_body(reader, elem, desc))
         elif kind == "optical_point":
             name = reader.name_of(elem)
             link = reader.link_ref(elem, "link", desc, f"<rt70:optical_point name='{name}'>")
@@ -107,7 +105,7 @@ def read_extensions(
         else:  # a kind declared in RT70 must be read here, never skipped
             raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
     _check_unique_names(reader, desc)
-    if not (winds or air or no_slips or mount or optics or beams):
+    if not (winds or air or no_slips or mount or optics or beams or modal):
         return desc
     return dataclasses.replace(
         desc,
@@ -117,7 +115,17 @@ def read_extensions(
         mount=read_mount(reader, mount[0], joints, desc.drives) if mount else None,
         optics=read_optics(reader, optics[0], desc) if optics else None,
         beams=tuple(beams),
+        modal_bodies=_unique_bodies(reader, modal),
     )
+
+
+def _unique_bodies(reader: ElementReader, bodies: list) -> tuple:
+    """The modal bodies, refusing two of one name (their coordinates are named by it)."""
+    names = [b.name for b in bodies]
+    for name in names:
+        if names.count(name) > 1:
+            raise reader.fail(ExtensionError, f"two <rt70:modal_body> elements named '{name}'")
+    return tuple(bodies)
 
 
 def _check_unique_names(reader: ElementReader, desc: RobotDescription) -> None:

@@ -116,6 +116,9 @@ RT70 = Spec(
                 ),
             )
         ),
+        "modal_body": Child(
+            Spec(required=("name", "link", "file"), optional=("modes", "damping_ratio"))
+        ),
         "drive": Child(
             Spec(
                 required=("name", "joint", *DRIVE_PARAMETERS),

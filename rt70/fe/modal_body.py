@@ -1,0 +1,118 @@
+"""A finite-element model as a modal body clamped to its frame: nodes, masses, modes.
+
+One job: the arrays of the modal body file (docs/fe-models.md, ``rt70-modal/1``) from a
+lumped-mass FE model of translational DOFs. The body's frame holds the ``clamped`` nodes
+(where it is attached: they move with the frame), so its modes are the fixed-interface
+modes of the Craig–Bampton reduction on those nodes (:func:`rt70.fe.craig_bampton`):
+``u_i = Φ η`` on the interior, zero on the clamped nodes; mass-normalised, so the modal
+mass is 1 and the modal stiffness ``diag(ω²)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from rt70.errors import Rt70Error
+from rt70.fe.craig_bampton import craig_bampton
+from rt70.fe.neutral import FEModel
+
+
+@dataclass(frozen=True)
+class ClampedModes:
+    """A clamped modal body's arrays (the modal body file's, module docstring).
+
+    Attributes
+    ----------
+    nodes : numpy.ndarray, shape (N, 3)
+        Node positions in the model's frame, m.
+    masses : numpy.ndarray, shape (N,)
+        Lumped masses, kg.
+    shapes : numpy.ndarray, shape (N, 3, k)
+        Mode shapes, zero on the clamped nodes.
+    stiffness : numpy.ndarray, shape (k, k)
+        ``diag(ω²)``, (rad/s)² per unit modal mass.
+    edges : numpy.ndarray of int, shape (E, 2)
+        The pairs of nodes K couples (a truss's bars, a mesh's element edges), for drawing.
+    """
+
+    nodes: np.ndarray
+    masses: np.ndarray
+    shapes: np.ndarray
+    stiffness: np.ndarray
+    edges: np.ndarray
+
+    @property
+    def freq_hz(self) -> np.ndarray:
+        """The modes' frequencies, Hz."""
+        return np.sqrt(np.diag(self.stiffness)) / (2.0 * np.pi)
+
+
+def clamped_modes(model: FEModel, clamped: list[int], n_modes: int) -> ClampedModes:
+    """The ``n_modes`` lowest modes of ``model`` with the ``clamped`` nodes held.
+
+    Parameters
+    ----------
+    model : FEModel
+        Three translations per node (components 1–3), a diagonal (lumped) mass matrix.
+    clamped : list of int
+        Node numbers of the nodes held by the body frame.
+    n_modes : int
+        Modes kept (the lowest).
+
+    Raises
+    ------
+    Rt70Error
+        A node without exactly its three translations, a mass matrix that is not
+        diagonal or not equal on a node's three rows, an unknown clamped node, or the
+        reduction's own errors (a boundary that does not hold the structure).
+    """
+    ids = np.asarray(model.node_ids)
+    node_rows = [model.dofs_of(int(n)) for n in ids.tolist()]
+    if any(len(r) != 3 or list(model.dof_comp[r]) != [1, 2, 3] for r in node_rows):
+        raise Rt70Error(f"{model.name}: a modal body needs three translations on every node")
+    rows = np.array(node_rows, dtype=np.int64)  # (N, 3)
+    M = sp.csr_array(model.M)
+    diagonal = M.diagonal()
+    if sp.csr_array(M - sp.diags_array(diagonal)).count_nonzero():
+        raise Rt70Error(f"{model.name}: a modal body needs a lumped (diagonal) mass matrix")
+    masses = diagonal[rows]
+    if np.any(masses != masses[:, :1]):
+        raise Rt70Error(f"{model.name}: a node's three translations have different masses")
+    unknown = sorted(set(clamped) - set(ids.tolist()))
+    if unknown:
+        raise Rt70Error(f"{model.name}: clamped node {unknown[0]} is not in the node table")
+    boundary = np.concatenate([model.dofs_of(int(n)) for n in clamped])
+    cb = craig_bampton(model.M, model.K, boundary, n_modes)
+    nb = cb.n_boundary
+    shapes = cb.T[:, nb:][rows]  # (N, 3, k): zero on the clamped rows
+    flat = shapes.reshape(-1, shapes.shape[2])
+    sign = np.sign(flat[np.argmax(np.abs(flat), axis=0), np.arange(flat.shape[1])])
+    shapes = shapes * sign  # each mode's largest entry positive: one sign on every machine
+    return ClampedModes(
+        np.asarray(model.node_xyz, dtype=float),
+        masses[:, 0].copy(),
+        shapes,
+        np.diag(cb.omega2),
+        coupled_nodes(model, rows),
+    )
+
+
+def coupled_nodes(model: FEModel, rows: np.ndarray) -> np.ndarray:
+    """The node pairs (i < j, indices into the node table) that K couples, (E, 2).
+
+    Parameters
+    ----------
+    model : FEModel
+        The FE model.
+    rows : numpy.ndarray of int, shape (N, 3)
+        Each node's three rows.
+    """
+    node_of = np.empty(model.n_dofs, dtype=np.int64)
+    node_of[rows.ravel()] = np.repeat(np.arange(rows.shape[0]), 3)
+    K = sp.coo_array(model.K)
+    a, b = node_of[K.row], node_of[K.col]
+    keep = (a < b) & (K.data != 0.0)
+    return np.unique(np.column_stack([a[keep], b[keep]]), axis=0).reshape(-1, 2)

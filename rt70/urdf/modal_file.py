@@ -1,0 +1,206 @@
+"""The modal body file, ``rt70-modal/1``: a flexible body as nodes, masses and mode shapes.
+
+One job: the format's one reader and writer (docs/fe-models.md, "The modal body file").
+A NumPy ``.npz`` archive with
+
+========== ============ ===========================================================
+key        shape        meaning
+========== ============ ===========================================================
+format     ()           the string ``rt70-modal/1``
+nodes      (N, 3)       the nodes ``x_n`` in the body frame (the link's frame), m
+masses     (N,)         their lumped translational masses ``m_n``, kg (≥ 0)
+shapes     (N, 3, k)    ``Φ_n``: each node's displacement per unit modal coordinate
+stiffness  (k, k)       the modal stiffness ``K_η`` (symmetric, positive semidefinite)
+damping    (k, k)       optional: the modal damping ``D_η`` (symmetric, psd)
+edges      (E, 2)       optional: node index pairs drawn as lines (the FE mesh's edges)
+source     ()           optional: where the body came from (a free text)
+========== ============ ===========================================================
+
+The body is ``r_n = x_n + Φ_n η`` (rt70.textbook.flexible): the nodes' masses are
+lumped and translational, the modes are shapes in the body frame, clamped to it where
+the body is attached (fixed-interface modes of a Craig–Bampton reduction, docs/fe-models.md).
+The reader checks every array (shapes, finite numbers, symmetry, definiteness, a
+positive modal mass) and raises :class:`~rt70.errors.ExtensionError` naming the file.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rt70.errors import ExtensionError
+
+#: The format's name, stored in the file.
+FORMAT = "rt70-modal/1"
+
+#: A matrix is symmetric when ``|X − Xᵀ| ≤ SYMMETRY_RTOL · max |X|`` (rounding of a
+#: product ``Φᵀ K Φ`` written out, not a modelling choice).
+SYMMETRY_RTOL = 1e-9
+
+#: A symmetric matrix is positive semidefinite when its lowest eigenvalue is above
+#: ``−DEFINITE_RTOL · max |λ|`` (rounding of the eigensolver on rigid modes).
+DEFINITE_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class ModalArrays:
+    """The arrays of a modal body file (module docstring), checked.
+
+    Attributes
+    ----------
+    nodes : numpy.ndarray, shape (N, 3)
+    masses : numpy.ndarray, shape (N,)
+    shapes : numpy.ndarray, shape (N, 3, k)
+    stiffness : numpy.ndarray, shape (k, k)
+    damping : numpy.ndarray, shape (k, k)
+        Zero when the file has none.
+    source : str
+    edges : numpy.ndarray of int, shape (E, 2)
+        Node index pairs drawn as lines (none when the file has none).
+    """
+
+    nodes: np.ndarray
+    masses: np.ndarray
+    shapes: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    source: str = ""
+    edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+
+    @property
+    def modes(self) -> int:
+        """k, the number of mode shapes."""
+        return self.shapes.shape[2]
+
+    @property
+    def modal_mass(self) -> np.ndarray:
+        """``M_ηη = Σ m_n Φ_nᵀ Φ_n``, (k, k)."""
+        return np.einsum("n,nai,naj->ij", self.masses, self.shapes, self.shapes)
+
+
+def write_modal_file(path: str | Path, body: ModalArrays) -> Path:
+    """Write ``body`` to ``path`` (an ``.npz``), atomically: a finished file or none.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write; its directory must exist.
+    body : ModalArrays
+        The body; checked as the reader checks it before anything is written.
+    """
+    path = Path(path)
+    check_arrays(body, str(path))
+    arrays = {
+        "format": np.array(FORMAT),
+        "nodes": body.nodes,
+        "masses": body.masses,
+        "shapes": body.shapes,
+        "stiffness": body.stiffness,
+        "damping": body.damping,
+        "edges": body.edges,
+        "source": np.array(body.source),
+    }
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".npz")
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            np.savez(handle, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_modal_file(path: str | Path, where: str) -> ModalArrays:
+    """The checked arrays of the modal body file ``path``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``.npz`` file.
+    where : str
+        The start of every message (the URDF file and element that name the file).
+
+    Raises
+    ------
+    ExtensionError
+        If the file is missing or unreadable, of another format, or an array is missing,
+        of the wrong shape, not finite, not symmetric or not semidefinite, or a mode
+        moves no mass.
+    """
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            arrays = {key: archive[key] for key in archive.files}
+    except FileNotFoundError:
+        raise ExtensionError(f"{where}: modal body file '{path}' not found") from None
+    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+        raise ExtensionError(f"{where}: '{path}' is not a readable .npz file ({exc})") from None
+    found = str(arrays.get("format", ""))
+    if found != FORMAT:
+        raise ExtensionError(f"{where}: '{path}' has format '{found}', expected '{FORMAT}'")
+    for key in ("nodes", "masses", "shapes", "stiffness"):
+        if key not in arrays:
+            raise ExtensionError(f"{where}: '{path}' has no array '{key}'")
+    shapes = np.asarray(arrays["shapes"], dtype=float)
+    k = shapes.shape[2] if shapes.ndim == 3 else 0
+    body = ModalArrays(
+        nodes=np.asarray(arrays["nodes"], dtype=float),
+        masses=np.asarray(arrays["masses"], dtype=float),
+        shapes=shapes,
+        stiffness=np.asarray(arrays["stiffness"], dtype=float),
+        damping=np.asarray(arrays.get("damping", np.zeros((k, k))), dtype=float),
+        source=str(arrays.get("source", "")),
+        edges=np.asarray(arrays.get("edges", np.zeros((0, 2))), dtype=np.int64),
+    )
+    check_arrays(body, f"{where}: '{path}'")
+    return body
+
+
+def check_arrays(body: ModalArrays, where: str) -> None:
+    """Raise :class:`~rt70.errors.ExtensionError` (``where`` first) unless ``body`` is sound."""
+    n = body.nodes.shape[0] if body.nodes.ndim == 2 else -1
+    if body.nodes.shape != (n, 3) or n < 1:
+        raise ExtensionError(f"{where}: nodes has shape {body.nodes.shape}, expected (N, 3)")
+    k = body.shapes.shape[2] if body.shapes.ndim == 3 else 0
+    expected = {
+        "masses": (body.masses, (n,)),
+        "shapes": (body.shapes, (n, 3, k)),
+        "stiffness": (body.stiffness, (k, k)),
+        "damping": (body.damping, (k, k)),
+    }
+    if k < 1:
+        raise ExtensionError(f"{where}: shapes has shape {body.shapes.shape}, expected (N, 3, k)")
+    for key, (array, shape) in expected.items():
+        if array.shape != shape:
+            raise ExtensionError(f"{where}: {key} has shape {array.shape}, expected {shape}")
+    for key, array in (("nodes", body.nodes), *((key, a) for key, (a, _) in expected.items())):
+        if not np.all(np.isfinite(array)):
+            raise ExtensionError(f"{where}: {key} has NaN or infinite entries")
+    edges = body.edges
+    if edges.ndim != 2 or edges.shape[1] != 2:
+        raise ExtensionError(f"{where}: edges has shape {edges.shape}, expected (E, 2)")
+    if edges.size and (edges.min() < 0 or edges.max() >= n or np.any(edges[:, 0] == edges[:, 1])):
+        raise ExtensionError(f"{where}: edges must join two different nodes of the {n}")
+    if np.any(body.masses < 0.0) or not body.masses.sum() > 0.0:
+        raise ExtensionError(f"{where}: masses must be ≥ 0 with a positive total")
+    for key in ("stiffness", "damping"):
+        _check_semidefinite(getattr(body, key), f"{where}: {key}")
+    eigenvalues = np.linalg.eigvalsh(body.modal_mass)
+    if not eigenvalues[0] > DEFINITE_RTOL * eigenvalues[-1]:
+        raise ExtensionError(
+            f"{where}: the modal mass Σ m Φᵀ Φ is singular: a mode (or a combination of "
+            "modes) moves no mass"
+        )
+
+
+def _check_semidefinite(matrix: np.ndarray, where: str) -> None:
+    scale = float(np.max(np.abs(matrix), initial=0.0))
+    if np.max(np.abs(matrix - matrix.T), initial=0.0) > SYMMETRY_RTOL * scale:
+        raise ExtensionError(f"{where} is not symmetric")
+    if scale > 0.0 and np.linalg.eigvalsh(matrix)[0] < -DEFINITE_RTOL * scale:
+        raise ExtensionError(f"{where} is not positive semidefinite")

@@ -1,0 +1,54 @@
+"""The record of a ``<rt70:modal_body>``: a flexible body on a link, as plain data.
+
+Read by :mod:`rt70.urdf.modal_body` (the element and its file,
+:mod:`rt70.urdf.modal_file`); both sides build their own body from it
+(:mod:`rt70.textbook.modal_model`, :mod:`rt70.reference.modal_nodes`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class ModalBody:
+    """A modal flexible body on a link (``<rt70:modal_body>``), its arrays checked.
+
+    Attributes
+    ----------
+    name : str
+        The element's name; the body's modal coordinates are ``name:eta1`` … ``name:etak``.
+    link : str
+        The link whose frame is the body frame (the body moves rigidly with it and deforms
+        by its modes).
+    file : str
+        The modal body file as resolved.
+    nodes, masses, shapes : numpy.ndarray
+        ``x_n`` (N, 3) in the link's frame, m; ``m_n`` (N,), kg; ``Φ_n`` (N, 3, k).
+    stiffness, damping : numpy.ndarray
+        ``K_η`` and ``D_η``, (k, k).
+    edges : numpy.ndarray of int, shape (E, 2)
+        Node index pairs drawn as lines (the mesh's edges; may be empty).
+    """
+
+    name: str
+    link: str
+    file: str
+    nodes: np.ndarray
+    masses: np.ndarray
+    shapes: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    edges: np.ndarray
+
+    @property
+    def modes(self) -> int:
+        """k, the number of modal coordinates."""
+        return self.shapes.shape[2]
+
+    @property
+    def coordinate_names(self) -> list[str]:
+        """``name:eta1`` … ``name:etak``."""
+        return [f"{self.name}:eta{i + 1}" for i in range(self.modes)]
