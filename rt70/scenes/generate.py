@@ -37,7 +37,12 @@ from rt70.scenes.book_scenes import (
 )
 from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene
 from rt70.scenes.modal_scenes import TRUSS_FILE, slewing_truss_scene, truss_arm
-from rt70.scenes.rt70_scenes import rt70_jack_scene, rt70_scene, rt70_servo_scene
+from rt70.scenes.rt70_scenes import (
+    rt70_flexible_scene,
+    rt70_jack_scene,
+    rt70_scene,
+    rt70_servo_scene,
+)
 from rt70.urdf.modal_file import ModalArrays, write_modal_file
 
 #: Default output directory: ``urdf/`` at the repository root.
@@ -49,6 +54,7 @@ SCENES: dict[str, Callable[[], str]] = {
     "rt70": rt70_scene,
     "rt70_servo": rt70_servo_scene,
     "rt70_jack": rt70_jack_scene,
+    "rt70_flexible": rt70_flexible_scene,
     "rt70_elevation": rt70_elevation_scene,
     "rt70_azimuth": rt70_azimuth_scene,
     "rt70_azimuth_el90": rt70_azimuth_el90_scene,

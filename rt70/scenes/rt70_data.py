@@ -355,3 +355,41 @@ LISTING_V0: np.ndarray = _state(
     (0.01, 0.01, 0.01, 0.0015, 0.0015, 0.0015),
     (0.1, 0.01, 0.01, 0.0015, 0.0015, 0.0015),
 )
+
+
+def _column_tube(diameter: float, lateral: float, length: float, E: float) -> dict[str, float]:
+    """A circular tube of outer ``diameter`` whose cantilever tip stiffness is ``lateral``.
+
+    ``I = lateral · L³ / (3 E)``; the bore ``d = (D⁴ − 64 I/π)^¼``. Returns the wall (m)
+    and the section: A, I_y = I_z, J = 2 I (m², m⁴).
+    """
+    second = lateral * length**3 / (3.0 * E)
+    inner = (diameter**4 - 64.0 * second / np.pi) ** 0.25
+    area = np.pi / 4.0 * (diameter**2 - inner**2)
+    return {
+        "wall": float((diameter - inner) / 2.0),
+        "A": float(area),
+        "Iy": float(second),
+        "Iz": float(second),
+        "J": float(2.0 * second),
+    }
+
+
+#: The counterreflector on a flexible column instead of the listing's direct pair
+#: ``rigel_counterreflector`` (scene ``rt70_flexible``, docs/beams.md "On the RT-70"). The
+#: book gives no section, only the pair's stiffness: the column is a steel tube 6 m long
+#: (the pair's offset) of 1 m diameter whose wall is chosen so that, clamped to the rigel,
+#: its tip's lateral stiffness ``3 E I / L³`` is the pair's 1.0e7 N/m: ``I = k L³ / (3 E)``
+#: = 3.43e-3 m⁴, wall 9.0 mm (:func:`_column_tube`). Its other stiffnesses follow from
+#: the tube (not the
+#: book's), and its stiffness-proportional damping is the book's law ``ξ_i = 0.05 Ω_i/Ω1``
+#: (§2.3): β = 0.1/Ω1 with Ω1 = 2π · 1.2512 Hz, the printed first resonance.
+COUNTERREFLECTOR_COLUMN: dict[str, float] = {
+    "length": 6.0,
+    "segments": 4,
+    "E": 2.1e11,
+    "G": 8.1e10,
+    "rho": 7850.0,
+    **_column_tube(1.0, 1.0e7, 6.0, 2.1e11),
+    "damping": 0.1 / (2.0 * np.pi * 1.2512),
+}

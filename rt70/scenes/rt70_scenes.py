@@ -13,10 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 
+import numpy as np
+
 from rt70.control.geartrains import parallel_drive
 from rt70.scenes import rt70_data, rt70_drives, rt70_state, rt70_wind
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.urdf_writer import ZERO3, check_name, fmt, fmt_vec
+from rt70.urdf.beams import expand_beams
 from rt70.urdf.description import DRIVE_PARAMETERS
 
 
@@ -138,18 +141,23 @@ def _rt70_text(
     listing_bodies: Sequence[dict],
     drives: Callable[[uw.Writer], None] | None = None,
     servos: bool = False,
+    column: bool = False,
 ) -> str:
     """The 42-DOF RT-70 URDF text with the given bodies (the listing's or a variant).
 
     ``drives`` writes the scene's ``<rt70:drive>`` elements (or other elements), after the
     optical points; ``servos`` gives the mount's axes their ``<rt70:servo>`` (on the
-    drives :func:`_servo_drives` writes).
+    drives :func:`_servo_drives` writes); ``column`` puts the counterreflector on its
+    flexible column (:func:`_counterreflector_column`) instead of its 6-DOF pair.
     """
     d = rt70_data
     bodies = {b["name"]: b for b in listing_bodies}
     w = uw.Writer()
     uw.begin(w, name, description)
     for body in listing_bodies:
+        if column and body["name"] == "counterreflector":
+            _counterreflector_column(w, body)
+            continue
         uw.six_dof_body(
             w,
             body["name"],
@@ -164,6 +172,8 @@ def _rt70_text(
     uw.gravity(w, d.LISTING_GRAVITY)
     w.comment("Direct elastic pairs: frame 1 = construction frame, frame 2 = body frame")
     for pair in d.LISTING_DIRECT_PAIRS:
+        if column and pair["child"] == "counterreflector":
+            continue
         child = bodies[pair["child"]]
         uw.bushing(
             w,
@@ -333,6 +343,54 @@ def _rt70_jack(w: uw.Writer) -> None:
         com=(0.0, reach - p_length / 2.0, 0.0),
     )
     loop(w, "jack_counterweight", "jack_piston", "counterweight", xyz1=(0.0, reach, 0.0))
+
+
+def rt70_flexible_scene() -> str:
+    """The RT-70 control object with its counterreflector on a flexible column.
+
+    :func:`rt70_servo_scene` (drives, servos, wind) with the listing's direct pair
+    rigel–counterreflector replaced by a steel column of rigid finite elements
+    (``<rt70:beam>``, :data:`rt70_data.COUNTERREFLECTOR_COLUMN`, docs/beams.md), written
+    out in the file (:func:`rt70.urdf.beams.expand_beams`) so that Pinocchio's parser and
+    URDF viewers see the column's segments too.
+    """
+    text = _rt70_text(
+        "rt70_flexible",
+        "RT-70 radio telescope as a control object (rt70_servo) with the counterreflector "
+        "on a flexible steel column of rigid finite elements instead of its 6-DOF pair",
+        rt70_data.SERVO_BODIES,
+        drives=_servo_drives_and_winds,
+        servos=True,
+        column=True,
+    )
+    return expand_beams(text, "rt70_flexible")  # written out: any URDF reader sees the column
+
+
+def _counterreflector_column(w: uw.Writer, body: dict) -> None:
+    """The counterreflector on its column: the beam along the rigel's z, the body at its end.
+
+    The beam runs along its own x, turned onto the rigel's z by ``rpy = (0, −π/2, 0)``;
+    the counterreflector is fixed to the beam's end with the inverse turn, so its frame is
+    parallel to the rigel's, ``offset`` above it, as in the listing.
+    """
+    c = rt70_data.COUNTERREFLECTOR_COLUMN
+    length = float(np.linalg.norm(body["offset"]))
+    if not np.allclose(body["offset"], (0.0, 0.0, c["length"])):
+        raise ValueError(f"the column runs along z for {c['length']} m, not to {body['offset']}")
+    w.comment(
+        f"{body['name']}: on a flexible column from {body['parent']} (COUNTERREFLECTOR_COLUMN)"
+    )
+    uw.massive_link(w, body["name"], body["mass"], body["moments"], body["com"])
+    w.empty(
+        "rt70:beam",
+        ("name", "column"),
+        ("parent", check_name(body["parent"])),
+        ("length", fmt(length)),
+        ("rpy", fmt_vec((0.0, -np.pi / 2.0, 0.0))),
+        ("segments", str(int(c["segments"]))),
+        *((key, fmt(c[key])) for key in ("E", "G", "rho", "A", "Iy", "Iz", "J", "damping")),
+    )
+    uw.joint(w, "column_tip", "fixed", "column_end", body["name"], rpy=(0.0, np.pi / 2.0, 0.0))
 
 
 def rt70_jack_scene() -> str:

@@ -178,8 +178,15 @@ def mass_matrix_derivative(inv: Invariants, eta: np.ndarray, j: int) -> np.ndarr
     return dM
 
 
-def velocity_terms(inv: Invariants, eta: np.ndarray, w: np.ndarray) -> np.ndarray:
+def velocity_terms(
+    inv: Invariants, eta: np.ndarray, w: np.ndarray, mass: np.ndarray | None = None
+) -> np.ndarray:
     """h(η, w): the body's velocity terms (module docstring), (6 + k,).
+
+    ``Ṁ w = Σ_j η̇_j (∂M/∂η_j) w`` and ``½ wᵀ (∂M/∂η_j) w`` for all j at once, from the
+    blocks of ∂M/∂η_j (:func:`mass_matrix_derivative`) without forming them:
+    ``[−a_j × ω;  a_j × v + J_j ω + R_j η̇;  R_jᵀ ω]`` with ``a_j = C_t e_j``, ``J_j``
+    the inertia of ∂(Σ m r rᵀ)/∂η_j and ``R_j`` the rotation coupling's derivative.
 
     Parameters
     ----------
@@ -190,14 +197,27 @@ def velocity_terms(inv: Invariants, eta: np.ndarray, w: np.ndarray) -> np.ndarra
     w : numpy.ndarray, shape (6 + k,)
         ``[v; ω; η̇]``: the frame's velocity and angular velocity in its own axes (m/s,
         rad/s) and the modal rates.
+    mass : numpy.ndarray, shape (6 + k, 6 + k), optional
+        ``M(η)`` when the caller has it (:func:`body_mass_matrix`).
     """
-    k = inv.modes
     v, omega, eta_dot = w[:3], w[3:6], w[6:]
-    p = body_mass_matrix(inv, eta) @ w
-    derivatives = [mass_matrix_derivative(inv, eta, j) for j in range(k)]
-    m_dot_w = sum((eta_dot[j] * (dM @ w) for j, dM in enumerate(derivatives)), np.zeros(6 + k))
-    h = m_dot_w
+    p = (body_mass_matrix(inv, eta) if mass is None else mass) @ w
+    a = inv.first_modal.T  # (k, 3): a_j
+    mixed = inv.second_mixed + np.swapaxes(inv.second_mixed, 1, 2)
+    d_second = (
+        mixed
+        + np.einsum("i,ijab->jab", eta, inv.second_modal)
+        + np.einsum("i,jiab->jab", eta, inv.second_modal)
+    )  # (k, 3, 3): ∂(Σ m r rᵀ)/∂η_j
+    trace = np.trace(d_second, axis1=1, axis2=2)
+    u = np.empty((a.shape[0], w.size))  # row j: (∂M/∂η_j) w
+    u[:, :3] = -np.cross(a, omega)
+    u[:, 3:6] = (
+        np.cross(a, v) + trace[:, None] * omega - d_second @ omega + inv.rotation_modal @ eta_dot
+    )
+    u[:, 6:] = np.einsum("jai,a->ji", inv.rotation_modal, omega)
+    h = eta_dot @ u
     h[:3] += np.cross(omega, p[:3])
     h[3:6] += np.cross(omega, p[3:6]) + np.cross(v, p[:3])
-    h[6:] -= 0.5 * np.array([w @ dM @ w for dM in derivatives])
+    h[6:] -= 0.5 * (u @ w)
     return h

@@ -126,10 +126,8 @@ def bias_terms(model: Model, frames: list[Frame], q: np.ndarray, qd: np.ndarray)
         W = _w_map(model, mb, frame)
         eta = q[mb.coords]
         accel = np.concatenate([frame.bias, np.zeros(mb.modes)])
-        out += W.T @ (
-            body_mass_matrix(mb.invariants, eta) @ accel
-            + velocity_terms(mb.invariants, eta, W @ qd)
-        )
+        M = body_mass_matrix(mb.invariants, eta)
+        out += W.T @ (M @ accel + velocity_terms(mb.invariants, eta, W @ qd, M))
     return out
 
 
@@ -236,6 +234,6 @@ def frame_wrenches(
         accel[:6] += frame.bias
         if gravity:
             accel[:3] -= frame.R.T @ model.gravity
-        wrench = M @ accel + velocity_terms(mb.invariants, eta, W @ qd)
+        wrench = M @ accel + velocity_terms(mb.invariants, eta, W @ qd, M)
         out.append((mb.body, wrench[:6]))
     return out
