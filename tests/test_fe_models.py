@@ -104,7 +104,7 @@ def _model(**changes) -> dict:
     ("changes", "message"),
     [
         ({"K": "asymmetric"}, "bad.npz: K is not symmetric: entries (0, 3) and (3, 0)"),
-        ({"dof_comp": "seven"}, "bad.npz: component 7 (components are 1 to 6)"),
+        ({"dof_comp": "seven"}, "bad.npz: component 7 (components are 0 to 6)"),
         ({"dof_node": "unknown"}, "bad.npz: DOFs on node 999, which is not in the table"),
         ({"dof_comp": "twice"}, "bad.npz: a node's component is listed twice"),
         ({"interfaces": {"hub": 999}}, "bad.npz: interface 'hub' is node 999, not in the"),

@@ -9,7 +9,8 @@ model needs to become a flexible body (docs/fe-models.md):
 - ``node_ids`` (n,) and ``node_xyz`` (n, 3): the FE program's node numbers and the
   nodes' positions, m;
 - ``dof_node``, ``dof_comp`` (N,): the node and the component of each matrix row —
-  1–3 translations x, y, z (m), 4–6 rotations about x, y, z (rad);
+  1–3 translations x, y, z (m), 4–6 rotations about x, y, z (rad), 0 for a scalar point
+  (a modal coordinate of a reduced model: its node has no position, ``node_xyz`` NaN);
 - ``interface_names``, ``interface_nodes`` (k,): the named interface nodes.
 
 ``M_*`` and ``K_*`` are the ``data``, ``indices``, ``indptr`` and ``shape`` of a
@@ -55,7 +56,7 @@ class FEModel:
     node_xyz : numpy.ndarray, shape (n, 3)
         Node positions, m.
     dof_node, dof_comp : numpy.ndarray, shape (N,)
-        Node number and component (1–6: x, y, z, rx, ry, rz) of each row.
+        Node number and component (1–6: x, y, z, rx, ry, rz; 0: a scalar point) of each row.
     interfaces : dict of str to int
         Named interface nodes (where the body attaches to others), node numbers.
     name : str
@@ -87,7 +88,7 @@ class FEModel:
     def dof_labels(self) -> list[str]:
         """``"node 12 x"``, … for every row."""
         return [
-            f"node {n} {COMPONENTS[c - 1]}"
+            f"node {n} {COMPONENTS[c - 1] if c else 'scalar'}"
             for n, c in zip(self.dof_node.tolist(), self.dof_comp.tolist(), strict=True)
         ]
 
@@ -100,7 +101,7 @@ def check(model: FEModel) -> None:
     FEModelError
         Shapes that do not agree, non-finite entries, M or K not symmetric (to
         :data:`SYMMETRY_RTOL`), a negative diagonal of M, a DOF on a node that is not in
-        the node table, a component outside 1–6, a node's component listed twice, an
+        the node table, a component outside 0–6, a node's component listed twice, an
         interface node that is not in the table.
     """
     where = model.name
@@ -132,10 +133,10 @@ def check(model: FEModel) -> None:
     unknown = np.setdiff1d(model.dof_node, ids)
     if unknown.size:
         raise FEModelError(f"{where}: DOFs on node {int(unknown[0])}, which is not in the table")
-    bad = (model.dof_comp < 1) | (model.dof_comp > 6)
+    bad = (model.dof_comp < 0) | (model.dof_comp > 6)
     if np.any(bad):
         comp = int(model.dof_comp[np.argmax(bad)])
-        raise FEModelError(f"{where}: component {comp} (components are 1 to 6)")
+        raise FEModelError(f"{where}: component {comp} (components are 0 to 6)")
     pairs = model.dof_node.astype(np.int64) * 8 + model.dof_comp
     if np.unique(pairs).size != pairs.size:
         raise FEModelError(f"{where}: a node's component is listed twice in the DOF map")

@@ -205,19 +205,24 @@ def _rt70_text(
                 ("damping", fmt_vec(strut["damping"])),
             )
         w.close("rt70:strut_package")
+    _optical_points(w)
+    _mount(w, servos=servos)
+    _optics(w)
+    if drives is not None:
+        drives(w)
+    return uw.end(w)
+
+
+def _optical_points(w: uw.Writer) -> None:
+    """The listing's optical points (book 4.1.8)."""
     w.comment("Optical points (section 4.1.8)")
-    for point in d.LISTING_OPTICAL_POINTS:
+    for point in rt70_data.LISTING_OPTICAL_POINTS:
         w.empty(
             "rt70:optical_point",
             ("name", check_name(point["name"])),
             ("link", check_name(point["link"])),
             ("xyz", fmt_vec(point["xyz"])),
         )
-    _mount(w, servos=servos)
-    _optics(w)
-    if drives is not None:
-        drives(w)
-    return uw.end(w)
 
 
 def _mount(w: uw.Writer, servos: bool) -> None:
