@@ -195,3 +195,13 @@ def test_write_all_writes_every_scene(tmp_path):
     for path, (name, build) in zip(written, SCENES.items(), strict=False):
         assert path.read_text(encoding="utf-8") == build(), name
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(p.name for p in written)
+
+
+@pytest.mark.parametrize("name", ["rt70", "rt70_servo", "rt70_jack", "rt70_flexible"])
+def test_rt70_scenes_draw_their_bodies(name):
+    """Each listing body has a cylinder a URDF viewer draws (Pinocchio's parser reads it)."""
+    _, _, visual = pin.buildModelsFromUrdf(str(URDF_DIR / f"{name}.urdf"))
+    drawn = {g.name.rsplit("_", 1)[0] for g in visual.geometryObjects}
+    assert set(RT70_BODIES) <= drawn
+    mirror = next(g for g in visual.geometryObjects if g.name.startswith("main_mirror"))
+    assert mirror.geometry.radius == 35.0

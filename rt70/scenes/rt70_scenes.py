@@ -18,6 +18,7 @@ import numpy as np
 from rt70.control.geartrains import parallel_drive
 from rt70.scenes import rt70_data, rt70_drives, rt70_state, rt70_wind
 from rt70.scenes import urdf_writer as uw
+from rt70.scenes.rt70_visuals import body_visual
 from rt70.scenes.urdf_writer import ZERO3, check_name, fmt, fmt_vec
 from rt70.urdf.beams import expand_beams
 from rt70.urdf.description import DRIVE_PARAMETERS
@@ -166,6 +167,7 @@ def _rt70_text(
             body["mass"],
             body["moments"],
             body["com"],
+            visual=body_visual(body),
         )
     w.blank()
     w.comment("Gravity (erratum 2: z up)")
@@ -385,7 +387,9 @@ def _counterreflector_column(w: uw.Writer, body: dict) -> None:
     w.comment(
         f"{body['name']}: on a flexible column from {body['parent']} (COUNTERREFLECTOR_COLUMN)"
     )
-    uw.massive_link(w, body["name"], body["mass"], body["moments"], body["com"])
+    uw.massive_link(
+        w, body["name"], body["mass"], body["moments"], body["com"], visual=body_visual(body)
+    )
     w.empty(
         "rt70:beam",
         ("name", "column"),

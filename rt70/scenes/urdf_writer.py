@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 
 from rt70.scenes.pairs import PAIR_JOINTS
 
@@ -36,6 +37,15 @@ _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 # ---------------------------------------------------------------------------------------
 # Formatting
 # ---------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A link's drawn shape: a cylinder along the link's z, centred at ``xyz`` (m)."""
+
+    radius: float
+    length: float
+    xyz: Sequence[float] = ZERO3
 
 
 def fmt(value: float) -> str:
@@ -241,6 +251,7 @@ def massive_link(
     moments: Sequence[float],
     com: Sequence[float] = ZERO3,
     rpy: Sequence[float] = ZERO3,
+    visual: Cylinder | None = None,
 ) -> None:
     """Write a link whose inertia has principal ``moments`` on axes rotated by ``rpy``.
 
@@ -259,6 +270,8 @@ def massive_link(
         Centre of mass in the link frame, m.
     rpy : sequence of float, optional
         Roll, pitch, yaw of the principal axes in the link frame, rad.
+    visual : Cylinder, optional
+        The link's drawn shape (``<visual>``: for URDF viewers; neither side reads it).
 
     Raises
     ------
@@ -282,6 +295,13 @@ def massive_link(
         ("izz", fmt(izz)),
     )
     w.close("inertial")
+    if visual is not None:
+        w.open("visual")
+        w.empty("origin", ("xyz", fmt_vec(visual.xyz)), ("rpy", fmt_vec(ZERO3)))
+        w.open("geometry")
+        w.empty("cylinder", ("radius", fmt(visual.radius)), ("length", fmt(visual.length)))
+        w.close("geometry")
+        w.close("visual")
     w.close("link")
 
 
@@ -294,6 +314,7 @@ def six_dof_body(
     moments: Sequence[float],
     com: Sequence[float] = ZERO3,
     inertia_rpy: Sequence[float] = ZERO3,
+    visual: Cylinder | None = None,
 ) -> None:
     """Write a body joined to ``parent`` by six 1-DOF joints in series (a 6-DOF pair).
 
@@ -320,6 +341,8 @@ def six_dof_body(
         Centre of mass in the body frame, m.
     inertia_rpy : sequence of float, optional
         Roll, pitch, yaw of the principal axes in the body frame, rad.
+    visual : Cylinder, optional
+        The body's drawn shape (:func:`massive_link`).
     """
     w.comment(f"{body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}]")
     previous = parent
@@ -336,7 +359,7 @@ def six_dof_body(
             axis=direction,
         )
         if last:
-            massive_link(w, child, mass, moments, com, inertia_rpy)
+            massive_link(w, child, mass, moments, com, inertia_rpy, visual)
         else:
             massless_link(w, child)
         previous = child
