@@ -33,9 +33,11 @@ def test_scene_agrees_with_pinocchio(name):
     scene = load_scene(name)
     records = cross_check(scene, samples=5, seed=123, repeat=1)
     assert [r.quantity for r in records] == list(quantities(scene))
-    # the wind row exactly where the scene has <rt70:wind>s: rt70_servo and the antennas
+    # the wind row exactly where the scene has <rt70:wind>s: RT-70 control objects, antennas
     assert ("wind" in quantities(scene)) == bool(scene.description.winds)
-    assert bool(scene.description.winds) == (name in ("rt70_servo", "rt70_flexible", "antenna_12m", "antenna_34m"))
+    assert bool(scene.description.winds) == (
+        name in ("rt70_servo", "rt70_flexible", "antenna_12m", "antenna_34m")
+    )
     for r in records:
         assert r.max_rel_err <= TOL, f"{name} {r.quantity}: {r.max_rel_err:.3g}"
 

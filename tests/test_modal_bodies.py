@@ -245,3 +245,32 @@ def test_another_format_is_refused(tmp_path):
       <rt70:modal_body name="b" link="world" file="{path}"/></robot>"""
     with pytest.raises(ExtensionError, match="expected 'rt70-modal/1'"):
         scene_from_text(text, "bad")
+
+
+def test_a_sweep_scales_the_modal_stiffness_and_damping():
+    from rt70.sweep.quantities import PARAMETERS
+
+    desc = load_scene("slewing_truss").description
+    body = desc.modal_bodies[0]
+    stiff = PARAMETERS["stiffness"].apply(desc, 4.0).modal_bodies[0]
+    damped = PARAMETERS["damping"].apply(desc, 0.5).modal_bodies[0]
+    assert np.array_equal(stiff.stiffness, 4.0 * body.stiffness)
+    assert np.array_equal(stiff.damping, body.damping)
+    assert np.array_equal(damped.damping, 0.5 * body.damping)
+    assert float(body.stiffness[0, 0]) in PARAMETERS["stiffness"].values(desc)
+
+
+def test_mode_shapes_draw_the_bodys_nodes():
+    from rt70.linear.mode_shapes import link_positions, structure_lines
+
+    scene = load_scene("slewing_truss")
+    body = scene.description.modal_bodies[0]
+    lines = structure_lines(scene)
+    assert len(lines.nodes) == body.nodes.shape[0]
+    assert len(lines.segments) >= body.edges.shape[0] > 0
+    q = np.zeros(scene.textbook.nv)
+    q[scene.textbook.modal[0].coords.start] = 0.01  # the first mode, the hub at rest
+    moved = link_positions(scene, q, lines) - link_positions(scene, 0 * q, lines)
+    expected = 0.01 * body.shapes[:, :, 0]
+    at = [i for i, _, _ in lines.nodes]
+    assert_close(moved[at], expected, rel=1e-12, scale=np.abs(expected).max())

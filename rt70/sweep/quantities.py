@@ -358,6 +358,9 @@ def _scale_stiffness(desc: RobotDescription, f: float) -> RobotDescription:
         joint_springs=[
             dataclasses.replace(s, stiffness=s.stiffness * f) for s in desc.joint_springs
         ],
+        modal_bodies=tuple(
+            dataclasses.replace(b, stiffness=b.stiffness * f) for b in desc.modal_bodies
+        ),
     )
 
 
@@ -366,12 +369,16 @@ def _scale_damping(desc: RobotDescription, f: float) -> RobotDescription:
         desc,
         bushings=[dataclasses.replace(b, damping=b.damping * f) for b in desc.bushings],
         joint_springs=[dataclasses.replace(s, damping=s.damping * f) for s in desc.joint_springs],
+        modal_bodies=tuple(
+            dataclasses.replace(b, damping=b.damping * f) for b in desc.modal_bodies
+        ),
     )
 
 
 def _structural(desc: RobotDescription, attribute: str) -> list[float]:
-    """The ``stiffness`` or ``damping`` numbers of every bushing and joint spring."""
+    """The ``stiffness`` or ``damping`` numbers of every bushing, joint spring and modal body."""
     numbers = [float(x) for b in desc.bushings for x in np.ravel(getattr(b, attribute))]
+    numbers += [float(x) for b in desc.modal_bodies for x in np.ravel(getattr(b, attribute))]
     return numbers + [float(getattr(s, attribute)) for s in desc.joint_springs]
 
 
@@ -389,13 +396,15 @@ PARAMETERS: dict[str, SceneParameter] = {
             "stiffness",
             _scale_stiffness,
             "the stiffness of every structural elastic element (bushings, strut-package "
-            "struts, joint springs); their damping unchanged; drives' reducers unchanged",
+            "struts, joint springs, modal bodies' K_η); their damping unchanged; drives' "
+            "reducers unchanged",
             lambda desc: _structural(desc, "stiffness"),
         ),
         SceneParameter(
             "damping",
             _scale_damping,
-            "the damping of every structural elastic element (bushings, struts, joint springs)",
+            "the damping of every structural elastic element (bushings, struts, joint springs, "
+            "modal bodies' D_η)",
             lambda desc: _structural(desc, "damping"),
         ),
         SceneParameter(
