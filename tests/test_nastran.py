@@ -58,6 +58,24 @@ def test_the_craig_bampton_blocks(matrices):
     assert_close(np.sqrt(omega2[0]) / (2 * np.pi), 365.2596, rel=1e-6)
 
 
+def test_dense_sparse_and_bigmat_files_hold_the_same_matrices():
+    """Nastran wrote one DMAP's nine matrices dense, sparse and BIGMAT (README there)."""
+    files = [read_op4(DATA / f"mat_t_{form}.op4") for form in ("dn", "s1", "s2")]
+    assert list(files[0]) == list(files[1]) == list(files[2])
+    assert len(files[0]) == 9
+    for name in files[0]:
+        dense = files[0][name].toarray()
+        for other in files[1:]:
+            assert np.array_equal(other[name].toarray(), dense), name
+    m = {name: matrix.toarray() for name, matrix in files[2].items()}
+    assert np.array_equal(m["EYE10"], np.eye(10)) and not m["NULL"].any()
+    # the deck's ADD with α = −1 + i: EYE5CD = α I, RND1Cx = α RND1Rx (single, double)
+    alpha = complex(-1.0, 1.0)
+    assert np.array_equal(m["EYE5CD"], alpha * np.eye(5))
+    assert_close(m["RND1CS"], alpha * m["RND1RS"], rel=1e-6, scale=np.abs(m["RND1RS"]).max())
+    assert_close(m["RND1CD"], alpha * m["RND1RD"], rel=1e-15, scale=np.abs(m["RND1RD"]).max())
+
+
 def test_the_bulk_cards():
     bulk = read_bulk(PCH)
     assert sorted(bulk.systems) == [20110001, 20110002, 20110003]
@@ -138,9 +156,9 @@ def test_bad_op4_files_are_refused(tmp_path):
     binary.write_bytes(b"\x18\x00\x00\x00" + b"\0" * 40)
     with pytest.raises(FEModelError, match="binary OUTPUT4"):
         read_op4(binary)
-    complex_ = tmp_path / "complex.op4"
-    complex_.write_text("       1       1       1       3CX      1P,3E22.15\n")
-    with pytest.raises(FEModelError, match="complex"):
-        read_op4(complex_)
+    other = tmp_path / "other.op4"
+    other.write_text("       1       1       1       7CX      1P,3E22.15\n")
+    with pytest.raises(FEModelError, match="precision type 7"):
+        read_op4(other)
     with pytest.raises(FEModelError, match="no matrix KXX"):
         read_superelement(OP4, PCH, stiffness="KXX")

@@ -8,7 +8,7 @@ basic coordinate system, SI as written. docs/fe-models.md, "Nastran".
 
 - :func:`read_op4`: the matrices of a formatted (ASCII) OUTPUT4 file, dense columns and
   sparse strings (the non-BIGMAT string header ``IS = IROW + 65536 (L + 1)`` and the
-  BIGMAT pair ``L, IROW``), real single or double precision.
+  BIGMAT pair ``L + 1, IROW``), real or complex, single or double precision.
 - :func:`read_bulk`: the ``GRID``, ``CORD2R``, ``SPOINT``, ``ASET``/``ASET1``/``QSET1``
   cards of a bulk data file in small, large (``*``) or free (``,``) field, with
   Nastran's reals (``1.5-3`` is 1.5e-3).
@@ -23,8 +23,8 @@ basic coordinate system, SI as written. docs/fe-models.md, "Nastran".
   motions to 1e-11 in this frame, and to 1e-2 only with the grids placed in the
   assembly's basic (tests/test_nastran.py).
 
-What is not read is refused by name (binary OUTPUT4, complex matrices, cylindrical and
-spherical systems), never skipped.
+What is not read is refused by name (binary OUTPUT4, cylindrical and spherical
+systems), never skipped.
 """
 
 from __future__ import annotations
@@ -42,8 +42,10 @@ from rt70.fe.neutral import FEModel, FEModelError
 
 #: 65536: the packing base of a non-BIGMAT string header.
 _PACK = 1 << 16
-#: Words per value of each OUTPUT4 precision type (1 RSP, 2 RDP; 3, 4 complex: refused).
-_WORDS = {1: 1, 2: 2}
+#: Words per number of each OUTPUT4 precision type (1 RSP, 2 RDP, 3 CSP, 4 CDP) and
+#: whether its values are complex (two numbers, real and imaginary).
+_WORDS = {1: 1, 2: 2, 3: 1, 4: 2}
+_COMPLEX = {3, 4}
 _NASTRAN_REAL = re.compile(r"^([+-]?(?:\d+\.?\d*|\.\d+))([+-]\d+)$")
 
 
@@ -53,8 +55,8 @@ def read_op4(path: str | Path) -> dict[str, sp.csc_array]:
     Raises
     ------
     FEModelError
-        A missing or binary file, a complex matrix, or a record that does not parse
-        (naming the file, the matrix and the line).
+        A missing or binary file, or a record that does not parse (naming the file, the
+        matrix and the line).
     """
     path = Path(path)
     try:
@@ -85,7 +87,7 @@ def _op4_matrix(path: Path, lines: list[str], i: int) -> tuple[str, sp.csc_array
     name = head[32:40].strip()
     where = f"{path}: matrix {name}"
     if ntype not in _WORDS:
-        raise FEModelError(f"{where}: precision type {ntype} (complex) is not read")
+        raise FEModelError(f"{where}: precision type {ntype} is not one of 1–4")
     fmt = re.search(r"(\d+)E(\d+)\.(\d+)", head[40:].upper())
     if fmt is None:
         raise FEModelError(f"{where}: no E-format in the header '{head[40:].strip()}'")
@@ -93,24 +95,28 @@ def _op4_matrix(path: Path, lines: list[str], i: int) -> tuple[str, sp.csc_array
     bigmat, nrow = nrow < 0, abs(nrow)
     words = _WORDS[ntype]
     rows, cols, vals = [], [], []
+    pair = 2 if ntype in _COMPLEX else 1  # numbers per value
     i += 1
     while True:
         icol, irow, nw = _ints(path, lines, i, 3)
         i += 1
         if icol > ncol:  # the closing record and its dummy value
-            _, i = _reals(path, lines, i, nw // words, per_line, width)
+            _, i = _reals(path, lines, i, nw, per_line, width)
             break
-        if irow:  # one dense run from irow
-            values, i = _reals(path, lines, i, nw // words, per_line, width)
-            run = [(irow - 1 + k, v) for k, v in enumerate(values)]
+        if irow:  # one dense run of nw numbers from irow (a formatted file counts numbers)
+            numbers, i = _reals(path, lines, i, nw, per_line, width)
+            run = list(enumerate(_values(numbers, pair), start=irow - 1))
         else:  # sparse strings
-            run, i = _strings(path, lines, i, nw, words, bigmat, per_line, width)
+            run, i = _strings(path, lines, i, nw, words, bigmat, per_line, width, pair)
         rows.extend(r for r, _ in run)
         cols.extend([icol - 1] * len(run))
         vals.extend(v for _, v in run)
     if rows and (min(rows) < 0 or max(rows) >= nrow):
         raise FEModelError(f"{where}: a row outside 1…{nrow}")
-    matrix = sp.csc_array(sp.coo_array((vals, (rows, cols)), shape=(nrow, ncol)))
+    dtype = complex if pair == 2 else float
+    matrix = sp.csc_array(
+        sp.coo_array((np.array(vals, dtype=dtype), (rows, cols)), shape=(nrow, ncol))
+    )
     return name, matrix, i
 
 
@@ -154,11 +160,13 @@ def _strings(
     bigmat: bool,
     per_line: int,
     width: int,
+    pair: int,
 ) -> tuple[list[tuple[int, float]], int]:
     """The (row, value) pairs of a sparse column of ``nw`` words from line ``i``.
 
-    Each string: its header — one integer ``IS = IROW + 65536 (L + 1)``, or two, ``L``
-    and ``IROW``, in a BIGMAT matrix — on a line of its own, then its ``L`` words.
+    Each string: its header — one integer ``IS = IROW + 65536 (L + 1)``, or two, ``L + 1``
+    and ``IROW``, in a BIGMAT matrix — on a line of its own, then its ``L`` words
+    (``words`` a number, ``pair`` numbers a value).
     """
     out: list[tuple[int, float]] = []
     used = 0
@@ -172,10 +180,17 @@ def _strings(
             length = head[0] // _PACK - 1
             irow = head[0] - _PACK * (length + 1)
             used += 1
-        values, i = _reals(path, lines, i, length // words, per_line, width)
-        out.extend((irow - 1 + k, v) for k, v in enumerate(values))
+        numbers, i = _reals(path, lines, i, length // words, per_line, width)
+        out.extend(enumerate(_values(numbers, pair), start=irow - 1))
         used += length
     return out, i
+
+
+def _values(numbers: list[float], pair: int) -> list:
+    """The numbers as values: themselves, or (real, imaginary) pairs as complex."""
+    if pair == 1:
+        return numbers
+    return [complex(a, b) for a, b in zip(numbers[::2], numbers[1::2], strict=True)]
 
 
 @dataclass
