@@ -265,6 +265,7 @@ RT70_MODULES = (
     "rt70.scenes.rt70_drives",
     "rt70.scenes.rt70_optics",
     "rt70.scenes.rt70_wind",
+    "rt70.scenes.rt70_visuals",
     "rt70.scenes.rt70_scenes",
 )
 
