@@ -70,7 +70,7 @@ def elastic_force(model, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.
         Book coordinates and velocities.
     """
     Qc, Qd = np.zeros(model.nv), np.zeros(model.nv)
-    for body, eta in _modal_slices(model):
+    for body, eta in model.modal_slices:
         Qc[eta] -= body.stiffness @ q[eta]
         Qd[eta] -= body.damping @ qd[eta]
     return Qc, Qd
@@ -78,13 +78,13 @@ def elastic_force(model, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.
 
 def elastic_potential(model, q: np.ndarray) -> float:
     """``Σ ½ ηᵀ K_η η`` of the modal bodies, J."""
-    return float(sum(0.5 * q[eta] @ body.stiffness @ q[eta] for body, eta in _modal_slices(model)))
+    return float(sum(0.5 * q[eta] @ body.stiffness @ q[eta] for body, eta in model.modal_slices))
 
 
-def _modal_slices(model) -> list[tuple[ModalBody, slice]]:
-    """Each modal body and its coordinates' slice of the book coordinates."""
+def modal_slices(bodies, names: list[str]) -> list[tuple[ModalBody, slice]]:
+    """Each modal body and its coordinates' slice of the book coordinates ``names``."""
     out = []
-    for body in model.modal_bodies:
-        start = model.coordinate_names.index(body.coordinate_names[0])
+    for body in bodies:
+        start = names.index(body.coordinate_names[0])
         out.append((body, slice(start, start + body.modes)))
     return out

@@ -18,7 +18,7 @@ import pinocchio as pin
 
 from rt70.errors import Rt70Error
 from rt70.reference.limits import check_reference
-from rt70.reference.modal_nodes import add_nodes
+from rt70.reference.modal_nodes import add_nodes, modal_slices
 from rt70.reference.parse import parse_urdf
 from rt70.urdf.beams import expand_beams
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
@@ -126,6 +126,8 @@ class ReferenceModel:
         (:mod:`rt70.reference.modal_nodes`).
     urdf_joints : list of int
         Pinocchio's joints that are the file's, in Pinocchio's order (all but the nodes').
+    modal_slices : list of (rt70.urdf.ModalBody, slice)
+        Each modal body and its coordinates' slice of the book coordinates.
     """
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
@@ -143,8 +145,9 @@ class ReferenceModel:
         self.pin_model_no_gravity = model.copy()
         self.pin_model_no_gravity.gravity.setZero()
         self.modal_bodies = desc.modal_bodies  # their stiffness and damping on η
+        node_joints = {joint for added in nodes for joint, _ in added}
         self.urdf_joints = [  # Pinocchio's joints that are the file's (not modal nodes)
-            i for i in range(1, model.njoints) if i not in {j for a in nodes for j, _ in a}
+            i for i in range(1, model.njoints) if i not in node_joints
         ]
         self.bushings = [
             Bushing(
@@ -166,6 +169,7 @@ class ReferenceModel:
         self.damping = np.array([b.damping for b in self.bushings]).reshape(-1, 6, 6)
         self.coords, self.coordinate_names = _coordinates(model, desc, nodes)
         self.identity_map = all(c.kind == "1dof" and c.book == c.iv for c in self.coords)
+        self.modal_slices = modal_slices(desc.modal_bodies, self.coordinate_names)
         joint_id = {name: i for i, name in enumerate(model.names)}
         self.spring_v = np.array(
             [model.idx_vs[joint_id[s.joint]] for s in desc.joint_springs], dtype=int

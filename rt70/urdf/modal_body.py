@@ -18,7 +18,7 @@ import scipy.linalg
 from rt70.errors import ExtensionError
 from rt70.urdf.description import ModalBody, RobotDescription
 from rt70.urdf.elements import ElementReader
-from rt70.urdf.modal_file import read_modal_file
+from rt70.urdf.modal_file import modal_mass, read_modal_file
 
 
 def read_modal_body(reader: ElementReader, elem: ET.Element, desc: RobotDescription) -> ModalBody:
@@ -70,8 +70,7 @@ def read_modal_body(reader: ElementReader, elem: ET.Element, desc: RobotDescript
                 f"{where}: the file has a damping matrix; give damping_ratio or the file's "
                 "damping, not both"
             )
-        mass = np.einsum("n,nai,naj->ij", body.masses, shapes, shapes)
-        damping = proportional_damping(mass, stiffness, zeta)
+        damping = proportional_damping(modal_mass(body.masses, shapes), stiffness, zeta)
     return ModalBody(
         name, link, str(path), body.nodes, body.masses, shapes, stiffness, damping, body.edges
     )

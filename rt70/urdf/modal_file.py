@@ -80,7 +80,12 @@ class ModalArrays:
     @property
     def modal_mass(self) -> np.ndarray:
         """``M_ηη = Σ m_n Φ_nᵀ Φ_n``, (k, k)."""
-        return np.einsum("n,nai,naj->ij", self.masses, self.shapes, self.shapes)
+        return modal_mass(self.masses, self.shapes)
+
+
+def modal_mass(masses: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+    """``M_ηη = Σ m_n Φ_nᵀ Φ_n`` of lumped masses (N,) and shapes (N, 3, k), (k, k)."""
+    return np.einsum("n,nai,naj->ij", masses, shapes, shapes)
 
 
 def write_modal_file(path: str | Path, body: ModalArrays) -> Path:
