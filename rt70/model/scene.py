@@ -15,7 +15,7 @@ from rt70.textbook.data import Data
 from rt70.textbook.massless import check_moves_mass
 from rt70.textbook.model import Model, build_model
 from rt70.urdf import RobotDescription, coordinate_names, read_urdf_string
-from rt70.urdf.beams import expand_beams
+from rt70.urdf.generated import expand_generated
 from rt70.urdf.inertia import balanced_text
 from rt70.urdf.text import prepare_text, read_source
 
@@ -163,7 +163,7 @@ def scene_from_text(
 
 
 def _scene(name: str, path: Path, text: str, source: str, balance_inertia: bool) -> Scene:
-    text = expand_beams(prepare_text(text, source), source)
+    text = expand_generated(prepare_text(text, source), source)
     desc = read_urdf_string(text, source=source, balance_inertia=balance_inertia)
     if desc.inertia_repairs:  # both sides read the repaired text, warned about once
         text = balanced_text(text, desc.inertia_repairs)

@@ -62,10 +62,10 @@ def to_pinocchio(model: ReferenceModel, q: np.ndarray, qd: np.ndarray | None = N
             else:
                 qp[iq : iq + 2] = np.cos(angle), np.sin(angle)
             J[iv, b] = c.multiplier
-        elif c.kind == "modal":  # a modal body's node: u = Φ_n η, constant
-            k = c.shape.shape[1]
-            qp[iq : iq + 3] = c.shape @ q[b : b + k]
-            J[iv : iv + 3, b : b + k] = c.shape
+        elif c.kind == "modal":  # a node (u = Φ_n η) or an interface chain joint (row · η)
+            rows, k = c.shape.shape
+            qp[iq : iq + rows] = c.shape @ q[b : b + k]
+            J[iv : iv + rows, b : b + k] = c.shape
         elif c.kind == "floating":
             x, phi, dx, dphi = q[b : b + 3], q[b + 3 : b + 6], qd_[b : b + 3], qd_[b + 3 : b + 6]
             # c = Rx(β) Ry(θ) Rz(α); its transpose has Pinocchio rpy ρ = −φ

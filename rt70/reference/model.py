@@ -20,7 +20,7 @@ from rt70.errors import Rt70Error
 from rt70.reference.limits import check_reference
 from rt70.reference.modal_nodes import add_nodes, modal_slices
 from rt70.reference.parse import parse_urdf
-from rt70.urdf.beams import expand_beams
+from rt70.urdf.generated import expand_generated
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
 from rt70.urdf.inertia import balanced_text
@@ -132,7 +132,7 @@ class ReferenceModel:
 
     def __init__(self, desc: RobotDescription, urdf_text: str) -> None:
         check_reference(desc)  # parser depth and memory, before Pinocchio sees the model
-        model = parse_urdf(expand_beams(urdf_text, desc.source), desc.source)
+        model = parse_urdf(expand_generated(urdf_text, desc.source), desc.source)
         self.body_frames = {}  # Pinocchio's getBodyId, without its scan of every frame
         for index, frame in enumerate(model.frames):
             if frame.type == pin.BODY:
@@ -241,7 +241,7 @@ def _coordinates(
     in the order of :func:`rt70.urdf.coordinate_names` (the file's depth-first order,
     the same as the textbook side's), so ``c.book`` is the user index of the joint's
     first coordinate. The modal bodies' node joints (``nodes``: joint and shape of each,
-    per body) map to the body's modal coordinates.
+    per body) and their interface chains' joints map to the body's modal coordinates.
     """
     mimics = {j.name: j.mimic for j in desc.joints if j.mimic is not None}
     names = coordinate_names(desc)
@@ -253,6 +253,8 @@ def _coordinates(
         seen.extend(body.coordinate_names)
         for joint, shape in added:
             node_of[joint] = (user[body.coordinate_names[0]], shape)
+        for joint, row in body.node_joints.items():  # an interface chain's: row · η
+            node_of[m.getJointId(joint)] = (user[body.coordinate_names[0]], row[None, :])
     for i in range(1, m.njoints):
         if i in node_of:
             first, shape = node_of[i]

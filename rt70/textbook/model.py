@@ -132,7 +132,12 @@ class Model:
         (:mod:`rt70.textbook.reactions` reports the wrench across each).
     modal : tuple of ModalModel
         The modal flexible bodies; their coordinates η follow the pairs' independent
-        coordinates in q (``q = [q_pairs; η]``), and move no pair.
+        coordinates in q (``q = [q_pairs; η]``), and move only the pairs of their
+        interface chains.
+    node_map : numpy.ndarray or None
+        ``H`` (n_full, n_modal): the interface chains' pair coordinates per unit η
+        (``q_full = G q_pairs + H η + q_offset``); None without interfaces (then G has
+        no zero rows).
     """
 
     name: str
@@ -162,6 +167,7 @@ class Model:
     air_density: float = DEFAULT_AIR_DENSITY
     pair_joints: list[tuple[str, ...]] = field(default_factory=list)
     modal: tuple[ModalModel, ...] = ()
+    node_map: np.ndarray | None = None
 
     @property
     def nb(self) -> int:
@@ -189,23 +195,32 @@ class Model:
         return self.n_pairs + self.n_modal
 
     def expand(self, q: np.ndarray, offset: bool = True) -> np.ndarray:
-        """``q_full = G q + q_offset`` (without the offset for velocities), pairs only."""
+        """``q_full = G q_p + H η + q_offset`` (no offset for velocities), q of shape (nv,).
+
+        ``q_p`` are the pairs' independent coordinates, η the modal ones; ``H``
+        (:attr:`node_map`) moves the interface chains' joints with η, and is absent
+        without interfaces.
+        """
+        eta = q[..., self.n_pairs :]
         if self.modal:
             q = q[..., : self.n_pairs]
         if self.G is None:
             return q
-        return self.G @ q + self.q_offset if offset else self.G @ q
+        q_full = self.G @ q + self.q_offset if offset else self.G @ q
+        return q_full if self.node_map is None else q_full + self.node_map @ eta
 
     def reduce(self, Q_full: np.ndarray) -> np.ndarray:
-        """Generalised force on the independent coordinates, ``Gᵀ Q_full``.
+        """Generalised force on the independent coordinates, ``[Gᵀ; Hᵀ] Q_full``.
 
-        ``Q_full`` (n_full, …) is on the pairs' coordinates; the modal coordinates' rows
-        are zero (no pair moves with them).
+        ``Q_full`` (n_full, …) is on the pairs' coordinates; a modal coordinate's row is
+        what the interface chains' joints take from it (zero without interfaces).
         """
         Q = Q_full if self.G is None else self.G.T @ Q_full
         if not self.modal:
             return Q
-        return np.concatenate([Q, np.zeros((self.n_modal,) + Q.shape[1:])])
+        if self.node_map is None:
+            return np.concatenate([Q, np.zeros((self.n_modal,) + Q.shape[1:])])
+        return np.concatenate([Q, self.node_map.T @ Q_full])
 
     def coords(self, j: int) -> slice:
         """Slice of pair j's coordinates in q."""
@@ -264,6 +279,9 @@ def build_model(desc: RobotDescription) -> Model:
     ]
     ndof_arr = np.array(pairs.ndof, dtype=int)
     G, q_offset, independent = _mimic_constraints(pairs.coord_names, desc)
+    G, q_offset, independent, node_map = _node_constraints(
+        pairs.coord_names, desc, G, q_offset, independent
+    )
     return Model(
         name=desc.name,
         parent=np.array(pairs.parent, dtype=int),
@@ -292,6 +310,7 @@ def build_model(desc: RobotDescription) -> Model:
         air_density=desc.air_density,
         pair_joints=pairs.pair_joints,
         modal=place_modal_bodies(desc.modal_bodies, link_frames, len(independent)),
+        node_map=node_map,
     )
 
 
@@ -450,6 +469,37 @@ def _mimic_constraints(
         return None, None, list(full_names)
     constraint = mimic_map(full_names, mimics)
     return constraint.T, constraint.offset, list(constraint.names)
+
+
+def _node_constraints(
+    full_names: list[str],
+    desc: RobotDescription,
+    G: np.ndarray | None,
+    q_offset: np.ndarray | None,
+    independent: list[str],
+) -> tuple[np.ndarray | None, np.ndarray | None, list[str], np.ndarray | None]:
+    """Take the interface chains' coordinates out of q: ``q_full = G q_p + H η + q_offset``.
+
+    A chain joint of a modal body's interface (:mod:`rt70.urdf.modal_interfaces`) has
+    the coordinate ``row · η``: its row of G is zero and its row of H (``node_map``,
+    n_full × n_modal) is ``row`` in the body's modal columns. Returns G, q_offset, the
+    independent pair coordinates and H (None without interfaces).
+    """
+    following = desc.node_joints
+    if not following:
+        return G, q_offset, independent, None
+    n_full = len(full_names)
+    if G is None:
+        G, q_offset = np.eye(n_full), np.zeros(n_full)
+    keep = [c for c, name in enumerate(independent) if name not in following]
+    G = G[:, keep]
+    starts = np.cumsum([0] + [b.modes for b in desc.modal_bodies])
+    H = np.zeros((n_full, int(starts[-1])))
+    for row, name in enumerate(full_names):
+        if name in following:
+            body, coefficients = following[name]
+            H[row, starts[body] : starts[body + 1]] = coefficients
+    return G, q_offset, [independent[c] for c in keep], H
 
 
 def _unskew(m: np.ndarray) -> np.ndarray:

@@ -237,12 +237,21 @@ def ground_inertias(model: Model, data: Work) -> np.ndarray:
 
 
 def _expand_batch(model: Model, Q: np.ndarray, offset: bool = True) -> np.ndarray:
+    """:meth:`Model.expand` of K rows, (K, nv) → (K, n_full)."""
+    eta = Q[:, model.n_pairs :]
     if model.modal:
         Q = Q[:, : model.n_pairs]
     if model.G is None:
         return Q
     out = Q @ model.G.T
+    if model.node_map is not None:
+        out += eta @ model.node_map.T
     return out + model.q_offset if offset else out
+
+
+def _reduce_batch(model: Model, tau: np.ndarray) -> np.ndarray:
+    """:meth:`Model.reduce` of K rows, (K, n_full) → (K, nv)."""
+    return model.reduce(tau.T).T
 
 
 def _check_batch(name: str, Q: np.ndarray, nv: int) -> np.ndarray:
@@ -287,9 +296,14 @@ def mass_matrix_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarra
         if direct:
             continue
         A = data.A[start:stop]
-        A[:, :n, :n] = out if model.G is None else model.G.T @ out @ model.G
+        if model.node_map is not None:
+            F = model.reduce(np.eye(model.n_full)).T  # q̇_full = [G H] q̇
+            A[:] = F.T @ out @ F
+        else:
+            A[:, :n, :n] = out if model.G is None else model.G.T @ out @ model.G
         if model.modal:
-            A[:, n:, :], A[:, :n, n:] = 0.0, 0.0
+            if model.node_map is None:
+                A[:, n:, :], A[:, :n, n:] = 0.0, 0.0
             for c in range(stop - start):
                 frames = _modal_frames(model, work, c)
                 A[c] += modal_bodies.mass_matrix_terms(model, frames, Q[start + c])
@@ -422,12 +436,9 @@ def bias_force_batch(model: Model, data: BatchData, Q: np.ndarray, Qd: np.ndarra
     h = theta0 @ V[..., None]  # momenta Θ⁰ V⁰
     f = (theta0 @ a[..., None] - np.swapaxes(crm, -1, -2) @ h)[..., 0]  # Θa + Φ(V) Θ V
     f_c = topo.anc @ f  # Σ_{j ⪰ k} f_j
-    tau = np.sum(data.sigma * f_c[:, topo.dof_body], axis=-1)
-    tau = tau if model.G is None else tau @ model.G
+    out = _reduce_batch(model, np.sum(data.sigma * f_c[:, topo.dof_body], axis=-1))
     if not model.modal:
-        return tau
-    out = np.zeros(Q.shape)
-    out[:, : model.n_pairs] = tau
+        return out
     for c in range(Q.shape[0]):
         frames = _modal_frames(model, data, c, a[c])
         out[c] += modal_bodies.bias_terms(model, frames, Q[c], Qd[c])
@@ -474,12 +485,9 @@ def gravity_force_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndar
     forward_kinematics_batch(model, data, _expand_batch(model, Q))
     theta0 = ground_inertias(model, data)
     w = topo.anc @ (theta0[..., :, :3] @ model.gravity)  # Σ_{j ⪰ k} Θ⁰_j [g0; 0]
-    tau = np.sum(data.sigma * w[:, topo.dof_body], axis=-1)
-    tau = tau if model.G is None else tau @ model.G
+    out = _reduce_batch(model, np.sum(data.sigma * w[:, topo.dof_body], axis=-1))
     if not model.modal:
-        return tau
-    out = np.zeros(Q.shape)
-    out[:, : model.n_pairs] = tau
+        return out
     for c in range(Q.shape[0]):
         out[c] += modal_bodies.gravity_terms(model, _modal_frames(model, data, c), Q[c])
     return out

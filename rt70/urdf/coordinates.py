@@ -7,7 +7,9 @@ The order is the file's: a depth-first walk of the kinematic tree from the root 
 the child joints of a link in document order; every joint that moves contributes its
 coordinates (``joint`` for a 1-DOF joint, ``joint:x`` … ``joint:rz`` for a floating
 joint, ``joint:x``, ``joint:y``, ``joint:rz`` for a planar one); ``fixed`` joints and
-``<mimic>`` joints (which follow their source, ``q = k q_s + o``) have none. The modal
+``<mimic>`` joints (which follow their source, ``q = k q_s + o``) and the joints of a modal
+body's interface chains (which follow its modes, :mod:`rt70.urdf.modal_interfaces`) have
+none. The modal
 coordinates of the modal bodies follow all of them, ``body:eta1`` … for each
 ``<rt70:modal_body>`` in document order.
 
@@ -44,10 +46,11 @@ def coordinate_names(desc: RobotDescription) -> list[str]:
     for joint in desc.joints:
         children.setdefault(joint.parent, []).append(joint)
     names: list[str] = []
+    following = desc.node_joints
     stack = list(reversed(children.get(desc.root, [])))
     while stack:  # depth-first, siblings in document order (no recursion: long chains)
         joint = stack.pop()
-        if joint.type != "fixed" and joint.mimic is None:
+        if joint.type != "fixed" and joint.mimic is None and joint.name not in following:
             names.extend(joint.name + sfx for sfx in SUFFIXES.get(joint.type, ("",)))
         stack.extend(reversed(children.get(joint.child, [])))
     for body in desc.modal_bodies:

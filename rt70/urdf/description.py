@@ -478,6 +478,19 @@ class RobotDescription:
     beams: tuple[Beam, ...] = ()
     modal_bodies: tuple[ModalBody, ...] = ()
 
+    @property
+    def node_joints(self) -> dict[str, tuple[int, np.ndarray]]:
+        """The interface chains' joints (``<rt70:interface>``): ``{joint: (body, row)}``.
+
+        Not coordinates: joint ``j``'s coordinate is ``row · η`` of modal body ``body``
+        (an index into :attr:`modal_bodies`).
+        """
+        return {
+            j: (b, row)
+            for b, body in enumerate(self.modal_bodies)
+            for j, row in body.node_joints.items()
+        }
+
     def joint(self, name: str) -> Joint:
         """Return the joint called ``name`` (KeyError if there is none)."""
         for joint in self.joints:

@@ -19,6 +19,7 @@ from rt70.errors import ExtensionError
 from rt70.urdf.description import ModalBody, RobotDescription
 from rt70.urdf.elements import ElementReader
 from rt70.urdf.modal_file import modal_mass, read_modal_file
+from rt70.urdf.modal_interfaces import body_file, read_interfaces
 
 
 def read_modal_body(reader: ElementReader, elem: ET.Element, desc: RobotDescription) -> ModalBody:
@@ -48,10 +49,7 @@ def read_modal_body(reader: ElementReader, elem: ET.Element, desc: RobotDescript
     name = reader.name_of(elem)
     where = f"{reader.source}: <rt70:modal_body name='{name}'>"
     link = reader.link_ref(elem, "link", desc, where)
-    raw_file = elem.get("file", "")
-    path = Path(raw_file)
-    if not path.is_absolute() and Path(reader.source).is_file():
-        path = Path(reader.source).parent / path
+    path = body_file(reader, elem)
     body = read_modal_file(path, where)
     k = body.modes
     raw = elem.get("modes", str(k))
@@ -71,9 +69,11 @@ def read_modal_body(reader: ElementReader, elem: ET.Element, desc: RobotDescript
                 "damping, not both"
             )
         damping = proportional_damping(modal_mass(body.masses, shapes), stiffness, zeta)
+    interfaces = read_interfaces(reader, elem, body, keep, where)
     return ModalBody(
-        name, link, str(path), body.nodes, body.masses, shapes, stiffness, damping, body.edges
-    )
+        name, link, str(path), body.nodes, body.masses, shapes, stiffness, damping, body.edges,
+        interfaces,
+    )  # fmt: skip
 
 
 def proportional_damping(mass: np.ndarray, stiffness: np.ndarray, zeta: float) -> np.ndarray:

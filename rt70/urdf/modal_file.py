@@ -12,6 +12,9 @@ masses     (N,)         their lumped translational masses ``m_n``, kg (≥ 0)
 shapes     (N, 3, k)    ``Φ_n``: each node's displacement per unit modal coordinate
 stiffness  (k, k)       the modal stiffness ``K_η`` (symmetric, positive semidefinite)
 damping    (k, k)       optional: the modal damping ``D_η`` (symmetric, psd)
+rotations  (N, 3, k)    optional: each node's small rotation per unit modal coordinate
+                        (a rotation vector in the body frame; used only where a link is
+                        attached to the node, ``<rt70:interface>``)
 edges      (E, 2)       optional: node index pairs drawn as lines (the FE mesh's edges)
 source     ()           optional: where the body came from (a free text)
 ========== ============ ===========================================================
@@ -62,6 +65,9 @@ class ModalArrays:
     source : str
     edges : numpy.ndarray of int, shape (E, 2)
         Node index pairs drawn as lines (none when the file has none).
+    rotations : numpy.ndarray or None, shape (N, 3, k)
+        The nodes' small rotations per unit modal coordinate; None when the file has none
+        (a link attached to a node then keeps the body frame's orientation).
     """
 
     nodes: np.ndarray
@@ -71,6 +77,7 @@ class ModalArrays:
     damping: np.ndarray
     source: str = ""
     edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+    rotations: np.ndarray | None = None
 
     @property
     def modes(self) -> int:
@@ -110,6 +117,8 @@ def write_modal_file(path: str | Path, body: ModalArrays) -> Path:
         "edges": body.edges,
         "source": np.array(body.source),
     }
+    if body.rotations is not None:
+        arrays["rotations"] = body.rotations
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".npz")
     try:
         with os.fdopen(fd, "wb") as handle, zipfile.ZipFile(handle, "w") as archive:
@@ -164,6 +173,7 @@ def read_modal_file(path: str | Path, where: str) -> ModalArrays:
         damping=np.asarray(arrays.get("damping", np.zeros((k, k))), dtype=float),
         source=str(arrays.get("source", "")),
         edges=np.asarray(arrays.get("edges", np.zeros((0, 2))), dtype=np.int64),
+        rotations=np.asarray(arrays["rotations"], dtype=float) if "rotations" in arrays else None,
     )
     check_arrays(body, f"{where}: '{path}'")
     return body
@@ -181,6 +191,8 @@ def check_arrays(body: ModalArrays, where: str) -> None:
         "stiffness": (body.stiffness, (k, k)),
         "damping": (body.damping, (k, k)),
     }
+    if body.rotations is not None:
+        expected["rotations"] = (body.rotations, (n, 3, k))
     if k < 1:
         raise ExtensionError(f"{where}: shapes has shape {body.shapes.shape}, expected (N, 3, k)")
     for key, (array, shape) in expected.items():

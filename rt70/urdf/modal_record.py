@@ -13,6 +13,34 @@ import numpy as np
 
 
 @dataclass(frozen=True)
+class Interface:
+    """A link attached to a node of a modal body (``<rt70:interface>``).
+
+    The link sits at the node, its axes the body frame's, and moves with the node:
+    translated by ``u = Φ_n η`` and, when the file gives the node's rotations, turned by
+    ``Rx(θ_x) Ry(θ_y) Rz(θ_z)`` with ``θ = Ψ_n η``. Both sides see it as a chain of
+    one-coordinate joints from the body's link — prismatic x, y, z, then revolute x, y, z —
+    whose coordinates are not free: joint i's is ``rows[i] · η``.
+
+    Attributes
+    ----------
+    link : str
+        The attached link (generated: the file's joints use it as a parent).
+    node : int
+        The node's index in the modal body file (from 0).
+    joints : tuple of str
+        The chain's joints, from the body's link to ``link``.
+    rows : numpy.ndarray, shape (len(joints), k)
+        Each chain joint's coordinate per unit modal coordinate.
+    """
+
+    link: str
+    node: int
+    joints: tuple[str, ...]
+    rows: np.ndarray
+
+
+@dataclass(frozen=True)
 class ModalBody:
     """A modal flexible body on a link (``<rt70:modal_body>``), its arrays checked.
 
@@ -31,6 +59,8 @@ class ModalBody:
         ``K_η`` and ``D_η``, (k, k).
     edges : numpy.ndarray of int, shape (E, 2)
         Node index pairs drawn as lines (the mesh's edges; may be empty).
+    interfaces : tuple of Interface
+        The links attached to its nodes.
     """
 
     name: str
@@ -42,6 +72,7 @@ class ModalBody:
     stiffness: np.ndarray
     damping: np.ndarray
     edges: np.ndarray
+    interfaces: tuple[Interface, ...] = ()
 
     @property
     def modes(self) -> int:
@@ -52,3 +83,8 @@ class ModalBody:
     def coordinate_names(self) -> list[str]:
         """``name:eta1`` … ``name:etak``."""
         return [f"{self.name}:eta{i + 1}" for i in range(self.modes)]
+
+    @property
+    def node_joints(self) -> dict[str, np.ndarray]:
+        """Every interface chain joint and its row: its coordinate is ``row · η``."""
+        return {j: row for i in self.interfaces for j, row in zip(i.joints, i.rows, strict=True)}

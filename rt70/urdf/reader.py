@@ -18,7 +18,7 @@ from rt70.errors import (
     UrdfError,
 )
 from rt70.physics.rotations import rpy_matrix
-from rt70.urdf.beams import expand_beams
+from rt70.urdf.generated import expand_generated
 from rt70.urdf.description import (
     URDF_JOINT_TYPES,
     Inertial,
@@ -96,7 +96,7 @@ def read_urdf_string(
     UrdfError
         (or a subclass) as :func:`read_urdf`.
     """
-    text = expand_beams(prepare_text(text, source), source)
+    text = expand_generated(prepare_text(text, source), source)
     refuse_entities(text, source)
     root, prefixes = parse(text, source)
     return _Reader(source, balance_inertia, prefixes).robot(root)

@@ -117,7 +117,11 @@ RT70 = Spec(
             )
         ),
         "modal_body": Child(
-            Spec(required=("name", "link", "file"), optional=("modes", "damping_ratio"))
+            Spec(
+                required=("name", "link", "file"),
+                optional=("modes", "damping_ratio"),
+                children={"interface": Child(Spec(required=("link", "node")))},
+            )
         ),
         "drive": Child(
             Spec(
