@@ -36,7 +36,12 @@ def state_locks(scene: Scene, q: np.ndarray) -> list[tuple[list[Lock], float]]:
     """
     bits = np.frombuffer(np.ascontiguousarray(q, dtype=float).tobytes(), dtype=np.uint32)
     rng = np.random.default_rng(bits[::2].copy())
-    joints = [j.name for j in scene.description.joints if j.type in BRAKE_JOINT_TYPES]
+    following = scene.description.node_joints  # they move with the modes: no brake
+    joints = [
+        j.name
+        for j in scene.description.joints
+        if j.type in BRAKE_JOINT_TYPES and j.name not in following
+    ]
     links = [n for n, (b, _, _) in scene.textbook.link_frames.items() if b >= 0]
     brake = joints[int(rng.integers(len(joints)))] if joints else None
     link = links[int(rng.integers(len(links)))]

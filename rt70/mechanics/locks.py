@@ -111,7 +111,8 @@ def check_locks(scene: Scene, locks: Sequence[Lock]) -> None:
     ------
     Rt70Error
         No lock; a brake on a joint that does not exist or is not 1-DOF (a mimic joint
-        is fine, a fixed, floating or planar joint is not).
+        is fine; a fixed, floating or planar joint is not, nor a joint of an interface
+        chain).
     UnknownLinkError
         A stow pin on a link without a frame on the textbook side, or on the ground.
     """
@@ -133,6 +134,11 @@ def check_locks(scene: Scene, locks: Sequence[Lock]) -> None:
                 raise Rt70Error(
                     f"{scene.path}: brake on joint '{lock.joint}': it is {joint.type}, "
                     "not a 1-DOF joint"
+                )
+            if lock.joint in scene.description.node_joints:
+                raise Rt70Error(
+                    f"{scene.path}: brake on joint '{lock.joint}': it carries a link on a "
+                    "modal body's node (<rt70:interface>) and moves with the modes"
                 )
         elif isinstance(lock, StowPin):
             if lock.link not in frames or frames[lock.link][0] < 0:
