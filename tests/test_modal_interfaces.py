@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_modal_bodies import NS, ROUNDING, deep_tree, states
 
 from rt70.errors import ExtensionError
 from rt70.model.scene import scene_from_text
@@ -30,7 +31,6 @@ from rt70.textbook import forces as tb_forces
 from rt70.textbook import reactions as tb_reactions
 from rt70.textbook import structured
 from rt70.urdf.modal_file import read_modal_file, write_modal_file
-from test_modal_bodies import NS, ROUNDING, deep_tree, states
 
 RNG = np.random.default_rng(20261128)
 NODE = 5  # a node of the truss arm off its clamped face

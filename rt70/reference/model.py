@@ -20,9 +20,9 @@ from rt70.errors import Rt70Error
 from rt70.reference.limits import check_reference
 from rt70.reference.modal_nodes import add_nodes, modal_slices
 from rt70.reference.parse import parse_urdf
-from rt70.urdf.generated import expand_generated
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
+from rt70.urdf.generated import expand_generated
 from rt70.urdf.inertia import balanced_text
 from rt70.urdf.text import prepare_text
 

@@ -18,7 +18,6 @@ from rt70.errors import (
     UrdfError,
 )
 from rt70.physics.rotations import rpy_matrix
-from rt70.urdf.generated import expand_generated
 from rt70.urdf.description import (
     URDF_JOINT_TYPES,
     Inertial,
@@ -30,6 +29,7 @@ from rt70.urdf.description import (
 )
 from rt70.urdf.elements import ONE_DOF_JOINT_TYPES, ElementReader
 from rt70.urdf.extensions import read_extensions
+from rt70.urdf.generated import expand_generated
 from rt70.urdf.inertia import balanced_moments, inertia_defect, principal_moments
 from rt70.urdf.schema import check_scene
 from rt70.urdf.text import (
