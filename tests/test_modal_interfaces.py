@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from test_modal_bodies import NS, ROUNDING, deep_tree, states
 
-from rt70.errors import ExtensionError
+from rt70.errors import ExtensionError, Rt70Error
 from rt70.model.scene import scene_from_text
 from rt70.reference import dynamics as ref_dynamics
 from rt70.reference import forces as ref_forces
@@ -201,3 +201,24 @@ def test_a_file_with_rotations_of_the_wrong_shape_is_refused(tmp_path):
     bad = dataclasses.replace(arm, rotations=np.zeros((3, 3, 4)))
     with pytest.raises(ExtensionError, match="rotations has shape"):
         write_modal_file(tmp_path / "bad.npz", bad)
+
+
+def test_the_corner_as_a_boundary_node_is_its_displacement(tmp_path):
+    """Constraint modes of an interface node first: its rows of the shapes are the unit
+    matrix there, the file stays sound, and with every coordinate the scene with a mass
+    on the corner is again the FE model with the mass."""
+    corner = slewing_truss.tip_node() + 1
+    arm = modal_scenes.truss_arm(modes=5, interface=(corner,))
+    node = int(np.argmax(arm.nodes.sum(axis=1)))
+    assert arm.shapes.shape[2] == 8
+    assert_close(arm.shapes[node, :, :3], np.eye(3), rel=ROUNDING)
+    assert_close(arm.shapes[node, :, 3:], np.zeros((3, 5)), rel=ROUNDING, scale=1.0)
+    write_modal_file(tmp_path / "checked.npz", arm)  # symmetric, semidefinite, massive
+    full = slewing_truss.interior_dofs() - 3
+    found = slewing_truss.modal_frequencies(full, tmp_path, 6, 150.0, corner_modes=True)
+    assert_close(found, slewing_truss.direct_frequencies(6, tip_mass=150.0), rel=1e-7)
+
+
+def test_a_clamped_node_cannot_be_an_interface_node():
+    with pytest.raises(Rt70Error, match="both clamped and an interface node"):
+        modal_scenes.truss_arm(modes=4, interface=(1,))

@@ -6,6 +6,15 @@ lumped-mass FE model of translational DOFs. The body's frame holds the ``clamped
 modes of the Craig–Bampton reduction on those nodes (:func:`rt70.fe.craig_bampton`):
 ``u_i = Φ η`` on the interior, zero on the clamped nodes; mass-normalised, so the modal
 mass is 1 and the modal stiffness ``diag(ω²)``.
+
+Nodes where the body carries something (``interface``: a link hangs there,
+``<rt70:interface>``) are best made boundary nodes too: their three constraint modes —
+the body's static shape for a unit displacement of the node, the clamp held — come first
+among the coordinates (the coordinate is the node's displacement itself), then the
+fixed-interface modes with the clamp and those nodes held. This is the Craig–Bampton
+basis on the clamp and the interface nodes with the clamp's own motion the frame's; it
+holds the static stiffness at the node exactly, which modes of the bare structure do not
+when a heavy body sits on a free node (docs/fe-models.md, "Links on the nodes").
 """
 
 from __future__ import annotations
@@ -33,9 +42,12 @@ class ClampedModes:
     shapes : numpy.ndarray, shape (N, 3, k)
         Mode shapes, zero on the clamped nodes.
     stiffness : numpy.ndarray, shape (k, k)
-        ``diag(ω²)``, (rad/s)² per unit modal mass.
+        The modal stiffness: the interface nodes' condensed stiffness (N/m) in the first
+        ``n_interface`` rows and columns, then ``diag(ω²)``, (rad/s)² per unit modal mass.
     edges : numpy.ndarray of int, shape (E, 2)
         The pairs of nodes K couples (a truss's bars, a mesh's element edges), for drawing.
+    n_interface : int
+        The constraint modes first among the coordinates (three per interface node).
     """
 
     nodes: np.ndarray
@@ -43,14 +55,18 @@ class ClampedModes:
     shapes: np.ndarray
     stiffness: np.ndarray
     edges: np.ndarray
+    n_interface: int = 0
 
     @property
     def freq_hz(self) -> np.ndarray:
-        """The modes' frequencies, Hz."""
-        return np.sqrt(np.diag(self.stiffness)) / (2.0 * np.pi)
+        """The fixed-interface modes' frequencies, Hz."""
+        omega2 = np.diag(self.stiffness)[self.n_interface :]
+        return np.sqrt(omega2) / (2.0 * np.pi)
 
 
-def clamped_modes(model: FEModel, clamped: list[int], n_modes: int) -> ClampedModes:
+def clamped_modes(
+    model: FEModel, clamped: list[int], n_modes: int, interface: list[int] | tuple = ()
+) -> ClampedModes:
     """The ``n_modes`` lowest modes of ``model`` with the ``clamped`` nodes held.
 
     Parameters
@@ -60,14 +76,18 @@ def clamped_modes(model: FEModel, clamped: list[int], n_modes: int) -> ClampedMo
     clamped : list of int
         Node numbers of the nodes held by the body frame.
     n_modes : int
-        Modes kept (the lowest).
+        Fixed-interface modes kept (the lowest).
+    interface : sequence of int
+        Node numbers of free nodes kept as boundary nodes: their constraint modes come
+        first (module docstring); empty: none.
 
     Raises
     ------
     Rt70Error
         A node without exactly its three translations, a mass matrix that is not
-        diagonal or not equal on a node's three rows, an unknown clamped node, or the
-        reduction's own errors (a boundary that does not hold the structure).
+        diagonal or not equal on a node's three rows, an unknown clamped or interface
+        node, an interface node that is clamped, or the reduction's own errors (a
+        boundary that does not hold the structure).
     """
     ids = np.asarray(model.node_ids)
     node_rows = [model.dofs_of(int(n)) for n in ids.tolist()]
@@ -81,22 +101,29 @@ def clamped_modes(model: FEModel, clamped: list[int], n_modes: int) -> ClampedMo
     masses = diagonal[rows]
     if np.any(masses != masses[:, :1]):
         raise Rt70Error(f"{model.name}: a node's three translations have different masses")
-    unknown = sorted(set(clamped) - set(ids.tolist()))
-    if unknown:
-        raise Rt70Error(f"{model.name}: clamped node {unknown[0]} is not in the node table")
-    boundary = np.concatenate([model.dofs_of(int(n)) for n in clamped])
-    cb = craig_bampton(model.M, model.K, boundary, n_modes)
-    nb = cb.n_boundary
-    shapes = cb.T[:, nb:][rows]  # (N, 3, k): zero on the clamped rows
-    flat = shapes.reshape(-1, shapes.shape[2])
+    for kind, nodes in (("clamped", clamped), ("interface", interface)):
+        unknown = sorted(set(nodes) - set(ids.tolist()))
+        if unknown:
+            raise Rt70Error(f"{model.name}: {kind} node {unknown[0]} is not in the node table")
+    both = sorted(set(clamped) & set(interface))
+    if both:
+        raise Rt70Error(f"{model.name}: node {both[0]} is both clamped and an interface node")
+    held = np.concatenate([model.dofs_of(int(n)) for n in clamped])
+    free = [model.dofs_of(int(n)) for n in interface]
+    cb = craig_bampton(model.M, model.K, np.concatenate([held, *free]), n_modes)
+    keep = np.arange(held.size, cb.T.shape[1])  # the clamp's columns: the frame's motion
+    shapes = cb.T[:, keep][rows]  # (N, 3, 3 n_s + k): zero on the clamped rows
+    n_s = keep.size - cb.omega2.size
+    flat = shapes[:, :, n_s:].reshape(-1, cb.omega2.size)
     sign = np.sign(flat[np.argmax(np.abs(flat), axis=0), np.arange(flat.shape[1])])
-    shapes = shapes * sign  # each mode's largest entry positive: one sign on every machine
+    shapes[:, :, n_s:] *= sign  # each mode's largest entry positive: one sign everywhere
     return ClampedModes(
         np.asarray(model.node_xyz, dtype=float),
         masses[:, 0].copy(),
         shapes,
-        np.diag(cb.omega2),
+        cb.K[np.ix_(keep, keep)],
         coupled_nodes(model, rows),
+        n_s,
     )
 
 

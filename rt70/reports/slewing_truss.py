@@ -59,7 +59,9 @@ def direct_frequencies(count: int, tip_mass: float = 0.0) -> np.ndarray:
     return np.sqrt(omega2) / (2.0 * np.pi)
 
 
-def modal_frequencies(modes: int, directory, count: int, tip_mass: float = 0.0) -> np.ndarray:
+def modal_frequencies(
+    modes: int, directory, count: int, tip_mass: float = 0.0, corner_modes: bool = False
+) -> np.ndarray:
     """The ``count`` lowest frequencies of the scene with ``modes`` modes, gravity off, Hz.
 
     Parameters
@@ -72,8 +74,12 @@ def modal_frequencies(modes: int, directory, count: int, tip_mass: float = 0.0) 
         Frequencies returned (at most ``modes + 1``).
     tip_mass : float
         A point mass (kg) on a link attached to the far top corner; 0: none.
+    corner_modes : bool
+        Make the corner a boundary node of the reduction: its three constraint modes
+        first, then ``modes`` fixed-interface modes with it held.
     """
-    arm = modal_scenes.truss_arm(modes)
+    corner = (tip_node() + 1,) if corner_modes else ()  # the FE model numbers nodes from 1
+    arm = modal_scenes.truss_arm(modes, corner)
     path = write_modal_file(directory / f"truss_{modes}.npz", arm)
     text = (
         modal_scenes.slewing_truss_scene()

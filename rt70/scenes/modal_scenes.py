@@ -34,7 +34,7 @@ TRUSS_DAMPING_RATIO = 0.005
 TRUSS_FILE = "slewing_truss.npz"
 
 
-def truss_arm(modes: int = TRUSS_MODES) -> ModalArrays:
+def truss_arm(modes: int = TRUSS_MODES, interface: tuple[int, ...] = ()) -> ModalArrays:
     """The truss clamped at its face x = 0: nodes in the hub's frame, masses, modes.
 
     The hub's frame has its origin at the centre of the clamped face, x along the truss.
@@ -43,10 +43,13 @@ def truss_arm(modes: int = TRUSS_MODES) -> ModalArrays:
     ----------
     modes : int
         Fixed-interface modes kept (the lowest).
+    interface : tuple of int
+        FE node numbers kept as boundary nodes: their constraint modes come first
+        (:func:`rt70.fe.modal_body.clamped_modes`).
     """
     fe = space_frame(**TRUSS)
     clamped = [int(n) for n, x in zip(fe.node_ids, fe.node_xyz, strict=True) if x[0] == 0.0]
-    body = clamped_modes(fe, clamped, modes)
+    body = clamped_modes(fe, clamped, modes, interface)
     centre = np.array([0.0, 0.5 * (TRUSS["ny"] - 1) * TRUSS["spacing"], 0.5 * TRUSS["depth"]])
     return ModalArrays(
         body.nodes - centre,
@@ -54,7 +57,8 @@ def truss_arm(modes: int = TRUSS_MODES) -> ModalArrays:
         body.shapes,
         body.stiffness,
         np.zeros_like(body.stiffness),
-        f"{fe.name} (rt70.fe.truss), clamped at x = 0, {modes} fixed-interface modes",
+        f"{fe.name} (rt70.fe.truss), clamped at x = 0, {modes} fixed-interface modes"
+        + (f", constraint modes of nodes {list(interface)} first" if interface else ""),
         body.edges,
     )
 
