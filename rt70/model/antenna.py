@@ -22,7 +22,7 @@ from rt70.errors import SceneError
 from rt70.model.optics import MirrorSystem, mirror_outputs
 from rt70.model.outputs import Output, Point, evaluate
 from rt70.physics.rotations import rpy_matrix
-from rt70.urdf.description import Mount, MountAxis, Optics
+from rt70.urdf.mount_record import Mount, MountAxis, Optics
 
 if TYPE_CHECKING:
     from rt70.model.scene import Scene
@@ -48,7 +48,7 @@ def within_range(axis: MountAxis, angle_deg: float) -> bool:
 
 
 def mount_of(scene: Scene) -> Mount:
-    """The scene's :class:`~rt70.urdf.description.Mount`.
+    """The scene's :class:`~rt70.urdf.mount_record.Mount`.
 
     Raises
     ------
@@ -106,7 +106,7 @@ def pointing(scene: Scene, elevation_deg: float, azimuth_deg: float = 0.0) -> di
 
 
 def optics_of(scene: Scene) -> Optics:
-    """The scene's :class:`~rt70.urdf.description.Optics`.
+    """The scene's :class:`~rt70.urdf.mount_record.Optics`.
 
     Raises
     ------

@@ -22,7 +22,8 @@ from rt70.control.servo import CascadeGains, cascade_gains
 from rt70.errors import SceneError
 from rt70.model.antenna import mount_of
 from rt70.model.scene import Scene
-from rt70.urdf.description import AxisServo, Drive, MountAxis
+from rt70.urdf.description import Drive
+from rt70.urdf.mount_record import AxisServo, MountAxis
 
 #: Position-loop design of each axis: ``{axis name: (bandwidth Hz, loop ratio)}``.
 Tuning = dict[str, tuple[float, float]]

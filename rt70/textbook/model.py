@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY
-from rt70.physics.constraints import mimic_map
+from rt70.textbook.coordinate_map import pair_coordinate_map
 from rt70.textbook.modal_model import ModalModel, place_modal_bodies
 from rt70.textbook.spatial import body_inertia, placement, rpy_matrix
 from rt70.urdf.description import Joint, RobotDescription, Wind
@@ -278,10 +278,7 @@ def build_model(desc: RobotDescription) -> Model:
         for t, m in zip(pairs.thetas, masses, strict=True)
     ]
     ndof_arr = np.array(pairs.ndof, dtype=int)
-    G, q_offset, independent = _mimic_constraints(pairs.coord_names, desc)
-    G, q_offset, independent, node_map = _node_constraints(
-        pairs.coord_names, desc, G, q_offset, independent
-    )
+    G, q_offset, independent, node_map = pair_coordinate_map(pairs.coord_names, desc)
     return Model(
         name=desc.name,
         parent=np.array(pairs.parent, dtype=int),
@@ -449,57 +446,6 @@ def _loops(desc: RobotDescription, link_frames: dict) -> list[LoopModel]:
         )
         for loop in desc.loops
     ]
-
-
-def _mimic_constraints(
-    full_names: list[str], desc: RobotDescription
-) -> tuple[np.ndarray | None, np.ndarray | None, list[str]]:
-    """``q_full = G q + q_offset`` from the URDF ``<mimic>`` elements (chapter 3).
-
-    Built by :func:`rt70.physics.constraints.mimic_map`, where every eliminated constraint is
-    defined. Returns G, q_offset (None, None without mimics) and the independent
-    coordinates.
-    """
-    mimics = {
-        j.name: (j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
-        for j in desc.joints
-        if j.mimic is not None
-    }
-    if not mimics:
-        return None, None, list(full_names)
-    constraint = mimic_map(full_names, mimics)
-    return constraint.T, constraint.offset, list(constraint.names)
-
-
-def _node_constraints(
-    full_names: list[str],
-    desc: RobotDescription,
-    G: np.ndarray | None,
-    q_offset: np.ndarray | None,
-    independent: list[str],
-) -> tuple[np.ndarray | None, np.ndarray | None, list[str], np.ndarray | None]:
-    """Take the interface chains' coordinates out of q: ``q_full = G q_p + H η + q_offset``.
-
-    A chain joint of a modal body's interface (:mod:`rt70.urdf.modal_interfaces`) has
-    the coordinate ``row · η``: its row of G is zero and its row of H (``node_map``,
-    n_full × n_modal) is ``row`` in the body's modal columns. Returns G, q_offset, the
-    independent pair coordinates and H (None without interfaces).
-    """
-    following = desc.node_joints
-    if not following:
-        return G, q_offset, independent, None
-    n_full = len(full_names)
-    if G is None:
-        G, q_offset = np.eye(n_full), np.zeros(n_full)
-    keep = [c for c, name in enumerate(independent) if name not in following]
-    G = G[:, keep]
-    starts = np.cumsum([0] + [b.modes for b in desc.modal_bodies])
-    H = np.zeros((n_full, int(starts[-1])))
-    for row, name in enumerate(full_names):
-        if name in following:
-            body, coefficients = following[name]
-            H[row, starts[body] : starts[body + 1]] = coefficients
-    return G, q_offset, [independent[c] for c in keep], H
 
 
 def _unskew(m: np.ndarray) -> np.ndarray:

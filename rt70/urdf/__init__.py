@@ -18,12 +18,11 @@ from rt70.urdf.description import (
     JointSpring,
     Link,
     Mimic,
-    Mount,
-    MountAxis,
     OpticalPoint,
     RobotDescription,
     Wind,
 )
+from rt70.urdf.mount_record import Mount, MountAxis
 from rt70.urdf.reader import read_urdf, read_urdf_string
 from rt70.urdf.text import RT70_NS
 

@@ -3,7 +3,7 @@
 One job: turn the XML of a mount — its type and, for each of its axes, the joint that
 turns it, where its angle counts from and which way, the range it points over and its
 servo (the drive it closes around, limits, design) — into a
-:class:`~rt70.urdf.description.Mount`, or refuse it with an
+:class:`~rt70.urdf.mount_record.Mount`, or refuse it with an
 :class:`~rt70.errors.ExtensionError` naming the file and the element
 (docs/urdf-extensions.md, ``<rt70:mount>``). Called by :mod:`rt70.urdf.extensions` once
 the joints and drives are known. The mount carries no dynamics: the analyses that point a structure
@@ -16,8 +16,9 @@ import math
 import xml.etree.ElementTree as ET
 
 from rt70.errors import ExtensionError
-from rt70.urdf.description import MOUNT_AXES, AxisServo, Drive, Joint, Mount, MountAxis
+from rt70.urdf.description import MOUNT_AXES, Drive, Joint
 from rt70.urdf.elements import ElementReader
+from rt70.urdf.mount_record import AxisServo, Mount, MountAxis
 from rt70.urdf.text import RT70_NS
 
 #: Joint types that can turn a pointing axis.

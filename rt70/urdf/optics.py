@@ -2,7 +2,7 @@
 
 One job: turn the XML of an optics — its type (prime focus, Cassegrain, Gregorian, beam
 waveguide), the link of its reference frame and, for each reflector, the optical points
-that are its focus and vertex — into an :class:`~rt70.urdf.description.Optics`, or refuse
+that are its focus and vertex — into an :class:`~rt70.urdf.mount_record.Optics`, or refuse
 it with an :class:`~rt70.errors.ExtensionError` naming the file and the element
 (docs/urdf-extensions.md, ``<rt70:optics>``). Called by :mod:`rt70.urdf.extensions` once
 the optical points are known. The optics carries no dynamics: the pointing outputs
@@ -14,8 +14,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from rt70.errors import ExtensionError
-from rt70.urdf.description import OPTICS_TYPES, OpticalPoint, Optics, Reflector, RobotDescription
+from rt70.urdf.description import OpticalPoint, RobotDescription
 from rt70.urdf.elements import ElementReader
+from rt70.urdf.mount_record import OPTICS_TYPES, Optics, Reflector
 from rt70.urdf.text import RT70_NS
 
 #: The roles a reflector takes in an optics.
@@ -37,7 +38,7 @@ def read_optics(reader: ElementReader, elem: ET.Element, desc: RobotDescription)
     Raises
     ------
     ExtensionError
-        If the type is not one of :data:`~rt70.urdf.description.OPTICS_TYPES`, the
+        If the type is not one of :data:`~rt70.urdf.mount_record.OPTICS_TYPES`, the
         reflectors are not the type's (a primary, and a secondary exactly when the type has
         one), a role is unknown or repeated, a focus or vertex names no optical point, a
         reflector's focus and vertex lie on different links or on the same point, a
