@@ -154,3 +154,28 @@ def test_equilibrium_stops_at_the_rounding_floor(elevation):
         assert_close(residual, np.zeros_like(residual), rel=3e-10, scale=scale)
     # at most one Newton step below STEP_TOL, on the scale its stop test uses
     assert_close(again, q, rel=lin.STEP_TOL, scale=max(1.0, np.abs(q).max()))
+
+
+def test_no_equilibrium_names_the_coordinates_without_stiffness():
+    """A boom on a sprung hinge and a free slewing base: gravity is balanced on the hinge,
+    and the slew has no stiffness at all, so Newton's K is singular along it alone."""
+    from rt70.errors import Rt70Error
+    from rt70.model.scene import scene_from_text
+
+    text = """<robot name="free_slew" xmlns:rt70="urn:rt70:urdf-extensions:1">
+  <link name="world"/>
+  <link name="base"><inertial><mass value="100"/>
+    <inertia ixx="10" iyy="10" izz="10" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="slew" type="continuous"><parent link="world"/><child link="base"/>
+    <axis xyz="0 0 1"/></joint>
+  <link name="boom"><inertial><mass value="50"/><origin xyz="1 0 0"/>
+    <inertia ixx="1" iyy="5" izz="5" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="boom"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <rt70:joint_spring name="hinge_spring" joint="hinge" stiffness="1e5"/>
+</robot>"""
+    scene = scene_from_text(text, "free_slew")
+    with pytest.raises(Rt70Error, match=r"no stiffness along 'slew' \(hold or lock"):
+        lin.equilibrium(scene)
+    q = lin.equilibrium(scene, {"slew": 0.3})  # held: the hinge's sag alone
+    assert q[0] == 0.3 and q[1] != 0.0

@@ -27,6 +27,7 @@ while the equilibrium is solved, and locked (removed) or left free in the linear
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,6 +49,10 @@ FD_STEP = 1e-6
 #: :func:`equilibrium` keeps its stiffness matrix while each Newton step cuts the force
 #: residual at least this much (a factor 10).
 REUSE_RATIO = 0.1
+#: An eigenvalue of a singular stiffness below this fraction of its largest is in its null
+#: space (the coordinates an equilibrium error names; the stiffness is differenced to
+#: about 1e-8 of its scale, so its rounding floor is far above machine precision).
+NULL_RTOL = 1e-8
 
 
 def static_force(scene: Scene, q: np.ndarray, side: str = "textbook") -> np.ndarray:
@@ -230,7 +235,7 @@ def equilibrium(
             previous = size  # the last K still converges fast: keep it (modified Newton)
         else:
             K, previous = hold.reduce_matrix(stiffness_matrix(scene, q, side=side)), size
-        step = _newton_step(scene, K, residual)
+        step = _newton_step(scene, K, residual, hold.names)
         q += hold.expand(step, offset=False)
         if float(np.max(np.abs(step), initial=0.0)) <= STEP_TOL * max(1.0, np.abs(q).max()):
             return q  # the position is fixed to rounding; what is left is the forces' rounding
@@ -250,20 +255,40 @@ def _free_residual(scene: Scene, hold: HolonomicMap, q: np.ndarray) -> tuple[np.
     return residual, size
 
 
-def _newton_step(scene: Scene, K: np.ndarray, residual: np.ndarray) -> np.ndarray:
-    """Newton's step ``K⁻¹ r`` on the free coordinates (a clear error if K cannot give it)."""
+def _newton_step(
+    scene: Scene, K: np.ndarray, residual: np.ndarray, names: tuple[str, ...]
+) -> np.ndarray:
+    """Newton's step ``K⁻¹ r`` on the free coordinates ``names``.
+
+    A K singular to working precision (no equilibrium) is a clear error naming the
+    coordinates of its null space.
+    """
     if not np.isfinite(K).all():
         raise Rt70Error(
             f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
             "largest floating-point number?)"
         )
-    try:
-        return scipy.linalg.solve(K, residual, assume_a="sym")
-    except (np.linalg.LinAlgError, ValueError):
-        raise Rt70Error(
-            f"{scene.name}: no static equilibrium: the free coordinates have no "
-            "stiffness in some direction (hold or lock it)"
-        ) from None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
+        try:
+            return scipy.linalg.solve(K, residual, assume_a="sym")
+        except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
+            pass
+    raise Rt70Error(
+        f"{scene.name}: no static equilibrium: the free coordinates have no stiffness along "
+        f"{_null_coordinates(K, names)} (hold or lock them, or give them a spring)"
+    )
+
+
+def _null_coordinates(K: np.ndarray, names: tuple[str, ...]) -> str:
+    """The coordinates that K's (numerical) null space moves, as a quoted list."""
+    w, V = np.linalg.eigh(0.5 * (K + K.T))
+    null = V[:, np.abs(w) <= NULL_RTOL * max(float(np.abs(w).max()), np.finfo(float).tiny)]
+    if null.size == 0:
+        null = V[:, [int(np.argmin(np.abs(w)))]]
+    weight = np.linalg.norm(null, axis=1)
+    moved = [n for n, x in zip(names, weight, strict=True) if x >= 0.1 * weight.max()]
+    return ", ".join(f"'{n}'" for n in moved[:8]) + (" …" if len(moved) > 8 else "")
 
 
 @dataclass
