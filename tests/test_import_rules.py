@@ -84,7 +84,7 @@ RULES = {
 FLOORS = (
     ("rt70.errors", "rt70.testing", "rt70.units"),
     ("rt70.guards", "rt70.bondgraph"),
-    ("rt70.physics", "rt70.fe"),
+    ("rt70.physics", "rt70.fe", "rt70.surface"),
     ("rt70.urdf",),
     ("rt70.textbook", "rt70.reference"),
     ("rt70.model",),

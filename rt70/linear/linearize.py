@@ -39,7 +39,6 @@ from rt70.model.sides import Side, check_side, side_of
 from rt70.physics.constraints import HolonomicMap, locking
 from rt70.physics.loads import Wrench
 from rt70.textbook import dynamics, forces, points
-from rt70.units import ARCSEC_PER_RAD
 
 #: Newton in :func:`equilibrium` stops when its step is below this (relative, m or rad).
 STEP_TOL = 1e-12
@@ -386,45 +385,6 @@ def _gravity_stiffness(
     s = side_of(scene, side)
     force = lambda x: s.dynamics.gravity_force(s.model, s.data, x)  # noqa: E731
     return _negative_jacobian(force, np.asarray(q, dtype=float), h)
-
-
-@dataclass(frozen=True)
-class Sag:
-    """Static deflection of one body under gravity, against its rigid (q_elastic = 0) pose."""
-
-    body: str
-    displacement_mm: np.ndarray  # of the body frame origin, ground axes
-    rotation_arcsec: float  # angle of the relative rotation
-
-
-def sag(scene: Scene, q_eq: np.ndarray, held: dict[str, float]) -> list[Sag]:
-    """Deflection of every body at the equilibrium ``q_eq`` relative to the rigid pose.
-
-    The rigid pose has the held coordinates at their values and every other coordinate
-    at 0; displacements are in mm, rotations in arc seconds.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene (both sides built).
-    q_eq : numpy.ndarray, shape (nv,)
-        The equilibrium under gravity (:func:`equilibrium`), m or rad.
-    held : dict of str to float
-        The held coordinates and their values, m or rad (as given to
-        :func:`equilibrium`).
-    """
-    model, data = scene.textbook, scene.textbook_data
-    q_rigid = np.zeros(model.nv)
-    q_rigid[coordinate_indices(scene, list(held))] = list(held.values())
-    dynamics.mass_matrix(model, data, q_rigid)
-    R0, p0 = data.R.copy(), data.p.copy()
-    dynamics.mass_matrix(model, data, q_eq)
-    out = []
-    for j, name in enumerate(model.body_names):
-        rel = R0[j].T @ data.R[j]
-        angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-        out.append(Sag(name, (data.p[j] - p0[j]) * 1e3, angle * ARCSEC_PER_RAD))
-    return out
 
 
 def force_input(

@@ -15,6 +15,7 @@ import numpy as np
 from rt70.guards.atomic import atomic_write, atomic_write_text
 from rt70.linear import linearize as lin
 from rt70.linear import modal, responses
+from rt70.linear.sag import sag
 from rt70.linear.topology import LinearModel
 from rt70.model.scene import Scene, load_scene
 from rt70.plotting.modal import plot_bode
@@ -293,7 +294,7 @@ def sweep_section(scene: Scene, elevations=(0, 15, 30, 45, 60, 75, 90)) -> str:
             ]
         )
         if e in (0, 45, 90):
-            for s in lin.sag(scene, q0, held):
+            for s in sag(scene, q0, held):
                 sag_rows.append(
                     [
                         f"{e}°",
