@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from rt70.errors import Rt70Error
 from rt70.surface.best_fit import best_fit, fit_maps
@@ -122,3 +123,66 @@ def test_bad_input_is_refused(call, message):
     nodes, weights = dish(rings=2, per_ring=6)
     with pytest.raises(Rt70Error, match=message):
         call(nodes, weights)
+
+
+def test_the_parametric_dish_is_a_stable_truss_with_its_mass_and_aperture():
+    from rt70.fe.modes import lowest_modes
+    from rt70.fe.reflector import paraboloid_dish
+
+    dish_ = paraboloid_dish(70.0, F, hub_radius=5.0, depth=3.0, EA=2e8, rho_A=20.0,
+                            panel_mass=15.0, rings=4, ribs=12)  # fmt: skip
+    fe = dish_.fe
+    front = fe.node_xyz[dish_.surface]
+    assert_close(front[:, 2], surface_height(front[:, 0], front[:, 1], F), rel=1e-15)
+    assert_close(dish_.weights.sum(), np.pi * (35.0**2 - 5.0**2), rel=1e-13)
+    i, j = sp.triu(fe.K, k=1).nonzero()  # the node pairs K couples are the bars
+    pairs = np.unique(np.sort(np.column_stack([i // 3, j // 3]), axis=1), axis=0)
+    bars = [(a, b) for a, b in pairs if a != b]
+    length = sum(np.linalg.norm(fe.node_xyz[a] - fe.node_xyz[b]) for a, b in bars)
+    assert_close(fe.M.diagonal().sum() / 3.0, 20.0 * length + 15.0 * dish_.weights.sum(),
+                 rel=1e-12)  # fmt: skip
+    free = lowest_modes(fe.M, fe.K, 8)
+    assert int(free.rigid.sum()) == 6 and free.freq_hz[6] > 0.1  # no mechanism
+    assert sorted(fe.interfaces.values()) == sorted(dish_.hub) and len(dish_.hub) == 24
+
+
+def test_the_dish_sagging_at_zenith_is_mostly_a_paraboloid():
+    """Gravity along the axis bends a radial-rib dish symmetrically: the best fit takes
+    most of it as a focal change and a vertex shift along the axis, none sideways."""
+    import scipy.sparse.linalg as spla
+
+    from rt70.fe.reflector import paraboloid_dish
+
+    d = paraboloid_dish(70.0, F, 5.0, 3.0, 2e8, 20.0, 15.0, rings=4, ribs=12)
+    fe = d.fe
+    held = np.concatenate([fe.dofs_of(n) for n in d.hub])
+    free = np.setdiff1d(np.arange(fe.n_dofs), held)
+    load = np.zeros(fe.n_dofs)
+    load[2::3] = -9.81 * fe.M.diagonal()[2::3]
+    u = np.zeros(fe.n_dofs)
+    u[free] = spla.spsolve(sp.csc_array(fe.K)[free][:, free], load[free])
+    nodes, delta = fe.node_xyz[d.surface], u.reshape(-1, 3)[d.surface]
+    fit = best_fit(nodes, delta, F, d.weights)
+    h = half_path_errors(nodes, delta, F)
+    raw = np.sqrt(np.sum(d.weights * h**2) / d.weights.sum())
+    assert fit.rms < 0.5 * raw
+    assert fit.focal_change > 0.0 and fit.vertex_shift[2] < 0.0
+    assert np.abs(fit.parameters[[0, 1, 3, 4]]).max() <= 1e-9 * np.abs(fit.parameters).max()
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"diameter": -70.0}, "diameter must be a positive"),
+        ({"hub_radius": 40.0}, "hub_radius must be between 0 and D/2"),
+        ({"panel_mass": -1.0}, "panel_mass must be ≥ 0"),
+        ({"ribs": 2}, "at least 1 ring and 3 ribs"),
+    ],
+)
+def test_a_wrong_dish_is_refused(change, message):
+    from rt70.fe.reflector import paraboloid_dish
+
+    args = {"diameter": 70.0, "focal_length": F, "hub_radius": 5.0, "depth": 3.0,
+            "EA": 2e8, "rho_A": 20.0, "panel_mass": 15.0} | change  # fmt: skip
+    with pytest.raises(Rt70Error, match=message):
+        paraboloid_dish(**args)
