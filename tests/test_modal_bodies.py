@@ -96,33 +96,38 @@ def test_coordinates_follow_the_joints(deep):
     assert deep.reference.coordinate_names == deep.textbook.coordinate_names
 
 
+def assert_sides_agree(scene, q: np.ndarray, qd: np.ndarray) -> None:
+    """A, S G, B q̇, T, U, the spring and damper forces, their potential and q̈ of the two
+    sides at one state, to rounding (q̈ to 1e-10)."""
+    tm, td = scene.textbook, scene.textbook_data
+    rm, rd = scene.reference, scene.reference_data
+    for name, args in (
+        ("mass_matrix", (q,)),
+        ("gravity_force", (q,)),
+        ("bias_force", (q, qd)),
+    ):
+        expected = getattr(ref_dynamics, name)(rm, rd, *args)
+        actual = getattr(tb_dynamics, name)(tm, td, *args)
+        assert_close(actual, expected, rel=ROUNDING, scale=np.abs(expected).max(), what=name)
+    T = ref_dynamics.kinetic_energy(rm, rd, q, qd)
+    assert_close(tb_dynamics.kinetic_energy(tm, td, q, qd), T, rel=ROUNDING)
+    U = ref_dynamics.gravity_potential(rm, rd, q)
+    assert_close(tb_dynamics.gravity_potential(tm, td, q), U, rel=ROUNDING)
+    Qc, Qd = tb_forces.spring_damper_force(tm, td, q, qd)
+    for actual, expected in zip((Qc, Qd), ref_forces.spring_damper_force(rm, rd, q, qd),
+                                strict=True):  # fmt: skip
+        assert_close(actual, expected, rel=ROUNDING, scale=np.abs(expected).max())
+    U_c = ref_forces.spring_potential(rm, rd, q)
+    assert U_c > 0.0
+    assert_close(tb_forces.spring_potential(tm, td, q), U_c, rel=ROUNDING)
+    qdd = ref_dynamics.forward_dynamics(rm, rd, q, qd)
+    actual = tb_dynamics.forward_dynamics(tm, td, q, qd, Qc + Qd)
+    assert_close(actual, qdd, rel=1e-10, scale=np.abs(qdd).max(), what="q̈")
+
+
 def test_the_sides_agree_to_rounding(deep):
-    tm, td, rm, rd = deep.textbook, deep.textbook_data, deep.reference, deep.reference_data
-    for q, qd, _ in states(tm.nv):
-        for name, args in (
-            ("mass_matrix", (q,)),
-            ("gravity_force", (q,)),
-            ("bias_force", (q, qd)),
-        ):
-            expected = getattr(ref_dynamics, name)(rm, rd, *args)
-            actual = getattr(tb_dynamics, name)(tm, td, *args)
-            assert_close(actual, expected, rel=ROUNDING, scale=np.abs(expected).max(), what=name)
-        for name in ("kinetic_energy",):
-            expected = getattr(ref_dynamics, name)(rm, rd, q, qd)
-            assert_close(getattr(tb_dynamics, name)(tm, td, q, qd), expected, rel=ROUNDING)
-        U = ref_dynamics.gravity_potential(rm, rd, q)
-        assert_close(tb_dynamics.gravity_potential(tm, td, q), U, rel=ROUNDING)
-        Qc, Qd = tb_forces.spring_damper_force(tm, td, q, qd)
-        for actual, expected in zip(
-            (Qc, Qd), ref_forces.spring_damper_force(rm, rd, q, qd), strict=True
-        ):
-            assert_close(actual, expected, rel=ROUNDING, scale=np.abs(expected).max())
-        U_c = ref_forces.spring_potential(rm, rd, q)
-        assert U_c > 0.0
-        assert_close(tb_forces.spring_potential(tm, td, q), U_c, rel=ROUNDING)
-        qdd = ref_dynamics.forward_dynamics(rm, rd, q, qd)
-        actual = tb_dynamics.forward_dynamics(tm, td, q, qd, Qc + Qd)
-        assert_close(actual, qdd, rel=1e-10, scale=np.abs(qdd).max(), what="q̈")
+    for q, qd, _ in states(deep.textbook.nv):
+        assert_sides_agree(deep, q, qd)
 
 
 def test_reactions_carry_the_bodies(deep):

@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from rt70.fe.modes import SHIFT_RTOL, START_SEED, lowest_modes
+from rt70.fe.modes import SHIFT_RTOL, START_SEED, backward_errors, lowest_modes
 from rt70.fe.ordering import nested_dissection
 from rt70.fe.truss import space_frame
 from rt70.guards.atomic import atomic_write_text
@@ -59,10 +59,7 @@ def colamd_modes(M, K, count: int):
     w, Y = scipy.linalg.eigh(V.T @ (Kc @ V), V.T @ (Mc @ V))
     V = V @ Y
     seconds = time.perf_counter() - start
-    norm_k, norm_m = float(abs(Kc).sum(axis=0).max()), float(abs(Mc).sum(axis=0).max())
-    r = np.abs(Kc @ V - (Mc @ V) * w).sum(axis=0)
-    residual = r / ((norm_k + np.abs(w) * norm_m) * np.abs(V).sum(axis=0))
-    return w, residual, seconds, lu.L.nnz + lu.U.nnz
+    return w, backward_errors(Mc, Kc, w, V), seconds, lu.L.nnz + lu.U.nnz
 
 
 def nd_fill(M, K) -> int:

@@ -132,8 +132,23 @@ def lowest_modes(
     w, Y = scipy.linalg.eigh(_sym(V.T @ KV), _sym(V.T @ MV))
     V = V @ Y  # mass-normalised: Yᵀ (Vᵀ M V) Y = 1
     seconds = time.perf_counter() - start
-    norm_k = float(abs(Kc).sum(axis=0).max())  # ‖K‖₁ and ‖M‖₁
-    norm_m = float(abs(Mc).sum(axis=0).max())
-    r = np.abs(Kc @ V - (Mc @ V) * w).sum(axis=0)
-    residual = r / ((norm_k + np.abs(w) * norm_m) * np.abs(V).sum(axis=0))
+    residual = backward_errors(Mc, Kc, w, V)
     return SparseModes(w, V, np.abs(w) <= RIGID_RTOL * ratio, residual, seconds)
+
+
+def backward_errors(M: sp.sparray, K: sp.sparray, omega2: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """``‖K v − ω² M v‖₁ / ((‖K‖₁ + |ω²| ‖M‖₁) ‖v‖₁)`` of each mode (column of V), (k,).
+
+    Parameters
+    ----------
+    M, K : scipy.sparse array, shape (N, N)
+        Mass and stiffness.
+    omega2 : numpy.ndarray, shape (k,)
+        The modes' ω², (rad/s)².
+    V : numpy.ndarray, shape (N, k)
+        Their shapes.
+    """
+    norm_k = float(abs(K).sum(axis=0).max())  # ‖K‖₁ and ‖M‖₁
+    norm_m = float(abs(M).sum(axis=0).max())
+    r = np.abs(K @ V - (M @ V) * omega2).sum(axis=0)
+    return r / ((norm_k + np.abs(omega2) * norm_m) * np.abs(V).sum(axis=0))

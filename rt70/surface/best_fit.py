@@ -34,7 +34,7 @@ import numpy as np
 import scipy.linalg
 
 from rt70.errors import Rt70Error
-from rt70.surface.paraboloid import check_nodes, obliquity, path_error_map
+from rt70.surface.paraboloid import check_nodes, path_error_map
 
 #: The BFP's parameters, in the order of β.
 PARAMETERS = ("u", "v", "w", "phi_x", "phi_y", "dF")
@@ -142,7 +142,8 @@ def fit_maps(nodes: np.ndarray, focal_length: float, weights: np.ndarray) -> Fit
     x, y = nodes[:, 0], nodes[:, 1]
     r2 = x**2 + y**2
     lever = 1.0 + r2 / (8.0 * F**2)  # 1 + z/(2F) on the nominal surface
-    c = obliquity(nodes, F)
+    H = path_error_map(nodes, F)
+    c = H[:, 2]  # cos²(θ/2): h of a unit Δz
     A = c[:, None] * np.column_stack(
         [-x / (2.0 * F), -y / (2.0 * F), np.ones_like(x), y * lever, -x * lever, -r2 / (4 * F**2)]
     )
@@ -156,7 +157,7 @@ def fit_maps(nodes: np.ndarray, focal_length: float, weights: np.ndarray) -> Fit
         )
     P = (Vt.T / s) @ (U.T * root)  # (Aᵀ W A)⁻¹ Aᵀ W
     R = np.eye(nodes.shape[0]) - A @ P
-    return FitMaps(A, P, R, w, path_error_map(nodes, F))
+    return FitMaps(A, P, R, w, H)
 
 
 def best_fit(

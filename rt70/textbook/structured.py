@@ -288,6 +288,8 @@ def mass_matrix_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarra
     Qf = _expand_batch(model, Q)
     direct = model.G is None and not model.modal
     n = model.n_pairs
+    # q̇_full = [G H] q̇ when interface chains move with η (made once, not per chunk)
+    full_map = None if model.node_map is None else model.reduce(np.eye(model.n_full)).T
     for start in range(0, Q.shape[0], data.chunk):
         stop = min(start + data.chunk, Q.shape[0])
         work = data.work(stop - start)
@@ -296,9 +298,8 @@ def mass_matrix_batch(model: Model, data: BatchData, Q: np.ndarray) -> np.ndarra
         if direct:
             continue
         A = data.A[start:stop]
-        if model.node_map is not None:
-            F = model.reduce(np.eye(model.n_full)).T  # q̇_full = [G H] q̇
-            A[:] = F.T @ out @ F
+        if full_map is not None:
+            A[:] = full_map.T @ out @ full_map
         else:
             A[:, :n, :n] = out if model.G is None else model.G.T @ out @ model.G
         if model.modal:

@@ -39,15 +39,20 @@ from rt70.errors import ExtensionError
 from rt70.urdf.beam_record import Beam
 from rt70.urdf.elements import ElementReader
 from rt70.urdf.schema import check_scene
-from rt70.urdf.text import RT70_NS, parse, refuse_entities, refuse_xacro
+from rt70.urdf.text import (
+    GENERATED_LIMIT,
+    RT70_NS,
+    insert_before_robot_end,
+    link_and_joint_names,
+    parse,
+    refuse_entities,
+    refuse_xacro,
+)
 
 #: Primary segments of a beam without a ``segments`` attribute (docs/beams.md: the
 #: cantilever's and the free–free beam's first three frequencies at this division).
 DEFAULT_SEGMENTS = 10
 
-#: Wide limits written on the generated joints (Pinocchio's parser requires them on
-#: revolute and prismatic joints; they never bind).
-_LIMIT = '<limit lower="-1000" upper="1000" effort="1e12" velocity="1e6"/>'
 
 #: The comment that marks a beam already written into a text (the expansion is idempotent).
 _MARK = "rt70:beam '{name}' as rigid finite elements"
@@ -146,14 +151,10 @@ def expand_beams(text: str, source: str = "<string>") -> str:
         return text
     check_scene(root, source, prefixes)
     reader = ElementReader(source)
-    taken = {e.get("name") for e in root.findall("link")} | {
-        e.get("name") for e in root.findall("joint")
-    }
+    taken = link_and_joint_names(root)
     prefix = min((p for p in prefixes.get(RT70_NS, ()) if p), default="rt70")
     blocks = [_beam_xml(read_beam(reader, e), prefix, taken, reader) for e in pending]
-    end = [m.end() for m in re.finditer(r"</\s*robot\s*>", text)][-1]
-    start = text.rindex("<", 0, end)
-    return text[:start] + "".join(blocks) + text[start:]
+    return insert_before_robot_end(text, blocks)
 
 
 def _beam_xml(beam: Beam, prefix: str, taken: set[str], reader: ElementReader) -> str:
@@ -254,7 +255,7 @@ def _joint(
     """One generated ``<joint>`` (with wide limits when it moves)."""
     origin = " ".join(repr(float(v)) for v in xyz)
     rot = "" if rpy is None else ' rpy="' + " ".join(repr(float(v)) for v in rpy) + '"'
-    moving = "" if axis is None else f'<axis xyz="{axis}"/>{_LIMIT}'
+    moving = "" if axis is None else f'<axis xyz="{axis}"/>{GENERATED_LIMIT}'
     return (
         f'  <joint name="{name}" type="{jtype}"><parent link="{parent}"/>'
         f'<child link="{child}"/><origin xyz="{origin}"{rot}/>{moving}</joint>\n'

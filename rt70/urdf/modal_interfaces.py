@@ -30,7 +30,15 @@ from rt70.urdf.elements import ElementReader
 from rt70.urdf.modal_file import ModalArrays, read_modal_file
 from rt70.urdf.modal_record import Interface
 from rt70.urdf.schema import check_scene
-from rt70.urdf.text import RT70_NS, parse, refuse_entities, refuse_xacro
+from rt70.urdf.text import (
+    GENERATED_LIMIT,
+    RT70_NS,
+    insert_before_robot_end,
+    link_and_joint_names,
+    parse,
+    refuse_entities,
+    refuse_xacro,
+)
 
 #: The chain's joints: name suffix, type and axis, translations first.
 CHAIN = (
@@ -42,8 +50,6 @@ CHAIN = (
     ("rz", "revolute", "0 0 1"),
 )
 
-#: Wide limits on the generated joints (Pinocchio's parser wants them; they never bind).
-_LIMIT = '<limit lower="-1000" upper="1000" effort="1e12" velocity="1e6"/>'
 
 #: The comment that marks an interface already written into a text (idempotent).
 _MARK = "rt70:interface '{link}' on a node of modal body '{body}'"
@@ -141,9 +147,7 @@ def expand_interfaces(text: str, source: str = "<string>") -> str:
         return text
     check_scene(root, source, prefixes)
     reader = ElementReader(source)
-    taken = {e.get("name") for e in root.findall("link")} | {
-        e.get("name") for e in root.findall("joint")
-    }
+    taken = link_and_joint_names(root)
     blocks, files = [], {}
     for body, sub in pending:
         name = body.get("name", "")
@@ -154,9 +158,7 @@ def expand_interfaces(text: str, source: str = "<string>") -> str:
         blocks.append(_chain_xml(body.get("link", ""), name, sub.get("link", ""),
                                  arrays.nodes[_node(sub, arrays, where)],
                                  arrays.rotations is not None, taken, where))  # fmt: skip
-    end = [m.end() for m in re.finditer(r"</\s*robot\s*>", text)][-1]
-    start = text.rindex("<", 0, end)
-    return text[:start] + "".join(blocks) + text[start:]
+    return insert_before_robot_end(text, blocks)
 
 
 def _chain_xml(
@@ -179,7 +181,7 @@ def _chain_xml(
         out.append(
             f'  <joint name="{joint}" type="{kind}"><parent link="{parent}"/>'
             f'<child link="{child}"/><origin xyz="{origin}" rpy="0 0 0"/>'
-            f'<axis xyz="{axis}"/>{_LIMIT}</joint>\n'
+            f'<axis xyz="{axis}"/>{GENERATED_LIMIT}</joint>\n'
         )
         parent = child
     return "".join(out)

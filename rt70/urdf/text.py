@@ -198,3 +198,22 @@ def qualified(name: str) -> str:
     if is_xacro(name):
         return f"xacro:{local}"
     return f"rt70:{local}" if uri == RT70_NS else name
+
+
+#: Wide limits written on the revolute and prismatic joints rt70 generates into a text
+#: (Pinocchio's parser requires them; they never bind).
+GENERATED_LIMIT = '<limit lower="-1000" upper="1000" effort="1e12" velocity="1e6"/>'
+
+
+def link_and_joint_names(root: ET.Element) -> set[str]:
+    """Every link and joint name of a parsed URDF (what a generated element may not take)."""
+    return {e.get("name") for e in root.findall("link")} | {
+        e.get("name") for e in root.findall("joint")
+    }
+
+
+def insert_before_robot_end(text: str, blocks: list[str]) -> str:
+    """``text`` with the generated ``blocks`` inserted just before its last ``</robot>``."""
+    end = [m.end() for m in re.finditer(r"</\s*robot\s*>", text)][-1]
+    start = text.rindex("<", 0, end)
+    return text[:start] + "".join(blocks) + text[start:]
