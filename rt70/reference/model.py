@@ -18,7 +18,7 @@ import pinocchio as pin
 
 from rt70.errors import Rt70Error
 from rt70.reference.limits import check_reference
-from rt70.reference.modal_nodes import add_nodes, modal_slices
+from rt70.reference.modal_nodes import modal_slices, with_nodes
 from rt70.reference.parse import parse_urdf
 from rt70.urdf.coordinates import SUFFIXES, coordinate_names
 from rt70.urdf.description import FrameRef, RobotDescription
@@ -138,7 +138,10 @@ class ReferenceModel:
             if frame.type == pin.BODY:
                 self.body_frames.setdefault(frame.name, index)
         bodies = {name: model.frames[i] for name, i in self.body_frames.items()}
-        nodes = [add_nodes(model, bodies, body) for body in desc.modal_bodies]
+        nodes: list = []
+        if desc.modal_bodies:  # the frames keep their indices; their joints are renumbered
+            model, nodes = with_nodes(model, bodies, desc.modal_bodies)
+            bodies = {name: model.frames[i] for name, i in self.body_frames.items()}
         model.gravity.linear = np.asarray(desc.gravity, dtype=float)
         model.armature[:] = 0.0
         self.pin_model = model
@@ -146,6 +149,7 @@ class ReferenceModel:
         self.pin_model_no_gravity.gravity.setZero()
         self.modal_bodies = desc.modal_bodies  # their stiffness and damping on η
         node_joints = {joint for added in nodes for joint, _ in added}
+        self.node_joints = {model.names[j]: j for j in node_joints}  # "<body>/node<n>"
         self.urdf_joints = [  # Pinocchio's joints that are the file's (not modal nodes)
             i for i in range(1, model.njoints) if i not in node_joints
         ]

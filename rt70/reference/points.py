@@ -23,10 +23,15 @@ from rt70.guards.arrays import check_vector
 from rt70.physics.loads import Wrench
 from rt70.reference.coordinates import to_pinocchio
 from rt70.reference.model import ReferenceData, ReferenceModel
+from rt70.urdf.modal_record import parse_node_point
 
 
 def link_point(model: ReferenceModel, link: str, xyz) -> tuple[int, pin.SE3]:
     """Pinocchio's parent joint of ``link`` and the placement of the point in it.
+
+    A modal body's node (``"<body>/node<n>"``, :func:`rt70.urdf.modal_record.node_point`)
+    is its own translation joint here (:mod:`rt70.reference.modal_nodes`), whose frame
+    has the body frame's axes and moves with the node: the point is ``xyz`` from it.
 
     Parameters
     ----------
@@ -40,9 +45,18 @@ def link_point(model: ReferenceModel, link: str, xyz) -> tuple[int, pin.SE3]:
     Raises
     ------
     UnknownLinkError
-        If Pinocchio has no body frame called ``link``.
+        If Pinocchio has no body frame called ``link`` and no node joint of that name.
     """
     m = model.pin_model
+    if link in model.node_joints:
+        offset = pin.SE3(np.eye(3), check_vector(f"point of node '{link}'", xyz, 3))
+        return model.node_joints[link], offset
+    node = parse_node_point(link)
+    if node is not None and any(b.name == node[0] for b in model.modal_bodies):
+        raise UnknownLinkError(
+            f"{m.name}: node '{link}' is not placed on the reference side, which places "
+            "only the nodes with mass (a node index past the file's, or a massless node)"
+        )
     if link not in model.body_frames:
         raise UnknownLinkError(f"{m.name}: no link '{link}' among Pinocchio's body frames")
     frame = m.frames[model.body_frames[link]]

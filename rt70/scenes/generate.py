@@ -37,6 +37,7 @@ from rt70.scenes.book_scenes import (
 )
 from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene
 from rt70.scenes.modal_scenes import TRUSS_FILE, slewing_truss_scene, truss_arm
+from rt70.scenes.reflector_scenes import RT70_DISH_FILE, rt70_mirror_body, rt70_mirror_scene
 from rt70.scenes.rt70_scenes import (
     rt70_flexible_scene,
     rt70_jack_scene,
@@ -66,10 +67,14 @@ SCENES: dict[str, Callable[[], str]] = {
     "crank_slider": crank_slider_scene,
     **{name: partial(antenna_urdf, spec) for name, spec in PRESETS.items()},
     "slewing_truss": slewing_truss_scene,
+    "rt70_mirror": rt70_mirror_scene,
 }
 
 #: The modal body files the scenes name (``rt70-modal/1``), by file name.
-MODAL_FILES: dict[str, Callable[[], ModalArrays]] = {TRUSS_FILE: truss_arm}
+MODAL_FILES: dict[str, Callable[[], ModalArrays]] = {
+    TRUSS_FILE: truss_arm,
+    RT70_DISH_FILE: rt70_mirror_body,
+}
 
 
 def write_all(directory: Path) -> list[Path]:

@@ -38,6 +38,10 @@ class ModalModel:
         ``K_η``, ``D_η``.
     start : int
         Index of its first modal coordinate in q.
+    nodes : numpy.ndarray, shape (N, 3)
+        The nodes ``x_n`` in the body's frame, m.
+    shapes : numpy.ndarray, shape (N, 3, k)
+        ``Φ_n`` in the body's axes.
     """
 
     name: str
@@ -48,6 +52,8 @@ class ModalModel:
     stiffness: np.ndarray
     damping: np.ndarray
     start: int
+    nodes: np.ndarray
+    shapes: np.ndarray
 
     @property
     def modes(self) -> int:
@@ -78,6 +84,8 @@ def place_modal_bodies(bodies: tuple[ModalBody, ...], link_frames: dict, start: 
         nodes = r + b.nodes @ c.T
         shapes = np.einsum("ab,nbj->naj", c, b.shapes)
         invariants = inertia_invariants(nodes, b.masses, shapes)
-        out.append(ModalModel(b.name, body, r, c, invariants, b.stiffness, b.damping, start))
+        out.append(
+            ModalModel(b.name, body, r, c, invariants, b.stiffness, b.damping, start, nodes, shapes)
+        )
         start += b.modes
     return tuple(out)

@@ -27,6 +27,7 @@ from rt70.textbook.kinematics import (
     update_structure,
 )
 from rt70.textbook.model import Model
+from rt70.urdf.modal_record import parse_node_point
 
 
 def link_point(model: Model, link: str, xyz) -> tuple[int, np.ndarray]:
@@ -59,6 +60,38 @@ def link_point(model: Model, link: str, xyz) -> tuple[int, np.ndarray]:
     return body, r_link + c_link @ check_vector(f"point of link '{link}'", xyz, 3)
 
 
+def located_point(model: Model, link: str, xyz) -> tuple[int, np.ndarray, np.ndarray, slice]:
+    """Body of a point and its place ``r = r0 + Φ η`` in the body's frame: ``(body, r0, Φ, η)``.
+
+    A link's point (:func:`link_point`) has ``Φ`` of zero columns; a modal body's node
+    (``"<body>/node<n>"``, :func:`rt70.urdf.modal_record.node_point`) is displaced by its
+    shape ``Φ_n`` (3, k) on the body's coordinates ``η`` (a slice of q).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    link : str
+        Name of a URDF link of the scene, or a modal body's node.
+    xyz : array_like, shape (3,)
+        The point in the link's frame (a node's: from the node, in the body frame's
+        axes), m.
+
+    Raises
+    ------
+    UnknownLinkError
+        If the model has no frame for ``link`` and no such node.
+    """
+    node = parse_node_point(link)
+    flexible = {m.name: m for m in model.modal}
+    if node is None or node[0] not in flexible or node[1] >= flexible[node[0]].nodes.shape[0]:
+        body, r = link_point(model, link, xyz)
+        return body, r, np.zeros((3, 0)), slice(0, 0)
+    m = flexible[node[0]]
+    r = m.nodes[node[1]] + m.c @ check_vector(f"point of node '{link}'", xyz, 3)
+    return m.body, r, m.shapes[node[1]], m.coords
+
+
 def point_positions(
     model: Model, data: Data, q: np.ndarray, points: Sequence[tuple[str, np.ndarray]]
 ) -> np.ndarray:
@@ -77,13 +110,13 @@ def point_positions(
     points : sequence of (str, array_like)
         The points: a link's name and the point in the link's frame (m).
     """
-    located = [link_point(model, link, xyz) for link, xyz in points]
+    located = [located_point(model, link, xyz) for link, xyz in points]
     q = check_vector("q", q, model.nv)
     data.q_full = model.expand(q)
     forward_kinematics(model, data, data.q_full)
     out = np.empty((len(located), 3))
-    for k, (body, r) in enumerate(located):
-        out[k] = frame_pose(data, body, r, np.eye(3))[1]
+    for k, (body, r0, Phi, eta) in enumerate(located):
+        out[k] = frame_pose(data, body, r0 + Phi @ q[eta], np.eye(3))[1]
     return out
 
 
@@ -99,7 +132,7 @@ def point_position(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> n
     q : numpy.ndarray, shape (nv,)
         Generalised coordinates, rad or m, in the model's order (``Model.coordinate_names``).
     link : str
-        Name of a URDF link of the scene.
+        Name of a URDF link of the scene, or a modal body's node (:func:`located_point`).
     xyz : array_like, shape (3,)
         The point in the link's frame, m.
     """
@@ -160,7 +193,8 @@ def point_jacobian(
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(J_v, J_ω)``, 3 × nv each, in ground axes: ``v_p = J_v q̇``, ``ω = J_ω q̇``.
 
-    One forward pass at q, then :func:`ground_jacobian`.
+    One forward pass at q, then :func:`ground_jacobian`; a modal body's node adds its
+    own velocity ``c_0,body Φ_n η̇`` to ``J_v``'s columns of η.
 
     Parameters
     ----------
@@ -175,9 +209,13 @@ def point_jacobian(
     xyz : array_like, shape (3,)
         The point in the link's frame, m.
     """
-    body, r = link_point(model, link, xyz)
+    body, r0, Phi, eta = located_point(model, link, xyz)
     update_structure(model, data, q)
-    return ground_jacobian(data, body, r)
+    Jv, Jw = ground_jacobian(data, body, r0 + Phi @ q[eta])
+    if Phi.shape[1]:
+        c = frame_pose(data, body, np.zeros(3), np.eye(3))[0]
+        Jv[:, eta] += c @ Phi
+    return Jv, Jw
 
 
 def generalized_force(model: Model, data: Data, q: np.ndarray, wrench: Wrench) -> np.ndarray:

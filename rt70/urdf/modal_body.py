@@ -71,7 +71,7 @@ def read_modal_body(reader: ElementReader, elem: ET.Element, desc: RobotDescript
     interfaces = read_interfaces(reader, elem, body, keep, where)
     return ModalBody(
         name, link, str(path), body.nodes, body.masses, shapes, stiffness, damping, body.edges,
-        interfaces,
+        interfaces, body.surface,
     )  # fmt: skip
 
 

@@ -17,6 +17,9 @@ rotations  (N, 3, k)    optional: each node's small rotation per unit modal coor
                         attached to the node, ``<rt70:interface>``)
 edges      (E, 2)       optional: node index pairs drawn as lines (the FE mesh's edges)
 source     ()           optional: where the body came from (a free text)
+surface_nodes (S,)      optional, with the next two: the reflecting surface's nodes
+surface_weights (S,)    their shares of the aperture (m², > 0): the best fit's weights
+focal_length ()         F of the surface's paraboloid ``z = (x² + y²)/(4F)``, m
 ========== ============ ===========================================================
 
 The body is ``r_n = x_n + Φ_n η`` (rt70.textbook.flexible): the nodes' masses are
@@ -37,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from rt70.errors import ExtensionError
+from rt70.urdf.modal_record import Surface
 
 #: The format's name, stored in the file.
 FORMAT = "rt70-modal/1"
@@ -48,6 +52,13 @@ SYMMETRY_RTOL = 1e-9
 #: A symmetric matrix is positive semidefinite when its lowest eigenvalue is above
 #: ``−DEFINITE_RTOL · max |λ|`` (rounding of the eigensolver on rigid modes).
 DEFINITE_RTOL = 1e-9
+
+#: A surface node lies on its paraboloid when ``|z − r²/(4F)| ≤ SURFACE_RTOL · r_max``
+#: (a file written from a design, not a measured surface: rounding of its coordinates).
+SURFACE_RTOL = 1e-9
+
+#: The three keys of a reflecting surface, all or none.
+SURFACE_KEYS = ("surface_nodes", "surface_weights", "focal_length")
 
 
 @dataclass(frozen=True)
@@ -68,6 +79,8 @@ class ModalArrays:
     rotations : numpy.ndarray or None, shape (N, 3, k)
         The nodes' small rotations per unit modal coordinate; None when the file has none
         (a link attached to a node then keeps the body frame's orientation).
+    surface : rt70.urdf.modal_record.Surface or None
+        The reflecting surface (its nodes, weights and F); None when the file has none.
     """
 
     nodes: np.ndarray
@@ -78,6 +91,7 @@ class ModalArrays:
     source: str = ""
     edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     rotations: np.ndarray | None = None
+    surface: Surface | None = None
 
     @property
     def modes(self) -> int:
@@ -119,6 +133,10 @@ def write_modal_file(path: str | Path, body: ModalArrays) -> Path:
     }
     if body.rotations is not None:
         arrays["rotations"] = body.rotations
+    if body.surface is not None:
+        arrays["surface_nodes"] = np.asarray(body.surface.nodes, dtype=np.int64)
+        arrays["surface_weights"] = body.surface.weights
+        arrays["focal_length"] = np.array(float(body.surface.focal_length))
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".npz")
     try:
         with os.fdopen(fd, "wb") as handle, zipfile.ZipFile(handle, "w") as archive:
@@ -174,9 +192,66 @@ def read_modal_file(path: str | Path, where: str) -> ModalArrays:
         source=str(arrays.get("source", "")),
         edges=np.asarray(arrays.get("edges", np.zeros((0, 2))), dtype=np.int64),
         rotations=np.asarray(arrays["rotations"], dtype=float) if "rotations" in arrays else None,
+        surface=_surface(arrays, f"{where}: '{path}'"),
     )
     check_arrays(body, f"{where}: '{path}'")
     return body
+
+
+def _surface(arrays: dict, where: str) -> Surface | None:
+    """The file's :class:`Surface` from its three keys (all or none), or None."""
+    present = [key for key in SURFACE_KEYS if key in arrays]
+    if not present:
+        return None
+    if len(present) < len(SURFACE_KEYS):
+        missing = ", ".join(k for k in SURFACE_KEYS if k not in arrays)
+        raise ExtensionError(
+            f"{where}: a surface needs {', '.join(SURFACE_KEYS)}; {missing} missing"
+        )
+    nodes = np.asarray(arrays["surface_nodes"])
+    if nodes.dtype.kind not in "iu":
+        raise ExtensionError(f"{where}: surface_nodes must be integers, not {nodes.dtype}")
+    F = np.asarray(arrays["focal_length"], dtype=float)
+    focal_length = float(F) if F.shape == () else float("nan")  # refused by check_surface
+    weights = np.asarray(arrays["surface_weights"], dtype=float)
+    return Surface(nodes.astype(np.int64), weights, focal_length)
+
+
+def check_surface(surface: Surface, nodes: np.ndarray, where: str) -> None:
+    """Refuse a surface whose nodes, weights or F are wrong (names ``where`` first).
+
+    Parameters
+    ----------
+    surface : rt70.urdf.modal_record.Surface
+        The surface.
+    nodes : numpy.ndarray, shape (N, 3)
+        The body's nodes in its frame, m.
+    where : str
+        The start of every message.
+    """
+    n = nodes.shape[0]
+    idx, weights, F = surface.nodes, surface.weights, surface.focal_length
+    if idx.ndim != 1 or idx.size < 6:
+        raise ExtensionError(f"{where}: surface_nodes has shape {idx.shape}, expected (S,), S ≥ 6")
+    if idx.min() < 0 or idx.max() >= n or np.unique(idx).size != idx.size:
+        raise ExtensionError(f"{where}: surface_nodes must be distinct nodes of the {n}")
+    if weights.shape != idx.shape:
+        raise ExtensionError(
+            f"{where}: surface_weights has shape {weights.shape}, expected {idx.shape}"
+        )
+    if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
+        raise ExtensionError(f"{where}: surface_weights must be finite and > 0")
+    if not (np.isfinite(F) and F > 0.0):
+        raise ExtensionError(f"{where}: focal_length must be one finite number > 0 (m)")
+    x = nodes[idx]
+    r2 = x[:, 0] ** 2 + x[:, 1] ** 2
+    off = np.abs(x[:, 2] - r2 / (4.0 * F))
+    worst = int(np.argmax(off))
+    if off[worst] > SURFACE_RTOL * max(float(np.sqrt(r2.max())), F):
+        raise ExtensionError(
+            f"{where}: surface node {int(idx[worst])} is {off[worst]:.3g} m off the "
+            f"paraboloid z = (x² + y²)/(4F), F = {F:g} m (vertex at the body frame's origin)"
+        )
 
 
 def check_arrays(body: ModalArrays, where: str) -> None:
@@ -210,6 +285,8 @@ def check_arrays(body: ModalArrays, where: str) -> None:
         raise ExtensionError(f"{where}: masses must be ≥ 0 with a positive total")
     for key in ("stiffness", "damping"):
         _check_semidefinite(getattr(body, key), f"{where}: {key}")
+    if body.surface is not None:
+        check_surface(body.surface, body.nodes, where)
     eigenvalues = np.linalg.eigvalsh(body.modal_mass)
     if not eigenvalues[0] > DEFINITE_RTOL * eigenvalues[-1]:
         raise ExtensionError(

@@ -7,9 +7,66 @@ Read by :mod:`rt70.urdf.modal_body` (the element and its file,
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
+
+#: A node of a modal body as a point carrier: ``"<body>/node<n>"`` (n from 0), the name
+#: Pinocchio's joint of the node has on the reference side.
+NODE_POINT = re.compile(r"(?P<body>.+)/node(?P<node>[0-9]+)")
+
+
+def node_point(body: str, node: int) -> str:
+    """The name of node ``node`` of the modal body ``body`` as a point carrier.
+
+    A point ``(node_point(body, n), xyz)`` sits at ``xyz`` (the body frame's axes) from
+    the node's displaced position ``x_n + Φ_n η``; both sides place it with their own
+    kinematics (:mod:`rt70.textbook.points`, :mod:`rt70.reference.points`).
+
+    Parameters
+    ----------
+    body : str
+        The ``<rt70:modal_body>``'s name.
+    node : int
+        The node's index in the modal body file, from 0.
+    """
+    return f"{body}/node{int(node)}"
+
+
+def parse_node_point(name: str) -> tuple[str, int] | None:
+    """``(body, node)`` of a name made by :func:`node_point`; None for any other name.
+
+    Parameters
+    ----------
+    name : str
+        A point carrier's name (a link's or a node's).
+    """
+    match = NODE_POINT.fullmatch(name)
+    return (match["body"], int(match["node"])) if match else None
+
+
+@dataclass(frozen=True)
+class Surface:
+    """The reflecting surface of a modal body: some of its nodes on a paraboloid.
+
+    The paraboloid is ``z = (x² + y²)/(4F)`` in the body frame: vertex at its origin,
+    axis along its +z (docs/surface.md).
+
+    Attributes
+    ----------
+    nodes : numpy.ndarray of int, shape (S,)
+        The surface nodes' indices in the modal body file.
+    weights : numpy.ndarray, shape (S,)
+        Each node's share of the aperture (projected area, m², times an optional
+        illumination taper); the best fit's weights.
+    focal_length : float
+        F, m.
+    """
+
+    nodes: np.ndarray
+    weights: np.ndarray
+    focal_length: float
 
 
 @dataclass(frozen=True)
@@ -61,6 +118,8 @@ class ModalBody:
         Node index pairs drawn as lines (the mesh's edges; may be empty).
     interfaces : tuple of Interface
         The links attached to its nodes.
+    surface : Surface or None
+        Its reflecting surface, when the file declares one.
     """
 
     name: str
@@ -73,6 +132,7 @@ class ModalBody:
     damping: np.ndarray
     edges: np.ndarray
     interfaces: tuple[Interface, ...] = ()
+    surface: Surface | None = None
 
     @property
     def modes(self) -> int:

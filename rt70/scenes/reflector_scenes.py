@@ -1,0 +1,343 @@
+"""A reflector as a flexible body in a scene: a dish on its link, mass and inertia kept.
+
+One job: turn a scene's rigid reflector link into the same link carrying a parametric
+dish (:func:`rt70.fe.reflector.paraboloid_dish`) as a modal body with a reflecting
+surface (docs/surface.md), without changing the link's mass, centre of mass or inertia:
+the dish takes its share and the link keeps the rest (the hub, the counterweights, the
+parts the truss does not model).
+
+- :func:`dish_body` — the dish clamped at its hub ring, its lowest modes augmented by the
+  static shapes of its weight and of a wind pressure (:func:`rt70.fe.modal_body.clamped_modes`),
+  with its surface nodes, their aperture weights and F;
+- :func:`rigid_properties` — the dish's mass, centre and inertia as a rigid body;
+- :func:`with_flexible_reflector` — the URDF text with the link's inertial reduced by the
+  dish's, a frame ``<dish>_link`` at the paraboloid's vertex welded to the link, and the
+  ``<rt70:modal_body>`` on it.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.fe.modal_body import clamped_modes
+from rt70.fe.reflector import Dish
+from rt70.scenes import urdf_writer as uw
+from rt70.urdf.modal_file import ModalArrays
+from rt70.urdf.modal_record import Surface
+
+#: The namespace of rt70's URDF elements.
+RT70_NAMESPACE = "urn:rt70:urdf-extensions:1"
+#: Tolerance of the residual inertia's triangle inequality, relative to its trace.
+TRIANGLE_RTOL = 1e-12
+
+
+def load_patterns(dish: Dish) -> np.ndarray:
+    """Nodal force patterns (8, N, 3) of the dish's weight and of a wind pressure.
+
+    The weight along x, y, z (each node's mass times a unit acceleration), and a
+    pressure over the surface nodes by their aperture weights: along z uniform, along z
+    varying as x and as y (a pitching and a yawing moment), and along x and y uniform.
+    Their static shapes make the dish's response to gravity at any elevation and to a
+    wind load of that form exact in the modal body (:func:`dish_body`).
+
+    Parameters
+    ----------
+    dish : rt70.fe.reflector.Dish
+        The dish.
+    """
+    masses = dish.fe.M.diagonal()[::3]
+    n = masses.size
+    out = np.zeros((8, n, 3))
+    for axis in range(3):
+        out[axis, :, axis] = masses
+    x, y = dish.fe.node_xyz[dish.surface, 0], dish.fe.node_xyz[dish.surface, 1]
+    w = dish.weights
+    out[3, dish.surface, 2] = w
+    out[4, dish.surface, 2] = w * x
+    out[5, dish.surface, 2] = w * y
+    out[6, dish.surface, 0] = w
+    out[7, dish.surface, 1] = w
+    return out
+
+
+def dish_body(dish: Dish, modes: int, source: str) -> ModalArrays:
+    """The dish clamped at its hub ring as a modal body file's arrays, with its surface.
+
+    Parameters
+    ----------
+    dish : rt70.fe.reflector.Dish
+        The dish (its front layer is the surface).
+    modes : int
+        Fixed-interface modes kept; the 8 static shapes of :func:`load_patterns` are added.
+    source : str
+        Where the dish came from (stored in the file).
+    """
+    body = clamped_modes(dish.fe, dish.hub, modes, loads=load_patterns(dish))
+    surface = Surface(np.asarray(dish.surface, dtype=np.int64), dish.weights, dish.focal_length)
+    return ModalArrays(
+        body.nodes, body.masses, body.shapes, body.stiffness, np.zeros_like(body.stiffness),
+        source, body.edges, surface=surface,
+    )  # fmt: skip
+
+
+def rigid_properties(nodes: np.ndarray, masses: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(m, c, I_c)`` of point masses: total, centre and inertia about the centre.
+
+    Parameters
+    ----------
+    nodes : numpy.ndarray, shape (N, 3)
+        Positions, m.
+    masses : numpy.ndarray, shape (N,)
+        Masses, kg.
+    """
+    m = float(masses.sum())
+    c = masses @ nodes / m
+    r = nodes - c
+    inertia = np.einsum("n,nij->ij", masses, np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3))
+    inertia -= np.einsum("n,ni,nj->ij", masses, r, r)
+    return m, c, inertia
+
+
+def _shifted(inertia: np.ndarray, mass: float, offset: np.ndarray) -> np.ndarray:
+    """Inertia about a point ``offset`` from the centre of mass (parallel axes)."""
+    return inertia + mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
+
+
+def residual_properties(
+    link: tuple[float, np.ndarray, np.ndarray],
+    dish: tuple[float, np.ndarray, np.ndarray],
+    name: str,
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """The link's mass properties less the dish's: ``(m, c, I_c)`` of what the link keeps.
+
+    Parameters
+    ----------
+    link, dish : (float, numpy.ndarray, numpy.ndarray)
+        ``(m, c, I_c)`` of the rigid link and of the dish, in the link's frame.
+    name : str
+        The link's name (for the message).
+
+    Raises
+    ------
+    Rt70Error
+        If what is left is not a body: a mass ≤ 0, or an inertia that is not positive
+        definite or breaks the triangle inequality (the dish is heavier, or spread wider,
+        than the link it replaces).
+    """
+    (m, c, inertia), (md, cd, Id) = link, dish
+    mh = m - md
+    if not mh > 0.0:
+        raise Rt70Error(f"link '{name}': the dish's {md:.6g} kg is not less than its {m:.6g} kg")
+    ch = (m * c - md * cd) / mh
+    about_origin = _shifted(inertia, m, c) - _shifted(Id, md, cd)
+    Ih = about_origin - mh * (ch @ ch * np.eye(3) - np.outer(ch, ch))
+    moments = np.linalg.eigvalsh(0.5 * (Ih + Ih.T))
+    slack = TRIANGLE_RTOL * moments.sum()
+    if moments[0] <= 0.0 or moments[0] + moments[1] < moments[2] - slack:
+        raise Rt70Error(
+            f"link '{name}': its inertia less the dish's has principal moments "
+            f"{', '.join(f'{x:.4g}' for x in moments)} kg·m², not a body's: the dish is "
+            "too heavy or too wide for the link (lighten its members or panels)"
+        )
+    return mh, ch, 0.5 * (Ih + Ih.T)
+
+
+def with_flexible_reflector(
+    text: str, link: str, vertex: np.ndarray, body: ModalArrays, name: str, file: str,
+    damping_ratio: float,
+) -> str:  # fmt: skip
+    """The URDF ``text`` with the dish ``body`` on ``link``, the link's totals kept.
+
+    Parameters
+    ----------
+    text : str
+        The scene's URDF text.
+    link : str
+        The rigid reflector link (its z the paraboloid's axis).
+    vertex : numpy.ndarray, shape (3,)
+        The paraboloid's vertex in the link's frame, m.
+    body : rt70.urdf.modal_file.ModalArrays
+        The dish (:func:`dish_body`), nodes in the paraboloid's frame.
+    name : str
+        The modal body's name; its frame link is ``<name>_link``.
+    file : str
+        The modal body file's name, beside the URDF file.
+    damping_ratio : float
+        Every mode's ratio of critical damping.
+
+    Raises
+    ------
+    Rt70Error
+        If ``link`` has no inertial or cannot give up the dish's mass
+        (:func:`residual_properties`).
+    """
+    ET.register_namespace("rt70", RT70_NAMESPACE)
+    root = ET.fromstring(text, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
+    found = [e for e in root.findall("link") if e.get("name") == link]
+    inertial = found[0].find("inertial") if found else None
+    if inertial is None:
+        raise Rt70Error(f"no link '{link}' with an <inertial> in the scene")
+    origin = inertial.find("origin")
+    if origin is not None and np.any(np.array(uw_floats(origin.get("rpy", "0 0 0")))):
+        raise Rt70Error(f"link '{link}': an inertial with rpy is not supported here")
+    c = np.array(uw_floats(origin.get("xyz", "0 0 0"))) if origin is not None else np.zeros(3)
+    m = float(inertial.find("mass").get("value"))
+    e = inertial.find("inertia").attrib
+    inertia = _inertia_matrix(e)
+    dish = rigid_properties(body.nodes + vertex, body.masses)
+    mh, ch, Ih = residual_properties((m, c, inertia), dish, link)
+    inertial.find("mass").set("value", uw.fmt(mh))
+    if origin is None:
+        origin = ET.SubElement(inertial, "origin")
+    origin.set("xyz", uw.fmt_vec(ch))
+    origin.set("rpy", "0 0 0")
+    for key, (i, j) in {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2),
+                        "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}.items():  # fmt: skip
+        inertial.find("inertia").set(key, uw.fmt(Ih[i, j]))
+    ET.indent(root, space="  ")
+    body_text = "\n".join(
+        [
+            f"  <!-- {name}: a flexible dish on '{link}' (rt70.scenes.reflector_scenes); "
+            f"'{link}' keeps {mh:.6g} kg of the {m:.6g} kg -->",
+            f'  <link name="{name}_link"/>',
+            f'  <joint name="{name}_weld" type="fixed"><parent link="{link}"/>'
+            f'<child link="{name}_link"/><origin xyz="{uw.fmt_vec(vertex)}" rpy="0 0 0"/></joint>',
+            f'  <rt70:modal_body name="{name}" link="{name}_link" file="{file}" '
+            f'damping_ratio="{uw.fmt(damping_ratio)}"/>',
+        ]
+    )
+    out = text[: text.index("<robot")] + ET.tostring(root, encoding="unicode")
+    return out.replace("</robot>", body_text + "\n</robot>\n")
+
+
+def uw_floats(text: str) -> list[float]:
+    """Three numbers of an ``xyz``/``rpy`` attribute."""
+    return [float(v) for v in text.split()]
+
+
+def _inertia_matrix(e: dict) -> np.ndarray:
+    """The symmetric inertia matrix of an ``<inertia>`` element's attributes."""
+    get = {k: float(e.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    return np.array(
+        [
+            [get["ixx"], get["ixy"], get["ixz"]],
+            [get["ixy"], get["iyy"], get["iyz"]],
+            [get["ixz"], get["iyz"], get["izz"]],
+        ]
+    )
+
+
+# --- the RT-70 with a flexible main mirror ------------------------------------------------
+
+#: The RT-70's main mirror as a dish: D (the telescope's 70 m), F, hub ring radius and
+#: truss depth (m), rings and ribs. F = 21 m is F/D = 0.3, stated, not from an RT-70
+#: source: the book calls the mirror system a long-focus Gregorian (§2.2) without a
+#: number, and the listing's optical points (focus 5 m from the vertex mark) are marks
+#: of the lumped model, not the optics (a 70-m paraboloid with F = 5 m would be 61 m
+#: deep). 0.3 is Effelsberg's 100-m primary (f = 30 m) and common for large dishes.
+RT70_DISH = {"diameter": 70.0, "focal_length": 21.0, "hub_radius": 6.0, "depth": 8.0,
+             "rings": 3, "ribs": 8}  # fmt: skip
+#: Every bar: a steel tube of 4 cm² (E = 2.1e11 Pa, ρ = 7850 kg/m³): EA (N), ρA (kg/m).
+RT70_BAR = {"EA": 2.1e11 * 4e-4, "rho_A": 7850.0 * 4e-4}
+#: The dish's share of the listing main mirror's polar moment (the rest stays lumped on
+#: the link: the listing's body is heavier at its centre than a uniform dish).
+RT70_DISH_SHARE = 0.75
+#: Fixed-interface modes of the dish kept (plus the 8 static shapes of its loads).
+RT70_DISH_MODES = 16
+#: The dish's modal damping ratio (the RT-70's structural damping is not in the source;
+#: 1 % is the usual figure for welded steel structures, stated).
+RT70_DISH_DAMPING = 0.01
+#: The dish's modal body file, beside the scene's URDF file.
+RT70_DISH_FILE = "rt70_mirror_dish.npz"
+
+
+def rt70_dish(panel_mass: float | None = None, **layout: int) -> Dish:
+    """The RT-70's main-mirror dish (:data:`RT70_DISH`, :data:`RT70_BAR`).
+
+    Parameters
+    ----------
+    panel_mass : float, optional
+        The panels' kg/m²; by default the value that gives the dish
+        :data:`RT70_DISH_SHARE` of the listing main mirror's polar moment (derived:
+        the polar moment is linear in it).
+    **layout : int
+        ``rings`` and ``ribs`` instead of :data:`RT70_DISH`'s (a finer dish for the
+        textbook side, whose cost grows with the modes, not the nodes).
+    """
+    geometry = {**RT70_DISH, **layout}
+    from rt70.fe.reflector import paraboloid_dish
+    from rt70.scenes.rt70_data import LISTING_BODIES
+
+    if panel_mass is None:
+        bare = rigid_properties(
+            *_nodes_masses(paraboloid_dish(**geometry, **RT70_BAR, panel_mass=0))
+        )
+        unit = rigid_properties(
+            *_nodes_masses(paraboloid_dish(**geometry, **RT70_BAR, panel_mass=1))
+        )
+        target = RT70_DISH_SHARE * _listing_main_mirror(LISTING_BODIES)[2][2, 2]
+        panel_mass = (target - bare[2][2, 2]) / (unit[2][2, 2] - bare[2][2, 2])
+        if not panel_mass >= 0.0:
+            raise Rt70Error("the RT-70 dish's bars alone exceed its share of the main mirror")
+    return paraboloid_dish(**geometry, **RT70_BAR, panel_mass=panel_mass)
+
+
+def _nodes_masses(dish: Dish) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(dish.fe.node_xyz, dtype=float), dish.fe.M.diagonal()[::3]
+
+
+def _listing_main_mirror(bodies) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(m, c, I_c)`` of the listing's main mirror (body 5)."""
+    body = [b for b in bodies if b["name"] == "main_mirror"][0]
+    return body["mass"], np.asarray(body["com"], dtype=float), np.diag(body["moments"])
+
+
+def rt70_mirror_body(modes: int = RT70_DISH_MODES, **layout: int) -> ModalArrays:
+    """The RT-70 main mirror's dish as a modal body file's arrays (:func:`dish_body`).
+
+    Parameters
+    ----------
+    modes : int
+        Fixed-interface modes kept (plus the 8 load shapes).
+    **layout : int
+        ``rings`` and ``ribs`` (:func:`rt70_dish`).
+    """
+    dish = rt70_dish(**layout)
+    return dish_body(
+        dish, modes,
+        f"{dish.fe.name}, the RT-70 main mirror (rt70.scenes.reflector_scenes): clamped at "
+        f"its hub ring, {modes} fixed-interface modes and 8 load shapes",
+    )  # fmt: skip
+
+
+def rt70_mirror_scene(body: ModalArrays | None = None, file: str = RT70_DISH_FILE) -> str:
+    """The listing's RT-70 with its main mirror a flexible dish (module docstring).
+
+    The dish's centre of mass sits at the main mirror's (its vertex below it on the
+    axis), so the link keeps the listing's mass, centre and inertia in total.
+
+    Parameters
+    ----------
+    body : rt70.urdf.modal_file.ModalArrays, optional
+        The dish (:func:`rt70_mirror_body`); the shipped one by default.
+    file : str
+        The name its file has beside the URDF file.
+    """
+    from rt70.scenes.rt70_scenes import rt70_scene
+
+    body = rt70_mirror_body() if body is None else body
+    _, c, _ = rigid_properties(body.nodes, body.masses)
+    text = rt70_scene().replace('<robot name="rt70"', '<robot name="rt70_mirror"', 1)
+    text = text.replace(
+        "<!-- RT-70 radio telescope, 42-DOF nonlinear model",
+        "<!-- RT-70 radio telescope with a flexible main mirror (a dish of 'main_dish.npz' "
+        "on the main mirror's pair); the 42-DOF nonlinear model",
+        1,
+    ).replace("main_dish.npz", RT70_DISH_FILE, 1)
+    return with_flexible_reflector(
+        text, "main_mirror", np.array([0.0, 0.0, -c[2]]), body, "main_dish", file,
+        RT70_DISH_DAMPING,
+    )  # fmt: skip
