@@ -37,7 +37,8 @@ PACKAGE = ROOT / "rt70"
 
 #: Modules below both sides that any layer may import (``rt70.physics.loads``: the plain
 #: Wrench value both sides turn into a generalised force; ``rt70.physics.aerodynamics``:
-#: the wind's Wrench on a body at a pose each side computes).
+#: the wind's Wrench on a body at a pose each side computes; ``rt70.surface.pressure``:
+#: that Wrench spread over surface nodes each side places).
 SHARED = (
     "rt70.errors",
     "rt70.guards.arrays",
@@ -47,6 +48,7 @@ SHARED = (
     "rt70.physics.aerodynamics",
     "rt70.physics.kkt",
     "rt70.physics.baumgarte",
+    "rt70.surface.pressure",
 )
 
 #: layer (module prefix) → module prefixes it may import from rt70.
@@ -62,6 +64,7 @@ RULES = {
         *SHARED[:4],
         "rt70.physics.aerodynamics",
         "rt70.physics.baumgarte",
+        "rt70.surface.pressure",
     ),
     "rt70.guards.resources": ("rt70.errors",),
     "rt70.physics.rotations": (),
@@ -74,6 +77,7 @@ RULES = {
     "rt70.physics.aerodynamics": ("rt70.errors", "rt70.physics.loads"),
     "rt70.physics.kkt": ("rt70.errors",),
     "rt70.physics.baumgarte": ("rt70.errors",),
+    "rt70.surface.pressure": ("rt70.errors",),
     "rt70.physics.nonholonomic": ("rt70.errors", "rt70.physics.kkt"),
 }
 

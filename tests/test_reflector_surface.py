@@ -29,11 +29,15 @@ from rt70.model.outputs import evaluate, output_matrix
 from rt70.model.scene import load_scene, scene_from_text
 from rt70.model.sides import side_of
 from rt70.model.surface_outputs import reflector_surface, surface_outputs, surface_rms
+from rt70.physics.aerodynamics import WindCondition
+from rt70.reference import wind as ref_wind
 from rt70.scenes import reflector_scenes as rs
 from rt70.scenes.rt70_data import LISTING_BODIES
 from rt70.surface.best_fit import fit_maps
+from rt70.surface.pressure import nodal_forces
 from rt70.telescope.homology import homology
 from rt70.testing import assert_close
+from rt70.textbook import wind as tb_wind
 from rt70.urdf.modal_file import ModalArrays, read_modal_file, write_modal_file
 from rt70.urdf.modal_record import Surface, node_point
 
@@ -157,7 +161,7 @@ def test_load_shapes_make_the_static_response_exact(dish):
     patterns = rs.load_patterns(dish)
     body = rs.dish_body(dish, 6, "test")
     modes_only = clamped_modes(dish.fe, dish.hub, 6)
-    for k in (0, 2, 4):  # gravity along x, along z; a pitching pressure
+    for k in (0, 2, 5, 6):  # gravity along x and z; an axial pressure; a pitching one
         exact = _static(dish, patterns[k])
         scale = np.abs(exact).max()
         for b, expect_exact in ((body, True), (modes_only, False)):
@@ -243,3 +247,30 @@ def test_a_scene_without_a_surface_is_refused_by_name():
     scene = scene_from_text('<robot name="bare"><link name="world"/></robot>', "bare")
     with pytest.raises(Exception, match="0 modal bodies have a reflecting surface"):
         reflector_surface(scene)
+
+
+def test_the_pressure_carries_the_wrench_exactly():
+    nodes = RNG.normal(0.0, 10.0, (40, 3))
+    weights = RNG.uniform(0.5, 2.0, 40)
+    force, moment, point = RNG.normal(0, 1e4, 3), RNG.normal(0, 1e5, 3), RNG.normal(0, 5, 3)
+    f = nodal_forces(force, moment, point, nodes, weights)
+    assert_close(f.sum(axis=0), force, rel=1e-13, scale=np.abs(force).max())
+    total = np.cross(nodes - point, f).sum(axis=0)
+    assert_close(total, moment, rel=1e-12, scale=np.abs(moment).max())
+    with pytest.raises(Exception, match="on a line"):
+        nodal_forces(force, moment, point, np.outer(np.arange(5.0), [1, 2, 3]), np.ones(5))
+
+
+def test_wind_on_the_surface_agrees_and_moves_the_structure_as_the_wrench(mirror):
+    condition = WindCondition(20.0, 30.0)
+    q = _small_state(mirror, scale=0.0)
+    tb = tb_wind.wind_forces(mirror.textbook, mirror.textbook_data, q, condition)
+    ref = ref_wind.wind_forces(mirror.reference, mirror.reference_data, q, condition)
+    spread = tb["main_mirror"]
+    assert_close(spread, ref["main_mirror"], rel=1e-12, scale=np.abs(spread).max())
+    wrench = tb_wind.wind_wrenches(mirror.textbook, mirror.textbook_data, q, condition)
+    lumped = tb_wind._force(mirror.textbook, mirror.textbook_data, wrench["main_mirror"])
+    rigid = np.ones(mirror.textbook.nv, dtype=bool)
+    rigid[mirror.textbook.modal[0].coords] = False
+    assert_close(spread[rigid], lumped[rigid], rel=1e-11, scale=np.abs(lumped).max())
+    assert np.abs(spread[~rigid]).max() > 1e-6 * np.abs(lumped).max()  # it deforms the dish

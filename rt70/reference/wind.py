@@ -16,7 +16,9 @@ from rt70.physics.aerodynamics import WindCondition, wind_wrench
 from rt70.physics.loads import Wrench
 from rt70.reference.drives import link_pose
 from rt70.reference.model import ReferenceData, ReferenceModel
-from rt70.reference.points import generalized_force, link_point
+from rt70.reference.points import generalized_force, link_point, point_jacobian, point_positions
+from rt70.surface.pressure import nodal_forces
+from rt70.urdf.modal_record import node_point
 
 
 def wind_wrenches(
@@ -60,7 +62,33 @@ def wind_forces(
         The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
     """
     wrenches = wind_wrenches(model, data, q, condition)
-    return {name: generalized_force(model, data, q, w) for name, w in wrenches.items()}
+    bodies = {b.name: b for b in model.modal_bodies}
+    surfaces = {w.name: w.surface for w in model.winds}
+    return {
+        name: generalized_force(model, data, q, w)
+        if surfaces[name] is None
+        else _surface_force(model, data, q, w, bodies[surfaces[name]])
+        for name, w in wrenches.items()
+    }
+
+
+def _surface_force(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray, wrench: Wrench, body
+) -> np.ndarray:
+    """``Q = Σ J_nᵀ f_n`` of the wrench spread over ``body``'s surface nodes.
+
+    The nodes are Pinocchio's node joints (:mod:`rt70.reference.modal_nodes`); their
+    positions and Jacobians are Pinocchio's; :func:`rt70.surface.pressure.nodal_forces`
+    spreads the wrench.
+    """
+    s = body.surface
+    points = [(node_point(body.name, int(n)), np.zeros(3)) for n in s.nodes]
+    p = point_positions(model, data, q, [*points, (wrench.link, wrench.xyz)])
+    forces = nodal_forces(wrench.force, wrench.torque, p[-1], p[:-1], s.weights)
+    Q = np.zeros(model.nv)
+    for f, (link, xyz) in zip(forces, points, strict=True):
+        Q += point_jacobian(model, data, q, link, xyz)[0].T @ f
+    return Q
 
 
 def wind_force(
@@ -94,11 +122,11 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
     RelativePoints`, frame 1 the ground) instead of Pinocchio's placements and point
     Jacobians per body and evaluation; :func:`rt70.physics.aerodynamics.wind_wrench` gives the same
     Wrench from the same pose, and ``Q = J_vᵀ F + J_ωᵀ M`` (tested equal to
-    :func:`wind_force`). Mapped coordinates or an unsupported path keep
-    :func:`wind_force`.
+    :func:`wind_force`). Mapped coordinates, a wind spread over a surface or an
+    unsupported path keep :func:`wind_force`.
     """
     slow = lambda q, condition: wind_force(model, data, q, condition)  # noqa: E731
-    if not model.identity_map or not model.winds:
+    if not model.identity_map or not model.winds or any(w.surface for w in model.winds):
         return slow
     import pinocchio as pin
 

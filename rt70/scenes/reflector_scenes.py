@@ -35,13 +35,14 @@ TRIANGLE_RTOL = 1e-12
 
 
 def load_patterns(dish: Dish) -> np.ndarray:
-    """Nodal force patterns (8, N, 3) of the dish's weight and of a wind pressure.
+    """Nodal force patterns (9, N, 3) of the dish's weight and of the wind's pressure.
 
-    The weight along x, y, z (each node's mass times a unit acceleration), and a
-    pressure over the surface nodes by their aperture weights: along z uniform, along z
-    varying as x and as y (a pitching and a yawing moment), and along x and y uniform.
-    Their static shapes make the dish's response to gravity at any elevation and to a
-    wind load of that form exact in the modal body (:func:`dish_body`).
+    The weight along x, y, z (each node's mass times a unit acceleration), and the
+    wind's pressure field over the surface nodes (:mod:`rt70.surface.pressure`): by
+    their aperture weights along x, y, z, and ``w_n (e_k × ρ_n)`` about the weighted
+    centre for k = x, y, z. Their static shapes make the dish's response to gravity at
+    any elevation and to any wind wrench spread by :func:`rt70.surface.pressure.nodal_forces`
+    exact in the modal body (:func:`dish_body`).
 
     Parameters
     ----------
@@ -49,17 +50,14 @@ def load_patterns(dish: Dish) -> np.ndarray:
         The dish.
     """
     masses = dish.fe.M.diagonal()[::3]
-    n = masses.size
-    out = np.zeros((8, n, 3))
-    for axis in range(3):
-        out[axis, :, axis] = masses
-    x, y = dish.fe.node_xyz[dish.surface, 0], dish.fe.node_xyz[dish.surface, 1]
-    w = dish.weights
-    out[3, dish.surface, 2] = w
-    out[4, dish.surface, 2] = w * x
-    out[5, dish.surface, 2] = w * y
-    out[6, dish.surface, 0] = w
-    out[7, dish.surface, 1] = w
+    out = np.zeros((9, masses.size, 3))
+    w = dish.weights / dish.weights.sum()
+    x = np.asarray(dish.fe.node_xyz, dtype=float)[dish.surface]
+    rho = x - w @ x
+    for k, e in enumerate(np.eye(3)):
+        out[k, :, k] = masses
+        out[3 + k, dish.surface, k] = w
+        out[6 + k, dish.surface] = w[:, None] * np.cross(e, rho)
     return out
 
 
@@ -71,7 +69,7 @@ def dish_body(dish: Dish, modes: int, source: str) -> ModalArrays:
     dish : rt70.fe.reflector.Dish
         The dish (its front layer is the surface).
     modes : int
-        Fixed-interface modes kept; the 8 static shapes of :func:`load_patterns` are added.
+        Fixed-interface modes kept; the 9 static shapes of :func:`load_patterns` are added.
     source : str
         Where the dish came from (stored in the file).
     """
@@ -147,7 +145,7 @@ def residual_properties(
 
 def with_flexible_reflector(
     text: str, link: str, vertex: np.ndarray, body: ModalArrays, name: str, file: str,
-    damping_ratio: float,
+    damping_ratio: float, wind: str | None = None,
 ) -> str:  # fmt: skip
     """The URDF ``text`` with the dish ``body`` on ``link``, the link's totals kept.
 
@@ -167,6 +165,9 @@ def with_flexible_reflector(
         The modal body file's name, beside the URDF file.
     damping_ratio : float
         Every mode's ratio of critical damping.
+    wind : str, optional
+        The ``<rt70:wind>`` of the reflector, to be spread over the dish's surface
+        (its ``surface`` attribute set to ``name``).
 
     Raises
     ------
@@ -197,6 +198,11 @@ def with_flexible_reflector(
     for key, (i, j) in {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2),
                         "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}.items():  # fmt: skip
         inertial.find("inertia").set(key, uw.fmt(Ih[i, j]))
+    if wind is not None:
+        found_wind = [e for e in root.iter(f"{{{RT70_NAMESPACE}}}wind") if e.get("name") == wind]
+        if not found_wind:
+            raise Rt70Error(f"no <rt70:wind name='{wind}'> in the scene")
+        found_wind[0].set("surface", name)
     ET.indent(root, space="  ")
     body_text = "\n".join(
         [
@@ -245,7 +251,7 @@ RT70_BAR = {"EA": 2.1e11 * 4e-4, "rho_A": 7850.0 * 4e-4}
 #: The dish's share of the listing main mirror's polar moment (the rest stays lumped on
 #: the link: the listing's body is heavier at its centre than a uniform dish).
 RT70_DISH_SHARE = 0.75
-#: Fixed-interface modes of the dish kept (plus the 8 static shapes of its loads).
+#: Fixed-interface modes of the dish kept (plus the 9 static shapes of its loads).
 RT70_DISH_MODES = 16
 #: The dish's modal damping ratio (the RT-70's structural damping is not in the source;
 #: 1 % is the usual figure for welded steel structures, stated).
@@ -301,7 +307,7 @@ def rt70_mirror_body(modes: int = RT70_DISH_MODES, **layout: int) -> ModalArrays
     Parameters
     ----------
     modes : int
-        Fixed-interface modes kept (plus the 8 load shapes).
+        Fixed-interface modes kept (plus the 9 load shapes).
     **layout : int
         ``rings`` and ``ribs`` (:func:`rt70_dish`).
     """
@@ -309,12 +315,12 @@ def rt70_mirror_body(modes: int = RT70_DISH_MODES, **layout: int) -> ModalArrays
     return dish_body(
         dish, modes,
         f"{dish.fe.name}, the RT-70 main mirror (rt70.scenes.reflector_scenes): clamped at "
-        f"its hub ring, {modes} fixed-interface modes and 8 load shapes",
+        f"its hub ring, {modes} fixed-interface modes and 9 load shapes",
     )  # fmt: skip
 
 
 def rt70_mirror_scene(body: ModalArrays | None = None, file: str = RT70_DISH_FILE) -> str:
-    """The listing's RT-70 with its main mirror a flexible dish (module docstring).
+    """The RT-70 control object (``rt70_servo``) with its main mirror a flexible dish.
 
     The dish's centre of mass sits at the main mirror's (its vertex below it on the
     axis), so the link keeps the listing's mass, centre and inertia in total.
@@ -326,18 +332,21 @@ def rt70_mirror_scene(body: ModalArrays | None = None, file: str = RT70_DISH_FIL
     file : str
         The name its file has beside the URDF file.
     """
-    from rt70.scenes.rt70_scenes import rt70_scene
+    from rt70.scenes.rt70_scenes import rt70_servo_scene
 
     body = rt70_mirror_body() if body is None else body
     _, c, _ = rigid_properties(body.nodes, body.masses)
-    text = rt70_scene().replace('<robot name="rt70"', '<robot name="rt70_mirror"', 1)
+    text = rt70_servo_scene()
+    head = text[: text.index("<robot")]
+    text = text.replace('<robot name="rt70_servo"', '<robot name="rt70_mirror"', 1)
     text = text.replace(
-        "<!-- RT-70 radio telescope, 42-DOF nonlinear model",
-        "<!-- RT-70 radio telescope with a flexible main mirror (a dish of 'main_dish.npz' "
-        "on the main mirror's pair); the 42-DOF nonlinear model",
+        head.splitlines()[1],
+        f"<!-- RT-70 as a control object (rt70_servo) with a flexible main mirror: the dish "
+        f"of {file} on the main mirror's pair, the main mirror's wind spread over its "
+        "surface -->",
         1,
-    ).replace("main_dish.npz", RT70_DISH_FILE, 1)
+    )
     return with_flexible_reflector(
         text, "main_mirror", np.array([0.0, 0.0, -c[2]]), body, "main_dish", file,
-        RT70_DISH_DAMPING,
+        RT70_DISH_DAMPING, wind="main_mirror",
     )  # fmt: skip

@@ -14,6 +14,7 @@ import numpy as np
 
 from rt70.textbook.flexible import Invariants, inertia_invariants
 from rt70.urdf.description import ModalBody
+from rt70.urdf.modal_record import Surface
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,8 @@ class ModalModel:
         The nodes ``x_n`` in the body's frame, m.
     shapes : numpy.ndarray, shape (N, 3, k)
         ``Φ_n`` in the body's axes.
+    surface : rt70.urdf.modal_record.Surface or None
+        Its reflecting surface (nodes, weights, F), as the file gives it.
     """
 
     name: str
@@ -54,6 +57,7 @@ class ModalModel:
     start: int
     nodes: np.ndarray
     shapes: np.ndarray
+    surface: Surface | None = None
 
     @property
     def modes(self) -> int:
@@ -85,7 +89,19 @@ def place_modal_bodies(bodies: tuple[ModalBody, ...], link_frames: dict, start: 
         shapes = np.einsum("ab,nbj->naj", c, b.shapes)
         invariants = inertia_invariants(nodes, b.masses, shapes)
         out.append(
-            ModalModel(b.name, body, r, c, invariants, b.stiffness, b.damping, start, nodes, shapes)
+            ModalModel(
+                b.name,
+                body,
+                r,
+                c,
+                invariants,
+                b.stiffness,
+                b.damping,
+                start,
+                nodes,
+                shapes,
+                b.surface,
+            )  # fmt: skip
         )
         start += b.modes
     return tuple(out)

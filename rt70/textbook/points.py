@@ -209,8 +209,25 @@ def point_jacobian(
     xyz : array_like, shape (3,)
         The point in the link's frame, m.
     """
-    body, r0, Phi, eta = located_point(model, link, xyz)
     update_structure(model, data, q)
+    return located_jacobian(data, q, located_point(model, link, xyz))
+
+
+def located_jacobian(
+    data: Data, q: np.ndarray, located: tuple[int, np.ndarray, np.ndarray, slice]
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(J_v, J_ω)`` of a located point (:func:`located_point`) from the S in ``data``.
+
+    Parameters
+    ----------
+    data : Data
+        Work buffers holding the configuration's poses and S (:func:`update_structure`).
+    q : numpy.ndarray, shape (nv,)
+        The configuration ``data`` holds (its modal coordinates place a node).
+    located : (int, numpy.ndarray, numpy.ndarray, slice)
+        ``(body, r0, Φ, η)`` of the point.
+    """
+    body, r0, Phi, eta = located
     Jv, Jw = ground_jacobian(data, body, r0 + Phi @ q[eta])
     if Phi.shape[1]:
         c = frame_pose(data, body, np.zeros(3), np.eye(3))[0]

@@ -16,10 +16,12 @@ import numpy as np
 from rt70.guards.arrays import check_vector
 from rt70.physics.aerodynamics import WindCondition, wind_wrench
 from rt70.physics.loads import Wrench
+from rt70.surface.pressure import nodal_forces
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import frame_pose, update_structure
 from rt70.textbook.model import Model
-from rt70.textbook.points import ground_jacobian, link_point
+from rt70.textbook.points import ground_jacobian, link_point, located_jacobian, located_point
+from rt70.urdf.modal_record import node_point
 
 
 def _force(model: Model, data: Data, wrench: Wrench) -> np.ndarray:
@@ -29,6 +31,22 @@ def _force(model: Model, data: Data, wrench: Wrench) -> np.ndarray:
         return np.zeros(model.nv)
     Jv, Jw = ground_jacobian(data, body, r)
     return Jv.T @ np.asarray(wrench.force) + Jw.T @ np.asarray(wrench.torque)
+
+
+def _surface_force(model: Model, data: Data, q: np.ndarray, wrench: Wrench, body) -> np.ndarray:
+    """``Q = Σ J_v,nᵀ f_n`` of the wrench spread over ``body``'s surface nodes (4.129)."""
+    s = body.surface
+    located = [located_point(model, node_point(body.name, int(n)), np.zeros(3)) for n in s.nodes]
+    p = np.array(
+        [frame_pose(data, b, r0 + Phi @ q[eta], np.eye(3))[1] for b, r0, Phi, eta in located]
+    )
+    at, r = link_point(model, wrench.link, wrench.xyz)
+    point = frame_pose(data, at, r, np.eye(3))[1]
+    forces = nodal_forces(wrench.force, wrench.torque, point, p, s.weights)
+    Q = np.zeros(model.nv)
+    for f, where in zip(forces, located, strict=True):
+        Q += located_jacobian(data, q, where)[0].T @ f
+    return Q
 
 
 def wind_wrenches(
@@ -76,7 +94,14 @@ def wind_forces(
         The steady wind: speed (m/s), azimuth it blows from (degrees), air density.
     """
     wrenches = wind_wrenches(model, data, q, condition)
-    return {name: _force(model, data, w) for name, w in wrenches.items()}
+    bodies = {m.name: m for m in model.modal}
+    surfaces = {w.name: w.surface for w in model.winds}
+    return {
+        name: _force(model, data, w)
+        if surfaces[name] is None
+        else _surface_force(model, data, q, w, bodies[surfaces[name]])
+        for name, w in wrenches.items()
+    }
 
 
 def wind_force(model: Model, data: Data, q: np.ndarray, condition: WindCondition) -> np.ndarray:

@@ -279,6 +279,9 @@ class Wind:
         as written in the URDF.
     table : rt70.physics.aerodynamics.CoefficientTable
         The coefficients C_A, C_N, C_M against θ (:mod:`rt70.physics.aerodynamics`).
+    surface : str or None
+        A modal body with a reflecting surface over whose nodes the wrench is spread as
+        a pressure (:mod:`rt70.surface.pressure`); None: the wrench acts at ``xyz``.
     """
 
     name: str
@@ -289,6 +292,7 @@ class Wind:
     length: float
     shape: str
     table: CoefficientTable
+    surface: str | None = None
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ from rt70.urdf.mount import read_mount
 from rt70.urdf.no_slip import read_no_slip
 from rt70.urdf.optics import read_optics
 from rt70.urdf.text import RT70_NS
-from rt70.urdf.wind import read_air, read_wind
+from rt70.urdf.wind import check_wind_surfaces, read_air, read_wind
 
 #: Kinds of ``<rt70:loop>`` and their number of constraint rows.
 LOOP_TYPES = {"point": 3, "frame": 6}
@@ -105,6 +105,7 @@ def read_extensions(
         else:  # a kind declared in RT70 must be read here, never skipped
             raise NotImplementedError(f"<rt70:{kind}> is declared but not read")
     _check_unique_names(reader, desc)
+    check_wind_surfaces(reader, winds, tuple(modal))
     if not (winds or air or no_slips or mount or optics or beams or modal):
         return desc
     return dataclasses.replace(

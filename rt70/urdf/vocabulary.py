@@ -140,7 +140,7 @@ RT70 = Spec(
         "wind": Child(
             Spec(
                 required=("name", "link", "axis", "area", "length"),
-                optional=("xyz", "shape", "coefficients"),
+                optional=("xyz", "shape", "coefficients", "surface"),
             )
         ),
         "air": Child(Spec(required=("density",)), most=1),

@@ -67,7 +67,33 @@ def read_wind(
             raise reader.fail(ExtensionError, f"{where}: {key}={value:g} must be positive")
         values[key] = value
     shape, table = _table(reader, elem, where)
-    return Wind(name, link, xyz, axis / norm, values["area"], values["length"], shape, table)
+    surface = elem.get("surface")
+    return Wind(
+        name, link, xyz, axis / norm, values["area"], values["length"], shape, table, surface
+    )
+
+
+def check_wind_surfaces(reader: ElementReader, winds: list[Wind], bodies: tuple) -> None:
+    """Refuse a ``surface=`` that names no modal body with a reflecting surface.
+
+    Parameters
+    ----------
+    reader : ElementReader
+        The reader of the file (its name for messages).
+    winds : list of Wind
+        The file's winds.
+    bodies : tuple of rt70.urdf.modal_record.ModalBody
+        The file's modal bodies.
+    """
+    with_surface = {b.name for b in bodies if b.surface is not None}
+    for w in winds:
+        if w.surface is not None and w.surface not in with_surface:
+            known = ", ".join(sorted(with_surface)) or "none"
+            raise reader.fail(
+                ExtensionError,
+                f"<rt70:wind name='{w.name}'>: surface=\"{w.surface}\" is no modal body with a "
+                f"reflecting surface (those with one: {known})",
+            )
 
 
 def _table(reader: ElementReader, elem: ET.Element, where: str) -> tuple[str, CoefficientTable]:
