@@ -54,6 +54,21 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
         metavar="T",
         help="also run T seconds of gusts through the nonlinear model and compare",
     )
+    poi.add_argument(
+        "--frequency",
+        type=options.frequency_ghz,
+        action="append",
+        metavar="GHZ",
+        help="observing frequency, GHz, for the reflector surface's Ruze efficiency "
+        "(repeatable; a scene with a reflecting surface, docs/surface.md)",
+    )
+    poi.add_argument(
+        "--rigging-elevation",
+        type=options.elevation_deg,
+        metavar="DEG",
+        help="elevation at which the surface's panels were set, degrees (default: the "
+        "middle of the mount's elevation range; a scene with a reflecting surface)",
+    )
     poi.add_argument("--seed", type=options.seed, default=0, help="gust record seed (default 0)")
     poi.add_argument("--progress", action="store_true", help="progress bar of the gust run")
     poi.add_argument("--json", action="store_true", help="print JSON")
@@ -94,6 +109,13 @@ def run(args: argparse.Namespace) -> int:
         )
         scene = load_scene(SERVO_SCENE)
     check_scene(scene)
+    has_surface = any(b.surface is not None for b in scene.description.modal_bodies)
+    if not has_surface and (args.frequency or args.rigging_elevation is not None):
+        option = "--frequency" if args.frequency else "--rigging-elevation"
+        raise Rt70Error(
+            f"{option}: {scene.name} has no reflecting surface (a <rt70:modal_body> whose "
+            "file has one, docs/surface.md)"
+        )
     if args.duration is not None:  # before the budget's work
         from rt70.telescope.gust_run import check_duration
 
@@ -107,7 +129,17 @@ def run(args: argparse.Namespace) -> int:
         run = gust_run(
             scene, case, args.duration, seed=args.seed, progress=args.progress, model=model
         )
+    surface = None
+    if has_surface:
+        from rt70.telescope.surface_budget import case_surface, default_rigging
+
+        rigging = (
+            default_rigging(scene) if args.rigging_elevation is None else args.rigging_elevation
+        )
+        surface = case_surface(model, rigging, [f * 1e9 for f in args.frequency or []])
     out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
+    if surface is not None:
+        out["surface"] = surface.to_dict()
     if run is not None:
         out["gust_run"] = run.to_dict()
     options.check_finite(out, f"{scene.name}: pointing budget")
@@ -115,6 +147,10 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(out, indent=2))
         return 0
     print(format_budget(scene.name, budget))
+    if surface is not None:
+        from rt70.telescope.surface_budget import format_surface
+
+        print("\n".join(format_surface(surface)))
     if run is not None:
         print(
             f"  {run.duration:g} s of gusts (seed {run.seed}), rms of the record against the "

@@ -54,7 +54,15 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "--quantity",
         type=_sweep_quantities,
         metavar="Q1,Q2",
-        help="quantities to compute (default first_frequency,sag)",
+        help="quantities to compute (default first_frequency,sag; also pointing, surface)",
+    )
+    swp.add_argument(
+        "--frequency",
+        type=options.frequency_ghz,
+        action="append",
+        metavar="GHZ",
+        help="observing frequency, GHz: the surface quantity adds Ruze's efficiency there "
+        "(repeatable; docs/surface.md)",
     )
     swp.add_argument("--out", required=True, metavar="FILE", help="output file, .npz")
     swp.add_argument(
@@ -100,6 +108,13 @@ def run(args: argparse.Namespace) -> int:
     values = {k: getattr(args, k) for k in ("elevation", "azimuth", "wind", "direction")}
     grid = sw.make_grid({k: v for k, v in values.items() if v is not None}, dict(args.scale or []))
     quantities = args.quantity or sw.DEFAULT_QUANTITIES
+    if args.frequency:
+        from rt70.sweep.quantities import register_quantity
+        from rt70.sweep.surface_quantity import surface_quantity
+
+        if "surface" not in quantities:
+            raise Rt70Error("--frequency: only the surface quantity uses it (--quantity surface)")
+        register_quantity(surface_quantity(args.frequency))
     out = Path(args.out)
     sw.check_output(out)
     if args.scheduler is None and args.workers != 0:
@@ -207,6 +222,7 @@ def _sweep_scale(text: str) -> tuple[str, tuple[float, ...]]:
 
 def _sweep_quantities(text: str) -> tuple[str, ...]:
     """The argparse type of ``--quantity a,b`` (registered quantities)."""
+    import rt70.sweep.surface_quantity  # noqa: F401  (registers 'surface')
     from rt70.sweep.quantities import quantity_names
 
     try:

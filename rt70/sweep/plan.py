@@ -23,6 +23,7 @@ import numpy as np
 from rt70.errors import Rt70Error
 from rt70.guards.resources import check_memory
 from rt70.model.scene import Scene, scene_from_text, scene_path
+from rt70.sweep import surface_quantity  # noqa: F401  (registers 'surface')
 from rt70.sweep.errors import SweepError
 from rt70.sweep.grid import Chunk, Grid
 from rt70.sweep.quantities import QUANTITIES, Quantity, check_factors, scaled_scene

@@ -145,8 +145,14 @@ QUANTITIES: dict[str, Quantity] = {}
 
 
 def register_quantity(quantity: Quantity) -> Quantity:
-    """Add ``quantity`` to :data:`QUANTITIES` (a field name may belong to one quantity only)."""
-    taken = {f.name: q.name for q in QUANTITIES.values() for f in q.fields if q is not quantity}
+    """Add ``quantity`` to :data:`QUANTITIES` (a field name may belong to one quantity only).
+
+    A quantity of a name already registered replaces it (``surface`` made again with
+    the frequencies of ``rt70 sweep --frequency``).
+    """
+    taken = {
+        f.name: q.name for q in QUANTITIES.values() for f in q.fields if q.name != quantity.name
+    }
     clash = [f.name for f in quantity.fields if f.name in taken]
     if clash:
         raise Rt70Error(f"sweep quantity {quantity.name}: field(s) {', '.join(clash)} taken")

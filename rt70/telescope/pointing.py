@@ -318,7 +318,7 @@ def windy_first_frequency(scene: Scene, w: WindyLinearization) -> float:
     return float(np.sqrt(lam[0]) / (2.0 * np.pi))
 
 
-def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
+def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization, extra: list[Output] = ()):
     """The closed loop driven by the Davenport gust filter: unit white noise in, outputs out.
 
     Returns the augmented python-control ``StateSpace`` (input ``w``) and the closed
@@ -332,6 +332,9 @@ def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
         The case: its outputs and the mean wind speed of the gust filter.
     w : WindyLinearization
         The linear model about the windy equilibrium (:func:`windy_linearization`).
+    extra : list of Output
+        More outputs after the budget's (a reflector's surface,
+        :mod:`rt70.telescope.surface_budget`).
     """
     from rt70.control.scene_loop import closed_loop
     from rt70.linear.covariance import cascade_with_filter
@@ -342,7 +345,7 @@ def gust_system(scene: Scene, case: PointingCase, w: WindyLinearization):
         scene,
         w.lm,
         {"gust": w.gust_column},
-        budget_outputs(scene, case),
+        [*budget_outputs(scene, case), *extra],
         scene_servos(scene),
         K_extra=w.K_wind,
     )
@@ -356,7 +359,9 @@ class BudgetModel:
     The wind at the case, its calm and windy drive-held equilibria, the budget's outputs,
     the linear model about the windy one, the closed loop (``loop``, inputs
     ``<drive>_reference`` and ``gust``) and the loop driven by the gust filter
-    (``augmented``, input ``w``) with its state covariance ``P``; ``seconds`` to build.
+    (``augmented``, input ``w``) with its state covariance ``P``; ``seconds`` to build;
+    the reflector's surface outputs in the loop when the scene has a surface
+    (``surface``, :mod:`rt70.telescope.surface_budget`).
     """
 
     case: PointingCase
@@ -368,6 +373,14 @@ class BudgetModel:
     augmented: object
     P: np.ndarray
     seconds: float
+    surface: object = None
+
+    def output_covariance(self, outputs: list[Output]) -> np.ndarray:
+        """The ensemble covariance of ``outputs``' components (all in the loop)."""
+        labels = list(self.augmented.output_labels)
+        idx = [labels.index(r) for o in outputs for r in self.rows(o)]
+        C = self.augmented.C[idx]
+        return C @ self.P @ C.T
 
     def rows(self, output: Output) -> list[str]:
         """The loop's output names of one budget output's components (``name:x`` …)."""
@@ -387,18 +400,21 @@ class BudgetModel:
 def budget_model(scene: Scene, case: PointingCase) -> BudgetModel:
     """Build the :class:`BudgetModel` of a case (module docstring)."""
     from rt70.linear.covariance import state_covariance
+    from rt70.telescope.surface_budget import scene_surface_outputs
 
     check_case(case)
     start = time.perf_counter()
     windy = WindyScene(scene, case.speed, case.direction)
     state = wind_equilibria(scene, case, windy)
     linear = windy_linearization(scene, windy, state)
-    augmented, loop = gust_system(scene, case, linear)
+    surface = scene_surface_outputs(scene)
+    augmented, loop = gust_system(scene, case, linear, surface[1] if surface else [])
     P = state_covariance(augmented)
     outputs = budget_outputs(scene, case)
     return BudgetModel(
-        case, windy, state, outputs, linear, loop, augmented, P, time.perf_counter() - start
-    )
+        case, windy, state, outputs, linear, loop, augmented, P, time.perf_counter() - start,
+        surface,
+    )  # fmt: skip
 
 
 def pointing_budget(
