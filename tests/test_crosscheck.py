@@ -36,7 +36,15 @@ def test_scene_agrees_with_pinocchio(name):
     # the wind row exactly where the scene has <rt70:wind>s: RT-70 control objects, antennas
     assert ("wind" in quantities(scene)) == bool(scene.description.winds)
     assert bool(scene.description.winds) == (
-        name in ("rt70_servo", "rt70_flexible", "rt70_mirror", "antenna_12m", "antenna_34m")
+        name
+        in (
+            "rt70_servo",
+            "rt70_flexible",
+            "rt70_mirror",
+            "antenna_12m",
+            "antenna_12m_dish",
+            "antenna_34m",
+        )
     )
     for r in records:
         assert r.max_rel_err <= TOL, f"{name} {r.quantity}: {r.max_rel_err:.3g}"

@@ -274,3 +274,48 @@ def test_wind_on_the_surface_agrees_and_moves_the_structure_as_the_wrench(mirror
     rigid[mirror.textbook.modal[0].coords] = False
     assert_close(spread[rigid], lumped[rigid], rel=1e-11, scale=np.abs(lumped).max())
     assert np.abs(spread[~rigid]).max() > 1e-6 * np.abs(lumped).max()  # it deforms the dish
+
+
+@pytest.mark.parametrize(
+    ("name", "fresh"),
+    [("rt70_mirror", rs.rt70_mirror_body), ("antenna_12m_dish", None)],
+)
+def test_the_shipped_dish_files_are_the_generators(name, fresh):
+    """The committed modal files against a fresh build, in what does not depend on the CPU.
+
+    Mode shapes of equal frequencies (the dish's symmetric pairs) are any basis of their
+    plane, so the modes are compared through the projector ``Φ Φᵀ M`` and ω².
+    """
+    if fresh is None:
+        from rt70.scenes.antenna_dish import antenna_12m_dish_body as fresh
+    body = load_scene(name).description.modal_bodies[0]
+    new = fresh()
+    assert_close(body.masses, new.masses, rel=1e-12, scale=new.masses.max())
+    assert_close(np.diag(body.stiffness), np.diag(new.stiffness), rel=1e-9)
+    assert np.array_equal(body.surface.nodes, new.surface.nodes)
+    assert_close(body.surface.weights, new.surface.weights, rel=1e-14)
+
+    def projector(shapes, masses):
+        Phi = shapes.reshape(-1, shapes.shape[2])
+        return Phi @ Phi.T * np.repeat(masses, 3)
+
+    P = projector(new.shapes, new.masses)
+    assert_close(projector(body.shapes, body.masses), P, rel=1e-7, scale=np.abs(P).max())
+
+
+def test_the_12m_dish_keeps_the_reflectors_mass_and_centre():
+    from rt70.scenes.antenna import antenna_urdf
+    from rt70.scenes.antenna_presets import PRESETS
+    from rt70.urdf import read_urdf_string
+
+    rigid = read_urdf_string(antenna_urdf(PRESETS["antenna_12m"]), "rigid.urdf").links["reflector"]
+    scene = load_scene("antenna_12m_dish")
+    link = scene.description.links["reflector"].inertial
+    body = scene.description.modal_bodies[0]
+    weld = [j for j in scene.description.joints if j.name == "dish_weld"][0]
+    m_d, c_d, _ = rs.rigid_properties(body.nodes + weld.xyz, body.masses)
+    m = m_d + link.mass
+    assert m == pytest.approx(rigid.inertial.mass, rel=1e-12)
+    c = (m_d * c_d + link.mass * np.asarray(link.com)) / m
+    assert_close(c, rigid.inertial.com, rel=1e-10, scale=1.0)
+    assert reflector_surface(scene).focal_length == 4.8

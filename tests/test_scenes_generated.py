@@ -36,6 +36,7 @@ EXPECTED_NV = {
     "antenna_34m": 6,
     "slewing_truss": 1,  # Pinocchio's parser sees the slew joint; the modes are rt70's
     "rt70_mirror": 42,  # the listing's; the dish's modes are rt70's
+    "antenna_12m_dish": 6,  # the preset's; the dish's modes are rt70's
 }
 
 RT70_BODIES = (

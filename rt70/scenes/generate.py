@@ -25,6 +25,7 @@ from pathlib import Path
 
 from rt70.guards.atomic import atomic_write_text
 from rt70.scenes.antenna import antenna_urdf
+from rt70.scenes.antenna_dish import DISH_FILE, antenna_12m_dish_body, antenna_12m_dish_scene
 from rt70.scenes.antenna_presets import PRESETS
 from rt70.scenes.book_scenes import (
     double_pendulum_scene,
@@ -68,12 +69,14 @@ SCENES: dict[str, Callable[[], str]] = {
     **{name: partial(antenna_urdf, spec) for name, spec in PRESETS.items()},
     "slewing_truss": slewing_truss_scene,
     "rt70_mirror": rt70_mirror_scene,
+    "antenna_12m_dish": antenna_12m_dish_scene,
 }
 
 #: The modal body files the scenes name (``rt70-modal/1``), by file name.
 MODAL_FILES: dict[str, Callable[[], ModalArrays]] = {
     TRUSS_FILE: truss_arm,
     RT70_DISH_FILE: rt70_mirror_body,
+    DISH_FILE: antenna_12m_dish_body,
 }
 
 

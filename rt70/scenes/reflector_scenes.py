@@ -17,6 +17,7 @@ parts the truss does not model).
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -91,17 +92,21 @@ def rigid_properties(nodes: np.ndarray, masses: np.ndarray) -> tuple[float, np.n
     masses : numpy.ndarray, shape (N,)
         Masses, kg.
     """
-    m = float(masses.sum())
-    c = masses @ nodes / m
+    m = math.fsum(masses)  # exactly rounded sums: the same digits on any CPU
+    c = np.array([math.fsum(masses * nodes[:, i]) for i in range(3)]) / m
     r = nodes - c
-    inertia = np.einsum("n,nij->ij", masses, np.einsum("ni,ni->n", r, r)[:, None, None] * np.eye(3))
-    inertia -= np.einsum("n,ni,nj->ij", masses, r, r)
+    r2 = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1] + r[:, 2] * r[:, 2]
+    inertia = np.array(
+        [[math.fsum(masses * ((r2 if i == j else 0.0) - r[:, i] * r[:, j])) for j in range(3)]
+         for i in range(3)]
+    )  # fmt: skip
     return m, c, inertia
 
 
 def _shifted(inertia: np.ndarray, mass: float, offset: np.ndarray) -> np.ndarray:
     """Inertia about a point ``offset`` from the centre of mass (parallel axes)."""
-    return inertia + mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
+    square = math.fsum(offset * offset)
+    return inertia + mass * (square * np.eye(3) - np.outer(offset, offset))
 
 
 def residual_properties(
@@ -145,7 +150,7 @@ def residual_properties(
 
 def with_flexible_reflector(
     text: str, link: str, vertex: np.ndarray, body: ModalArrays, name: str, file: str,
-    damping_ratio: float, wind: str | None = None,
+    damping_ratio: float, wind: str | None = None, hub_radius: float | None = None,
 ) -> str:  # fmt: skip
     """The URDF ``text`` with the dish ``body`` on ``link``, the link's totals kept.
 
@@ -168,6 +173,11 @@ def with_flexible_reflector(
     wind : str, optional
         The ``<rt70:wind>`` of the reflector, to be spread over the dish's surface
         (its ``surface`` attribute set to ``name``).
+    hub_radius : float, optional
+        When the link's inertia is an idealisation the dish replaces (a uniform disk):
+        the link keeps the rest of the mass, at the centre that keeps the total centre of
+        mass, as a solid sphere of this radius (m); the total inertia is then the dish's
+        and the sphere's. By default the link keeps its inertia less the dish's.
 
     Raises
     ------
@@ -188,8 +198,19 @@ def with_flexible_reflector(
     m = float(inertial.find("mass").get("value"))
     e = inertial.find("inertia").attrib
     inertia = _inertia_matrix(e)
+    vertex = np.round(np.asarray(vertex, dtype=float), 9) + 0.0  # nm: the same on any CPU
     dish = rigid_properties(body.nodes + vertex, body.masses)
-    mh, ch, Ih = residual_properties((m, c, inertia), dish, link)
+    if hub_radius is None:
+        mh, ch, Ih = residual_properties((m, c, inertia), dish, link)
+    else:
+        mh = m - dish[0]
+        if not mh > 0.0:
+            raise Rt70Error(
+                f"link '{link}': the dish's {dish[0]:.6g} kg is not less than {m:.6g} kg"
+            )
+        ch = (m * c - dish[0] * dish[1]) / mh
+        Ih = 0.4 * mh * hub_radius**2 * np.eye(3)
+    mh, ch, Ih = _written(mh, ch, Ih, float(np.max(np.abs(body.nodes))))
     inertial.find("mass").set("value", uw.fmt(mh))
     if origin is None:
         origin = ET.SubElement(inertial, "origin")
@@ -210,13 +231,33 @@ def with_flexible_reflector(
             f"'{link}' keeps {mh:.6g} kg of the {m:.6g} kg -->",
             f'  <link name="{name}_link"/>',
             f'  <joint name="{name}_weld" type="fixed"><parent link="{link}"/>'
-            f'<child link="{name}_link"/><origin xyz="{uw.fmt_vec(vertex)}" rpy="0 0 0"/></joint>',
+            f'<child link="{name}_link"/><origin xyz="{uw.fmt_vec(vertex)}" '
+            'rpy="0 0 0"/></joint>',
             f'  <rt70:modal_body name="{name}" link="{name}_link" file="{file}" '
             f'damping_ratio="{uw.fmt(damping_ratio)}"/>',
         ]
     )
     out = text[: text.index("<robot")] + ET.tostring(root, encoding="unicode")
     return out.replace("</robot>", body_text + "\n</robot>\n")
+
+
+#: Digits kept of the link's derived mass properties, relative to their scale: the sums
+#: behind them round differently on another CPU in the last bits, and a scene file must
+#: come out the same everywhere (tests/test_scenes_generated.py); 12 digits keep the
+#: totals to 1e-12.
+WRITTEN_DIGITS = 12
+
+
+def _written(
+    mass: float, centre: np.ndarray, inertia: np.ndarray, length: float
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """The mass properties as written: :data:`WRITTEN_DIGITS` digits of their scales."""
+    scale = float(np.trace(inertia))
+    return (
+        float(f"{mass:.{WRITTEN_DIGITS}g}"),
+        np.round(centre / length, WRITTEN_DIGITS) * length + 0.0,
+        np.round(inertia / scale, WRITTEN_DIGITS) * scale + 0.0,
+    )
 
 
 def uw_floats(text: str) -> list[float]:
