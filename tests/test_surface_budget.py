@@ -84,3 +84,11 @@ def test_sweep_refuses_surface_options_where_they_mean_nothing(capsys, tmp_path)
         main(["sweep", "rt70_mirror", "--quantity", "sag", "--frequency", "3", "--out", out]) == 2
     )
     assert "only the surface quantity" in capsys.readouterr().err
+
+
+def test_the_plant_carries_the_surface_outputs(capsys):
+    assert main(["plant", "antenna_12m_dish", "--elevation", "40", "--json"]) == 0
+    outputs = json.loads(capsys.readouterr().out)["outputs"]
+    surface = reflector_surface(load_scene("antenna_12m_dish"))
+    assert "surface_focus_shift:z" in outputs and "surface_beam_deviation:1" in outputs
+    assert sum(o.startswith("surface_residual:") for o in outputs) == len(surface.nodes)

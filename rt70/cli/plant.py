@@ -171,13 +171,27 @@ def _mirror_outputs(scene, elevation: float, azimuth: float) -> list:
     """The focal offset and pointing corrections, when the scene declares ``<rt70:optics>``.
 
     None above :data:`ZENITH_KEYHOLE_DEG`: at the zenith Δα, Δβ are undefined (4.160).
+    A scene with a reflecting surface adds its outputs (docs/surface.md): the best fit's
+    focus shift, axis tilt and beam deviation, and the residual of every surface node.
     """
+    outputs = _surface_outputs(scene)
     if scene.description.optics is None or elevation >= ZENITH_KEYHOLE_DEG:
-        return []
+        return outputs
     from rt70.model.antenna import pointing_outputs
 
     wanted = ("focal_offset", "pointing_correction")
-    return [o for o in pointing_outputs(scene, elevation, azimuth) if o.name in wanted]
+    return [o for o in pointing_outputs(scene, elevation, azimuth) if o.name in wanted] + outputs
+
+
+def _surface_outputs(scene) -> list:
+    """The reflecting surface's outputs ``surface_*``, or none without a surface."""
+    if not any(b.surface is not None for b in scene.description.modal_bodies):
+        return []
+    from rt70.model.surface_outputs import reflector_surface, surface_outputs
+
+    wanted = ("focus_shift", "axis_tilt", "beam_deviation", "residual")
+    outs = surface_outputs(reflector_surface(scene), "surface")
+    return [o for o in outs if o.name.removeprefix("surface_") in wanted]
 
 
 def _reduce(args: argparse.Namespace, scene, method: str, full, info: dict):
