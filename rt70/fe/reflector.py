@@ -2,7 +2,7 @@
 
 One job: the FE model (rt70's neutral form, :class:`rt70.fe.neutral.FEModel`) of a
 parametric dish, for a user who has a diameter, a focal length and member sizes but no
-FE model yet (issue 25, docs/surface.md). The dish is the classic radial-rib backup
+FE model yet (docs/surface.md). The dish is the classic radial-rib backup
 structure of large antennas: ``ribs`` radial trusses joined by ``rings`` hoops.
 
 - **Front layer**: nodes on the paraboloid ``z = r²/(4F)`` at the radii
