@@ -31,7 +31,12 @@ from rt70.urdf.modal_record import ModalBody, node_point
 
 #: Micrometres per metre (the residual's unit).
 UM_PER_M = 1e6
-#: The body frame's points: its origin and unit offsets along x, y, z (link frame, m).
+#: The body frame's points: its origin and offsets along x, y, z, in units of the
+#: aperture's radius (link frame). Its axes are read off their differences, whose
+#: rounding (ε |p|, some 2e-14 m for points 90 m from the ground origin) turns them by
+#: ε |p| / length: over the radius that moves a rim node by ε |p|, not by ε |p| times
+#: the radius in metres (7e-13 m on the RT-70 with unit offsets, 1e-9 of a millimetre
+#: deformation).
 FRAME_POINTS = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 #: Ruze's fit of the beam deviation factor of a paraboloid (IEEE Trans. AP-13:660–665,
 #: 1965): ``BDF = (1 + k (D/4F)²) / (1 + (D/4F)²)`` with ``k = 0.36``.
@@ -117,7 +122,8 @@ def reflector_surface(scene: Scene, body: str | None = None) -> ReflectorSurface
 def _path_errors(surface: ReflectorSurface, p: np.ndarray) -> np.ndarray:
     """The half-path errors h of the surface nodes from the stacked frame and node positions."""
     o = p[0]
-    R = np.column_stack([p[1] - o, p[2] - o, p[3] - o])  # the body frame's axes, ground
+    length = 0.5 * surface.diameter  # the offsets' length (FRAME_POINTS)
+    R = np.column_stack([p[1] - o, p[2] - o, p[3] - o]) / length  # the body frame's axes
     delta = (p[4:] - o) @ R - surface.xyz  # Rᵀ (p_n − o) − x_n, row by row
     return np.sum(surface.maps.H * delta, axis=1)
 
@@ -127,18 +133,19 @@ def surface_outputs(surface: ReflectorSurface, prefix: str | None = None) -> lis
 
     ``<prefix>`` is the body's name by default. All in the body frame's axes:
 
-    ==========================  ======  ====  ================================================
-    output                      unit    size  meaning
-    ==========================  ======  ====  ================================================
-    ``<prefix>_vertex_shift``   mm      3     the BFP vertex's translation ``t``
-    ``<prefix>_axis_tilt``      arcsec  2     ``(φ_x, φ_y)``: the angular defocus
-    ``<prefix>_focal_change``   mm      1     ΔF
-    ``<prefix>_focus_shift``    mm      3     the BFP focus's shift: lateral and axial defocus
-    ``<prefix>_beam_deviation`` arcsec  2     the beam's turn about x and y, feed fixed to
-                                              the body frame: ``(1 + BDF) φ + BDF (u, v)/F``
-                                              turned to rotations
-    ``<prefix>_residual``       um      S     each node's half-path error left by the BFP
-    ==========================  ======  ====  ================================================
+    ============================ ====== ==== ==============================================
+    output                       unit   size meaning
+    ============================ ====== ==== ==============================================
+    ``<prefix>_vertex_shift``    mm     3    the BFP vertex's translation ``t``
+    ``<prefix>_axis_tilt``       arcsec 2    ``(φ_x, φ_y)``: the angular defocus
+    ``<prefix>_focal_change``    mm     1    ΔF
+    ``<prefix>_focus_shift``     mm     3    the BFP focus's shift: lateral and axial
+                                             defocus
+    ``<prefix>_beam_deviation``  arcsec 2    the beam's turn about x and y, the feed fixed
+                                             to the body frame: ``(1 + BDF) φ`` plus
+                                             ``BDF (u, v)/F``, as rotations
+    ``<prefix>_residual``        um     S    each node's half-path error left by the BFP
+    ============================ ====== ==== ==============================================
 
     The beam deviation is a prime-focus reading (Ruze 1965's BDF for a feed displaced
     from the BFP's focus): the feed stays at the nominal focus while the surface's BFP
@@ -153,7 +160,8 @@ def surface_outputs(surface: ReflectorSurface, prefix: str | None = None) -> lis
     """
     b = surface.body
     prefix = b.name if prefix is None else prefix
-    points = tuple((b.link, xyz) for xyz in FRAME_POINTS) + tuple(
+    length = 0.5 * surface.diameter
+    points = tuple((b.link, tuple(length * x for x in xyz)) for xyz in FRAME_POINTS) + tuple(
         (node_point(b.name, int(n)), (0.0, 0.0, 0.0)) for n in surface.nodes
     )
     P, R, F = surface.maps.P, surface.maps.R, surface.focal_length

@@ -38,7 +38,7 @@ from rt70.scenes.book_scenes import (
 )
 from rt70.scenes.loop_scenes import crank_slider_scene, four_bar_scene
 from rt70.scenes.modal_scenes import TRUSS_FILE, slewing_truss_scene, truss_arm
-from rt70.scenes.reflector_scenes import RT70_DISH_FILE, rt70_mirror_body, rt70_mirror_scene
+from rt70.scenes.rt70_mirror import RT70_DISH_FILE, rt70_mirror_body, rt70_mirror_scene
 from rt70.scenes.rt70_scenes import (
     rt70_flexible_scene,
     rt70_jack_scene,

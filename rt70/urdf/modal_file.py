@@ -3,24 +3,24 @@
 One job: the format's one reader and writer (docs/fe-models.md, "The modal body file").
 A NumPy ``.npz`` archive with
 
-========== ============ ===========================================================
-key        shape        meaning
-========== ============ ===========================================================
-format     ()           the string ``rt70-modal/1``
-nodes      (N, 3)       the nodes ``x_n`` in the body frame (the link's frame), m
-masses     (N,)         their lumped translational masses ``m_n``, kg (≥ 0)
-shapes     (N, 3, k)    ``Φ_n``: each node's displacement per unit modal coordinate
-stiffness  (k, k)       the modal stiffness ``K_η`` (symmetric, positive semidefinite)
-damping    (k, k)       optional: the modal damping ``D_η`` (symmetric, psd)
-rotations  (N, 3, k)    optional: each node's small rotation per unit modal coordinate
-                        (a rotation vector in the body frame; used only where a link is
-                        attached to the node, ``<rt70:interface>``)
-edges      (E, 2)       optional: node index pairs drawn as lines (the FE mesh's edges)
-source     ()           optional: where the body came from (a free text)
-surface_nodes (S,)      optional, with the next two: the reflecting surface's nodes
-surface_weights (S,)    their shares of the aperture (m², > 0): the best fit's weights
-focal_length ()         F of the surface's paraboloid ``z = (x² + y²)/(4F)``, m
-========== ============ ===========================================================
+=============== ========= ===========================================================
+key             shape     meaning
+=============== ========= ===========================================================
+format          ()        the string ``rt70-modal/1``
+nodes           (N, 3)    the nodes ``x_n`` in the body frame (the link's frame), m
+masses          (N,)      their lumped translational masses ``m_n``, kg (≥ 0)
+shapes          (N, 3, k) ``Φ_n``: each node's displacement per unit modal coordinate
+stiffness       (k, k)    the modal stiffness ``K_η`` (symmetric, positive semidefinite)
+damping         (k, k)    optional: the modal damping ``D_η`` (symmetric, psd)
+rotations       (N, 3, k) optional: each node's small rotation per unit modal coordinate
+                          (a rotation vector in the body frame; used only where a link is
+                          attached to the node, ``<rt70:interface>``)
+edges           (E, 2)    optional: node index pairs drawn as lines (the FE mesh's edges)
+source          ()        optional: where the body came from (a free text)
+surface_nodes   (S,)      optional, with the next two: the reflecting surface's nodes
+surface_weights (S,)      their shares of the aperture (m², > 0): the best fit's weights
+focal_length    ()        F of the surface's paraboloid ``z = (x² + y²)/(4F)``, m
+=============== ========= ===========================================================
 
 The body is ``r_n = x_n + Φ_n η`` (rt70.textbook.flexible): the nodes' masses are
 lumped and translational, the modes are shapes in the body frame, clamped to it where
