@@ -271,6 +271,7 @@ RT70_MODULES = (
     "rt70.scenes.rt70_wind",
     "rt70.scenes.rt70_visuals",
     "rt70.scenes.rt70_scenes",
+    "rt70.scenes.rt70_mirror",
 )
 
 #: Generic analyses and simulation: they take what they need of a scene as arguments.

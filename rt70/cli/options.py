@@ -156,29 +156,6 @@ def wind_speed(text: str) -> float:
     return value
 
 
-#: The highest frequency Ruze's law is asked at, Hz: 3 THz, a wavelength of 0.1 mm, past
-#: which no radio telescope works (a larger number is a unit slip: Hz for GHz).
-MAX_FREQUENCY_GHZ = 3000.0
-
-
-def frequency_ghz(text: str) -> float:
-    """An observing frequency in GHz: ``0 < f ≤`` :data:`MAX_FREQUENCY_GHZ`."""
-    value = positive_float(text)
-    if value > MAX_FREQUENCY_GHZ:
-        raise argparse.ArgumentTypeError(
-            f"at most {MAX_FREQUENCY_GHZ:g} GHz (the value is in GHz), got {text}"
-        )
-    return value
-
-
-def elevation_deg(text: str) -> float:
-    """An elevation in degrees, 0 to 90."""
-    value = _number(text)
-    if not 0.0 <= value <= 90.0:
-        raise argparse.ArgumentTypeError(f"must lie in [0, 90] degrees, got {text}")
-    return value
-
-
 def angle_error(text: str) -> float:
     """An angle off a programmed one, rad: ``|x| ≤ π`` (a heading is an angle modulo 2π)."""
     value = _number(text)

@@ -12,6 +12,7 @@ import json
 import sys
 
 from rt70.cli import options
+from rt70.cli.surface_options import add_frequency_argument, elevation_deg
 from rt70.errors import Rt70Error
 
 #: The listing as printed, and the scene that is its control object (docs/rt70-errata.md
@@ -54,17 +55,10 @@ def add_parser(sub, add_pointing_arguments) -> argparse.ArgumentParser:
         metavar="T",
         help="also run T seconds of gusts through the nonlinear model and compare",
     )
-    poi.add_argument(
-        "--frequency",
-        type=options.frequency_ghz,
-        action="append",
-        metavar="GHZ",
-        help="observing frequency, GHz, for the reflector surface's Ruze efficiency "
-        "(repeatable; a scene with a reflecting surface, docs/surface.md)",
-    )
+    add_frequency_argument(poi, "the reflector surface's Ruze efficiency there")
     poi.add_argument(
         "--rigging-elevation",
-        type=options.elevation_deg,
+        type=elevation_deg,
         metavar="DEG",
         help="elevation at which the surface's panels were set, degrees (default: the "
         "middle of the mount's elevation range; a scene with a reflecting surface)",
@@ -109,13 +103,7 @@ def run(args: argparse.Namespace) -> int:
         )
         scene = load_scene(SERVO_SCENE)
     check_scene(scene)
-    has_surface = any(b.surface is not None for b in scene.description.modal_bodies)
-    if not has_surface and (args.frequency or args.rigging_elevation is not None):
-        option = "--frequency" if args.frequency else "--rigging-elevation"
-        raise Rt70Error(
-            f"{option}: {scene.name} has no reflecting surface (a <rt70:modal_body> whose "
-            "file has one, docs/surface.md)"
-        )
+    has_surface = _check_surface_options(args, scene)
     if args.duration is not None:  # before the budget's work
         from rt70.telescope.gust_run import check_duration
 
@@ -129,14 +117,7 @@ def run(args: argparse.Namespace) -> int:
         run = gust_run(
             scene, case, args.duration, seed=args.seed, progress=args.progress, model=model
         )
-    surface = None
-    if has_surface:
-        from rt70.telescope.surface_budget import case_surface, default_rigging
-
-        rigging = (
-            default_rigging(scene) if args.rigging_elevation is None else args.rigging_elevation
-        )
-        surface = case_surface(model, rigging, [f * 1e9 for f in args.frequency or []])
+    surface = _surface(args, scene, model) if has_surface else None
     out = {"scene": scene.name, "requested_scene": requested, **budget.to_dict()}
     if surface is not None:
         out["surface"] = surface.to_dict()
@@ -163,3 +144,23 @@ def run(args: argparse.Namespace) -> int:
                 f"± {run.rms_error[name]:.2g}"
             )
     return 0
+
+
+def _check_surface_options(args: argparse.Namespace, scene) -> bool:
+    """Whether the scene has a reflecting surface; refuse its options on one without."""
+    has_surface = any(b.surface is not None for b in scene.description.modal_bodies)
+    if not has_surface and (args.frequency or args.rigging_elevation is not None):
+        option = "--frequency" if args.frequency else "--rigging-elevation"
+        raise Rt70Error(
+            f"{option}: {scene.name} has no reflecting surface (a <rt70:modal_body> whose "
+            "file has one, docs/surface.md)"
+        )
+    return has_surface
+
+
+def _surface(args: argparse.Namespace, scene, model):
+    """The surface part of the budget (:func:`rt70.telescope.surface_budget.case_surface`)."""
+    from rt70.telescope.surface_budget import case_surface, default_rigging
+
+    rigging = default_rigging(scene) if args.rigging_elevation is None else args.rigging_elevation
+    return case_surface(model, rigging, [f * 1e9 for f in args.frequency or []])

@@ -12,6 +12,7 @@ import json
 import sys
 
 from rt70.cli import options
+from rt70.cli.surface_options import add_frequency_argument
 from rt70.errors import Rt70Error
 
 
@@ -56,14 +57,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         metavar="Q1,Q2",
         help="quantities to compute (default first_frequency,sag; also pointing, surface)",
     )
-    swp.add_argument(
-        "--frequency",
-        type=options.frequency_ghz,
-        action="append",
-        metavar="GHZ",
-        help="observing frequency, GHz: the surface quantity adds Ruze's efficiency there "
-        "(repeatable; docs/surface.md)",
-    )
+    add_frequency_argument(swp, "the surface quantity adds Ruze's efficiency there")
     swp.add_argument("--out", required=True, metavar="FILE", help="output file, .npz")
     swp.add_argument(
         "--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, tcp://host:port"

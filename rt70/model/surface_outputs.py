@@ -32,11 +32,11 @@ from rt70.urdf.modal_record import ModalBody, node_point
 #: Micrometres per metre (the residual's unit).
 UM_PER_M = 1e6
 #: The body frame's points: its origin and offsets along x, y, z, in units of the
-#: aperture's radius (link frame). Its axes are read off their differences, whose
-#: rounding (ε |p|, some 2e-14 m for points 90 m from the ground origin) turns them by
-#: ε |p| / length: over the radius that moves a rim node by ε |p|, not by ε |p| times
-#: the radius in metres (7e-13 m on the RT-70 with unit offsets, 1e-9 of a millimetre
-#: deformation).
+#: aperture's radius (link frame). Its axes are read off their differences, rounded by
+#: ε times the points' distance from the ground origin (some 2e-14 m at 90 m), which
+#: turns the axes by that over the offsets' length: over the radius it moves a rim node
+#: by the same 2e-14 m, where unit offsets moved it by 35 times that on the RT-70
+#: (7e-13 m, 1e-9 of a millimetre deformation).
 FRAME_POINTS = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 #: Ruze's fit of the beam deviation factor of a paraboloid (IEEE Trans. AP-13:660–665,
 #: 1965): ``BDF = (1 + k (D/4F)²) / (1 + (D/4F)²)`` with ``k = 0.36``.

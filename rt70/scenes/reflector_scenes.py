@@ -194,34 +194,10 @@ def with_flexible_reflector(
     inertial = found[0].find("inertial") if found else None
     if inertial is None:
         raise Rt70Error(f"no link '{link}' with an <inertial> in the scene")
-    origin = inertial.find("origin")
-    if origin is not None and np.any(np.array(uw_floats(origin.get("rpy", "0 0 0")))):
-        raise Rt70Error(f"link '{link}': an inertial with rpy is not supported here")
-    c = np.array(uw_floats(origin.get("xyz", "0 0 0"))) if origin is not None else np.zeros(3)
     m = float(inertial.find("mass").get("value"))
-    e = inertial.find("inertia").attrib
-    inertia = _inertia_matrix(e)
     vertex = np.round(np.asarray(vertex, dtype=float), 9) + 0.0  # nm: the same on any CPU
     dish = rigid_properties(body.nodes + vertex, body.masses)
-    if hub_radius is None:
-        mh, ch, Ih = residual_properties((m, c, inertia), dish, link)
-    else:
-        mh = m - dish[0]
-        if not mh > 0.0:
-            raise Rt70Error(
-                f"link '{link}': the dish's {dish[0]:.6g} kg is not less than {m:.6g} kg"
-            )
-        ch = (m * c - dish[0] * dish[1]) / mh
-        Ih = 0.4 * mh * hub_radius**2 * np.eye(3)
-    mh, ch, Ih = _written(mh, ch, Ih, float(np.max(np.abs(body.nodes))))
-    inertial.find("mass").set("value", uw.fmt(mh))
-    if origin is None:
-        origin = ET.SubElement(inertial, "origin")
-    origin.set("xyz", uw.fmt_vec(ch))
-    origin.set("rpy", "0 0 0")
-    for key, (i, j) in {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2),
-                        "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}.items():  # fmt: skip
-        inertial.find("inertia").set(key, uw.fmt(Ih[i, j]))
+    mh = _keep_the_rest(inertial, link, dish, hub_radius, float(np.max(np.abs(body.nodes))))
     if wind is not None:
         found_wind = [e for e in root.iter(f"{{{RT70_NAMESPACE}}}wind") if e.get("name") == wind]
         if not found_wind:
@@ -242,6 +218,44 @@ def with_flexible_reflector(
     )
     out = text[: text.index("<robot")] + ET.tostring(root, encoding="unicode")
     return out.replace("</robot>", body_text + "\n</robot>\n")
+
+
+def _keep_the_rest(
+    inertial: ET.Element, link: str, dish: tuple, hub_radius: float | None, length: float
+) -> float:
+    """Set the link's ``<inertial>`` to what it keeps of its body beside the dish; its mass.
+
+    The link's mass properties less the dish's (:func:`residual_properties`), or, with
+    ``hub_radius``, the rest of the mass as a solid sphere at the centre that keeps the
+    total centre (:func:`with_flexible_reflector`); written to :data:`WRITTEN_DIGITS`.
+    """
+    origin = inertial.find("origin")
+    if origin is not None and np.any(np.array(uw_floats(origin.get("rpy", "0 0 0")))):
+        raise Rt70Error(f"link '{link}': an inertial with rpy is not supported here")
+    c = np.array(uw_floats(origin.get("xyz", "0 0 0"))) if origin is not None else np.zeros(3)
+    m = float(inertial.find("mass").get("value"))
+    if hub_radius is None:
+        mh, ch, Ih = residual_properties(
+            (m, c, _inertia_matrix(inertial.find("inertia").attrib)), dish, link
+        )
+    else:
+        mh = m - dish[0]
+        if not mh > 0.0:
+            raise Rt70Error(
+                f"link '{link}': the dish's {dish[0]:.6g} kg is not less than {m:.6g} kg"
+            )
+        ch = (m * c - dish[0] * dish[1]) / mh
+        Ih = 0.4 * mh * hub_radius**2 * np.eye(3)
+    mh, ch, Ih = _written(mh, ch, Ih, length)
+    inertial.find("mass").set("value", uw.fmt(mh))
+    if origin is None:
+        origin = ET.SubElement(inertial, "origin")
+    origin.set("xyz", uw.fmt_vec(ch))
+    origin.set("rpy", "0 0 0")
+    for key, (i, j) in {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2),
+                        "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}.items():  # fmt: skip
+        inertial.find("inertia").set(key, uw.fmt(Ih[i, j]))
+    return mh
 
 
 #: Digits kept of the link's derived mass properties, relative to their scale: the sums
