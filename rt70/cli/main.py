@@ -22,29 +22,43 @@ budget: a run its method cannot integrate stops with one line (:mod:`rt70.simula
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import warnings
 
-from rt70.cli import bench as cli_bench
-from rt70.cli import cart as cli_cart
-from rt70.cli import impact as cli_impact
-from rt70.cli import modes as cli_modes
-from rt70.cli import new as cli_new
 from rt70.cli import options, session
-from rt70.cli import plant as cli_plant
-from rt70.cli import pointing as cli_pointing
-from rt70.cli import reactions as cli_reactions
-from rt70.cli import servo as cli_servo
-from rt70.cli import simulate as cli_simulate
-from rt70.cli import sweep as cli_sweep
-from rt70.cli import validate as cli_validate
 from rt70.cli.session import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 from rt70.errors import Rt70Error
 
+#: Every command: its module of this folder (``add_parser(sub)``, ``run(args)``), in the
+#: order of ``rt70 --help``; those marked take the pointing arguments as a second argument.
+COMMANDS = {
+    "validate": ("validate", False),
+    "bench": ("bench", False),
+    "modes": ("modes", False),
+    "plant": ("plant", False),
+    "pointing": ("pointing", True),
+    "reactions": ("reactions", False),
+    "servo": ("servo", False),
+    "simulate": ("simulate", True),
+    "sweep": ("sweep", False),
+    "cart": ("cart", False),
+    "new": ("new", False),
+    "impact": ("impact", False),
+}
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``rt70`` command (errors: one line, exit 2)."""
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``rt70`` command (errors: one line, exit 2).
+
+    Parameters
+    ----------
+    only : str, optional
+        Build the parser of this command alone (its module alone is imported: a command
+        pays for what it uses); ``""``: of none (``rt70 --version``); None: of every
+        command (``rt70 --help``, an unknown command's error).
+    """
     parser = options.Parser(
         prog="rt70",
         description="Models of flexible structures, cross-checked against Pinocchio.",
@@ -52,25 +66,39 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action=options.PrintVersion)
     sub = parser.add_subparsers(dest="command", required=True)
-    cli_validate.add_parser(sub)
-    cli_bench.add_parser(sub)
-    cli_modes.add_parser(sub)
-    cli_plant.add_parser(sub)
-    cli_pointing.add_parser(sub, options.add_pointing_arguments)
-    cli_reactions.add_parser(sub)
-    cli_servo.add_parser(sub)
-    cli_simulate.add_parser(sub, options.add_pointing_arguments)
-    cli_sweep.add_parser(sub)
-    cli_cart.add_parser(sub)
-    cli_new.add_parser(sub)
-    cli_impact.add_parser(sub)
+    for name, (module, pointing) in COMMANDS.items():
+        if only is not None and name != only:
+            continue
+        command = importlib.import_module(f"rt70.cli.{module}")
+        if pointing:
+            command.add_parser(sub, options.add_pointing_arguments)
+        else:
+            command.add_parser(sub)
     return parser
+
+
+def command_of(argv: list[str]) -> str | None:
+    """The command ``argv`` asks for, ``""`` for ``--version`` alone, or None (build all).
+
+    The first word that is not an option names the command; ``--version`` before any
+    command needs none. Anything else (help, an unknown command) gets every command's
+    parser, so ``--help`` lists them all and a misspelt command is named in the error.
+    """
+    for word in argv:
+        if word == "--version":
+            return ""
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+        if word in ("-h", "--help"):
+            return None
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     argv = sys.argv[1:] if argv is None else argv
-    args = build_parser().parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
+    parser = build_parser(command_of(argv))
+    args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
     guards = session.warning_guards(args.command)  # module docstring
     with (
         session.stop_signals(EXIT_TERMINATED),
