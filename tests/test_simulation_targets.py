@@ -127,3 +127,10 @@ def test_kernel_targets_are_judged_on_the_ratio(monkeypatch):
     assert rhs.met is True and rhs.measured.startswith("2.9× (29.0 µs against 10.0 µs")
     assert jac.met is False and jac.measured.startswith("3.0× (304.0 µs against 100.0 µs")
     assert "pinned to 1" in rhs.measured and "median of 1 interleaved rounds" in jac.measured
+
+
+def test_startup_target_times_the_version_command():
+    check = st.version_target(repeats=1)
+    assert check.met in (True, False)  # the verdict is the machine's; the test is not
+    assert "best of 1" in check.measured and "rt70 --version" in check.target
+    assert st.version_target(quick=True).met is None

@@ -13,6 +13,10 @@ Whole command
     tolerance, run as a subprocess, best of :data:`COMMAND_REPEATS` wall times, ≤
     :data:`COMMAND_TARGET_S` (:func:`command_target`): this includes the start-up
     (imports, URDF, Pinocchio) and what follows the integration (energies, printing).
+Start-up
+    ``rt70 --version`` as a subprocess, best of :data:`VERSION_REPEATS` wall times, ≤
+    :data:`VERSION_TARGET_S` (:func:`version_target`): the interpreter, the command
+    line's own modules and the version lookup, no command's.
 Right-hand side and Jacobian
     The reference backend's ``accelerations`` and ``jacobian``
     (:class:`rt70.simulation.backends.PinocchioBackend`) at the RT-70 listing's initial state,
@@ -48,7 +52,10 @@ if TYPE_CHECKING:
     from rt70.telescope.scenarios import DriveFactory, Scenario
 
 #: Whole command, s.
-COMMAND_TARGET_S = 1.0
+COMMAND_TARGET_S = 0.5
+#: ``rt70 --version``, s, and its attempts (best wall time).
+VERSION_TARGET_S = 0.15
+VERSION_REPEATS = 5
 #: Attempts of the whole command (best wall time).
 COMMAND_REPEATS = 3
 #: Right-hand side / pin.aba and Jacobian / pin.computeABADerivatives.
@@ -168,6 +175,33 @@ def command_target(win, repeats: int = COMMAND_REPEATS, quick: bool = False) -> 
         f"--method {win.method} --rtol {win.rtol:g})"
     )
     return TargetCheck(goal, measured, min(walls) <= COMMAND_TARGET_S)
+
+
+def version_target(repeats: int = VERSION_REPEATS, quick: bool = False) -> TargetCheck:
+    """The start-up target: ``rt70 --version`` as a subprocess, best wall time.
+
+    Parameters
+    ----------
+    repeats : int, optional
+        Runs of the command; the best wall time counts.
+    quick : bool, optional
+        A quick run: not timed (not judged).
+    """
+    from rt70.errors import Rt70Error
+
+    goal = f"start-up `rt70 --version` ≤ {VERSION_TARGET_S:g} s"
+    if quick:
+        return TargetCheck(goal, "— (not measured in a quick run)", None)
+    cmd = [sys.executable, "-m", "rt70", "--version"]
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        walls.append(time.perf_counter() - start)
+        if done.returncode != 0:
+            raise Rt70Error(f"rt70 --version: exit {done.returncode}")
+    measured = f"{min(walls):.3f} s (best of {len(walls)}, wall)"
+    return TargetCheck(goal, measured, min(walls) <= VERSION_TARGET_S)
 
 
 def kernel_ratios(rounds: int = 7, budget_s: float = 0.05) -> dict[str, tuple[float, float, float]]:
@@ -361,17 +395,19 @@ def check(rows, quick: bool = False, progress: Say | None = None) -> list[Target
     Returns
     -------
     list of TargetCheck
-        Integration, whole command, right-hand side, Jacobian, servo closed.
+        Integration, whole command, start-up, right-hand side, Jacobian, servo closed.
     """
     say = progress or _quiet
     integration, win = integration_target(rows)
     if quick:
         command = command_target(None, quick=True)
+        version = version_target(quick=True)
         servo = servo_target(None)
     else:
-        say("timing the whole command (subprocess, best of 3)")
+        say("timing the whole command (subprocess, best of 3) and the start-up")
         command = command_target(win)
+        version = version_target()
         servo = servo_target(servo_runs(progress=say))
     say("timing the right-hand side and Jacobian against Pinocchio's")
     kernels = kernel_targets(rounds=3, budget_s=0.01) if quick else kernel_targets()
-    return [integration, command, *kernels, servo]
+    return [integration, command, version, *kernels, servo]

@@ -29,17 +29,19 @@ import hashlib
 import math
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rt70.control.loop_measures import Margins, bandwidth_hz, margins, stable
-from rt70.control.scene_loop import closed_loop, loop_gain
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
 from rt70.model.antenna import mount_of, pointing, range_deg
 from rt70.model.scene import Scene
 from rt70.telescope.axis_servos import Tuning, axis_servos, drive_servos
 from rt70.telescope.drive_equilibrium import drive_held_linearization
+
+if TYPE_CHECKING:  # python-control (≈ 1.5 s to import) only where a design is made
+    from rt70.control.loop_measures import Margins
 
 #: Bracket of the position-loop bandwidth search, Hz.
 LOW_HZ, HIGH_HZ = 0.01, 5.0
@@ -165,6 +167,9 @@ def _adequate(scene: Scene, plants: list, tuning: Tuning, axes: tuple[str, ...])
 
     Stops at the first failing margin; the closed loop's stability is checked last.
     """
+    from rt70.control.loop_measures import margins, stable
+    from rt70.control.scene_loop import closed_loop, loop_gain
+
     servos = drive_servos(scene, tuning)
     declared = axis_servos(scene)
     for lm in plants:
@@ -218,6 +223,9 @@ def _highest(
 
 def _check(scene: Scene, plants: list, result: ServoDesign) -> None:
     """Fill in the least margins of every loop and the closed-loop bandwidths."""
+    from rt70.control.loop_measures import bandwidth_hz, margins, stable
+    from rt70.control.scene_loop import closed_loop, loop_gain
+
     servos = drive_servos(scene, result.tuning)
     declared = axis_servos(scene)
     for axis, d in declared.items():
