@@ -25,6 +25,7 @@ from rt70.urdf.modal_file import ModalArrays
 RT70_DISH = {"diameter": 70.0, "focal_length": 21.0, "hub_radius": 6.0, "depth": 8.0,
              "rings": 3, "ribs": 8}  # fmt: skip
 #: Every bar: a steel tube of 4 cm² (E = 2.1e11 Pa, ρ = 7850 kg/m³): EA (N), ρA (kg/m).
+#: Bars alone of 6.5 cm² would fill the dish's share of the polar moment in this layout.
 RT70_BAR = {"EA": 2.1e11 * 4e-4, "rho_A": 7850.0 * 4e-4}
 #: The dish's share of the listing main mirror's polar moment (the rest stays lumped on
 #: the link: the listing's body is heavier at its centre than a uniform dish).
