@@ -338,7 +338,8 @@ from matplotlib.figure import Figure
 def slow_savefig(self, fname, *args, **kwargs):  # a plot that takes forever to write
     Path(fname).write_bytes(b"x" * 2_000_000)  # a 2 MB partial file
     print("WRITING", flush=True)
-    time.sleep(120)
+    for _ in range(1200):  # short sleeps: the kernel may hand SIGTERM to another thread
+        time.sleep(0.1)  # (BLAS's), and Python runs the handler at the main thread's next step
 
 Figure.savefig = slow_savefig
 from rt70.cli.main import main
