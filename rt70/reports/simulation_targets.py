@@ -136,10 +136,21 @@ def command_seconds(method: str, rtol: float, repeats: int = COMMAND_REPEATS) ->
     Rt70Error
         If the command fails.
     """
+    args = ["simulate", "rt70", "--t-end", "10", "--method", method, "--rtol", repr(rtol)]
+    return _wall_times(args, repeats)
+
+
+def _wall_times(args: list[str], repeats: int) -> list[float]:
+    """Wall times of ``rt70 ARGS`` (``python -m rt70``) run ``repeats`` times, s.
+
+    Raises
+    ------
+    Rt70Error
+        If a run fails: its exit code and the last line it printed on stderr.
+    """
     from rt70.errors import Rt70Error
 
-    cmd = [sys.executable, "-m", "rt70", "simulate", "rt70", "--t-end", "10"]
-    cmd += ["--method", method, "--rtol", repr(rtol)]
+    cmd = [sys.executable, "-m", "rt70", *args]
     walls = []
     for _ in range(repeats):
         start = time.perf_counter()
@@ -187,19 +198,10 @@ def version_target(repeats: int = VERSION_REPEATS, quick: bool = False) -> Targe
     quick : bool, optional
         A quick run: not timed (not judged).
     """
-    from rt70.errors import Rt70Error
-
     goal = f"start-up `rt70 --version` ≤ {VERSION_TARGET_S:g} s"
     if quick:
         return TargetCheck(goal, "— (not measured in a quick run)", None)
-    cmd = [sys.executable, "-m", "rt70", "--version"]
-    walls = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        walls.append(time.perf_counter() - start)
-        if done.returncode != 0:
-            raise Rt70Error(f"rt70 --version: exit {done.returncode}")
+    walls = _wall_times(["--version"], repeats)
     measured = f"{min(walls):.3f} s (best of {len(walls)}, wall)"
     return TargetCheck(goal, measured, min(walls) <= VERSION_TARGET_S)
 
