@@ -185,9 +185,10 @@ def _mirror_outputs(scene, elevation: float, azimuth: float) -> list:
 
 def _surface_outputs(scene) -> list:
     """The reflecting surface's outputs ``surface_*``, or none without a surface."""
-    if not any(b.surface is not None for b in scene.description.modal_bodies):
+    from rt70.model.surface_outputs import has_surface, reflector_surface, surface_outputs
+
+    if not has_surface(scene):
         return []
-    from rt70.model.surface_outputs import reflector_surface, surface_outputs
 
     wanted = ("focus_shift", "axis_tilt", "beam_deviation", "residual")
     outs = surface_outputs(reflector_surface(scene), "surface")

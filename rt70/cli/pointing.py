@@ -148,14 +148,16 @@ def run(args: argparse.Namespace) -> int:
 
 def _check_surface_options(args: argparse.Namespace, scene) -> bool:
     """Whether the scene has a reflecting surface; refuse its options on one without."""
-    has_surface = any(b.surface is not None for b in scene.description.modal_bodies)
-    if not has_surface and (args.frequency or args.rigging_elevation is not None):
+    from rt70.model.surface_outputs import has_surface
+
+    found = has_surface(scene)
+    if not found and (args.frequency or args.rigging_elevation is not None):
         option = "--frequency" if args.frequency else "--rigging-elevation"
         raise Rt70Error(
             f"{option}: {scene.name} has no reflecting surface (a <rt70:modal_body> whose "
             "file has one, docs/surface.md)"
         )
-    return has_surface
+    return found
 
 
 def _surface(args: argparse.Namespace, scene, model):

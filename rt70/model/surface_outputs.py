@@ -79,6 +79,17 @@ class ReflectorSurface:
         return (1.0 + BDF_K * a2) / (1.0 + a2)
 
 
+def has_surface(scene: Scene) -> bool:
+    """Whether a modal body of ``scene`` has a reflecting surface (its file declares one).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    """
+    return any(b.surface is not None for b in scene.description.modal_bodies)
+
+
 def reflector_surface(scene: Scene, body: str | None = None) -> ReflectorSurface:
     """The reflecting surface of the modal body ``body`` (or the scene's only one).
 

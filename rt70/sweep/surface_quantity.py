@@ -41,7 +41,6 @@ def _surface(scene: Scene, point: SweepPoint, frequencies_ghz: tuple[float, ...]
     from rt70.telescope.pointing import PointingCase, budget_model
     from rt70.telescope.surface_budget import (
         PREFIX,
-        budget_surface_outputs,
         case_surface,
         default_rigging,
         scene_surface_outputs,
@@ -57,7 +56,7 @@ def _surface(scene: Scene, point: SweepPoint, frequencies_ghz: tuple[float, ...]
         surface, outs = scene_surface_outputs(scene)
         q_rig = equilibrium(scene, pointing(scene, rigging, point.azimuth))
         at = [evaluate(scene, q, outs, "reference") for q in (q_rig, point.equilibrium(scene))]
-        change = {o.name: at[1][o.name] - at[0][o.name] for o in budget_surface_outputs(surface)}
+        change = {o.name: at[1][o.name] - at[0][o.name] for o in outs}
         gravity = float(surface_rms(surface, change[f"{PREFIX}_residual"]))
         rms = (gravity, 0.0, 0.0, gravity)
         focus, tilt = change[f"{PREFIX}_focus_shift"], change[f"{PREFIX}_axis_tilt"]

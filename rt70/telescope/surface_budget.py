@@ -189,9 +189,9 @@ def scene_surface_outputs(scene: Scene) -> tuple[ReflectorSurface, list[Output]]
     scene : Scene
         The scene.
     """
-    from rt70.model.surface_outputs import reflector_surface
+    from rt70.model.surface_outputs import has_surface, reflector_surface
 
-    if not any(b.surface is not None for b in scene.description.modal_bodies):
+    if not has_surface(scene):
         return None
     surface = reflector_surface(scene)
     return surface, budget_surface_outputs(surface)
