@@ -115,9 +115,27 @@ def point_positions(
     data.q_full = model.expand(q)
     forward_kinematics(model, data, data.q_full)
     out = np.empty((len(located), 3))
-    for k, (body, r0, Phi, eta) in enumerate(located):
-        out[k] = frame_pose(data, body, r0 + Phi @ q[eta], np.eye(3))[1]
+    for k, where in enumerate(located):
+        out[k] = located_position(data, q, where)
     return out
+
+
+def located_position(
+    data: Data, q: np.ndarray, located: tuple[int, np.ndarray, np.ndarray, slice]
+) -> np.ndarray:
+    """Ground-axis position (3,) of a located point (:func:`located_point`) from ``data``.
+
+    Parameters
+    ----------
+    data : Data
+        Work buffers holding the configuration's poses (:func:`forward_kinematics`).
+    q : numpy.ndarray, shape (nv,)
+        The configuration ``data`` holds (its modal coordinates place a node).
+    located : (int, numpy.ndarray, numpy.ndarray, slice)
+        ``(body, r0, Φ, η)`` of the point.
+    """
+    body, r0, Phi, eta = located
+    return frame_pose(data, body, r0 + Phi @ q[eta], np.eye(3))[1]
 
 
 def point_position(model: Model, data: Data, q: np.ndarray, link: str, xyz) -> np.ndarray:

@@ -20,7 +20,13 @@ from rt70.surface.pressure import nodal_forces
 from rt70.textbook.data import Data
 from rt70.textbook.kinematics import frame_pose, update_structure
 from rt70.textbook.model import Model
-from rt70.textbook.points import ground_jacobian, link_point, located_jacobian, located_point
+from rt70.textbook.points import (
+    ground_jacobian,
+    link_point,
+    located_jacobian,
+    located_point,
+    located_position,
+)
 from rt70.urdf.modal_record import node_point
 
 
@@ -37,11 +43,8 @@ def _surface_force(model: Model, data: Data, q: np.ndarray, wrench: Wrench, body
     """``Q = Σ J_v,nᵀ f_n`` of the wrench spread over ``body``'s surface nodes (4.129)."""
     s = body.surface
     located = [located_point(model, node_point(body.name, int(n)), np.zeros(3)) for n in s.nodes]
-    p = np.array(
-        [frame_pose(data, b, r0 + Phi @ q[eta], np.eye(3))[1] for b, r0, Phi, eta in located]
-    )
-    at, r = link_point(model, wrench.link, wrench.xyz)
-    point = frame_pose(data, at, r, np.eye(3))[1]
+    p = np.array([located_position(data, q, where) for where in located])
+    point = located_position(data, q, located_point(model, wrench.link, wrench.xyz))
     forces = nodal_forces(wrench.force, wrench.torque, point, p, s.weights)
     Q = np.zeros(model.nv)
     for f, where in zip(forces, located, strict=True):
