@@ -29,6 +29,7 @@ from rt70.errors import Rt70Error
 from rt70.fe.modal_body import clamped_modes
 from rt70.fe.reflector import Dish
 from rt70.scenes import urdf_writer as uw
+from rt70.urdf import read_urdf_string
 from rt70.urdf.modal_file import ModalArrays
 from rt70.urdf.modal_record import Surface
 
@@ -112,6 +113,15 @@ def _shifted(inertia: np.ndarray, mass: float, offset: np.ndarray) -> np.ndarray
     return inertia + mass * (square * np.eye(3) - np.outer(offset, offset))
 
 
+def _rest_mass(link: tuple, dish: tuple, name: str) -> tuple[float, np.ndarray]:
+    """``(m, c)`` the link keeps beside the dish: the mass left and where the total stays."""
+    (m, c, _), (md, cd, _) = link, dish
+    mh = m - md
+    if not mh > 0.0:
+        raise Rt70Error(f"link '{name}': the dish's {md:.6g} kg is not less than its {m:.6g} kg")
+    return mh, (m * c - md * cd) / mh
+
+
 def residual_properties(
     link: tuple[float, np.ndarray, np.ndarray],
     dish: tuple[float, np.ndarray, np.ndarray],
@@ -134,12 +144,9 @@ def residual_properties(
         than the link it replaces).
     """
     (m, c, inertia), (md, cd, Id) = link, dish
-    mh = m - md
-    if not mh > 0.0:
-        raise Rt70Error(f"link '{name}': the dish's {md:.6g} kg is not less than its {m:.6g} kg")
-    ch = (m * c - md * cd) / mh
+    mh, ch = _rest_mass(link, dish, name)
     about_origin = _shifted(inertia, m, c) - _shifted(Id, md, cd)
-    Ih = about_origin - mh * (ch @ ch * np.eye(3) - np.outer(ch, ch))
+    Ih = about_origin - _shifted(np.zeros((3, 3)), mh, ch)
     moments = np.linalg.eigvalsh(0.5 * (Ih + Ih.T))
     slack = TRIANGLE_RTOL * moments.sum()
     if moments[0] <= 0.0 or moments[0] + moments[1] < moments[2] - slack:
@@ -194,10 +201,12 @@ def with_flexible_reflector(
     inertial = found[0].find("inertial") if found else None
     if inertial is None:
         raise Rt70Error(f"no link '{link}' with an <inertial> in the scene")
-    m = float(inertial.find("mass").get("value"))
+    read = read_urdf_string(text, f"<{link}>").links[link].inertial  # the reader's numbers
+    m = read.mass
     vertex = np.round(np.asarray(vertex, dtype=float), 9) + 0.0  # nm: the same on any CPU
     dish = rigid_properties(body.nodes + vertex, body.masses)
-    mh = _keep_the_rest(inertial, link, dish, hub_radius, float(np.max(np.abs(body.nodes))))
+    length = float(np.max(np.abs(body.nodes)))
+    mh = _keep_the_rest(inertial, link, (m, read.com, read.inertia), dish, hub_radius, length)
     if wind is not None:
         found_wind = [e for e in root.iter(f"{{{RT70_NAMESPACE}}}wind") if e.get("name") == wind]
         if not found_wind:
@@ -221,30 +230,27 @@ def with_flexible_reflector(
 
 
 def _keep_the_rest(
-    inertial: ET.Element, link: str, dish: tuple, hub_radius: float | None, length: float
+    inertial: ET.Element,
+    link: str,
+    properties: tuple[float, np.ndarray, np.ndarray],
+    dish: tuple,
+    hub_radius: float | None,
+    length: float,
 ) -> float:
     """Set the link's ``<inertial>`` to what it keeps of its body beside the dish; its mass.
 
-    The link's mass properties less the dish's (:func:`residual_properties`), or, with
-    ``hub_radius``, the rest of the mass as a solid sphere at the centre that keeps the
-    total centre (:func:`with_flexible_reflector`); written to :data:`WRITTEN_DIGITS`.
+    The link's mass properties ``(m, c, I_c)`` (as the URDF reader gives them) less the
+    dish's (:func:`residual_properties`), or, with ``hub_radius``, the rest of the mass as
+    a solid sphere at the centre that keeps the total centre
+    (:func:`with_flexible_reflector`); written to :data:`WRITTEN_DIGITS`.
     """
     origin = inertial.find("origin")
-    if origin is not None and np.any(np.array(uw_floats(origin.get("rpy", "0 0 0")))):
+    if origin is not None and any(float(v) for v in origin.get("rpy", "0 0 0").split()):
         raise Rt70Error(f"link '{link}': an inertial with rpy is not supported here")
-    c = np.array(uw_floats(origin.get("xyz", "0 0 0"))) if origin is not None else np.zeros(3)
-    m = float(inertial.find("mass").get("value"))
     if hub_radius is None:
-        mh, ch, Ih = residual_properties(
-            (m, c, _inertia_matrix(inertial.find("inertia").attrib)), dish, link
-        )
+        mh, ch, Ih = residual_properties(properties, dish, link)
     else:
-        mh = m - dish[0]
-        if not mh > 0.0:
-            raise Rt70Error(
-                f"link '{link}': the dish's {dish[0]:.6g} kg is not less than {m:.6g} kg"
-            )
-        ch = (m * c - dish[0] * dish[1]) / mh
+        mh, ch = _rest_mass(properties, dish, link)
         Ih = 0.4 * mh * hub_radius**2 * np.eye(3)
     mh, ch, Ih = _written(mh, ch, Ih, length)
     inertial.find("mass").set("value", uw.fmt(mh))
@@ -274,21 +280,4 @@ def _written(
         float(f"{mass:.{WRITTEN_DIGITS}g}"),
         np.round(centre / length, WRITTEN_DIGITS) * length + 0.0,
         np.round(inertia / scale, WRITTEN_DIGITS) * scale + 0.0,
-    )
-
-
-def uw_floats(text: str) -> list[float]:
-    """Three numbers of an ``xyz``/``rpy`` attribute."""
-    return [float(v) for v in text.split()]
-
-
-def _inertia_matrix(e: dict) -> np.ndarray:
-    """The symmetric inertia matrix of an ``<inertia>`` element's attributes."""
-    get = {k: float(e.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-    return np.array(
-        [
-            [get["ixx"], get["ixy"], get["ixz"]],
-            [get["ixy"], get["iyy"], get["iyz"]],
-            [get["ixz"], get["iyz"], get["izz"]],
-        ]
     )
