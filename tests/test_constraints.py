@@ -67,6 +67,13 @@ def test_locking_is_the_identity_without_the_locked_columns():
     assert np.array_equal(m.reduce_matrix(M), M[np.ix_([0, 2], [0, 2])])
     assert np.array_equal(m.reduce_force(np.arange(4.0)), [0.0, 2.0])
     assert constraints.locking(["a", "b"], ["b"]).offset.tolist() == [0.0, 0.0]
+    # the selection the map takes for its products is exactly the products with T
+    general = constraints.HolonomicMap(m.T, m.offset, m.full_names, m.names)
+    q, Q = np.array([2.0, 3.0]), np.arange(4.0)
+    assert np.array_equal(m.expand(q), general.expand(q))
+    assert np.array_equal(m.expand(q, offset=False), general.expand(q, offset=False))
+    assert np.array_equal(m.reduce_force(Q), general.reduce_force(Q))
+    assert np.array_equal(m.reduce_matrix(M), general.reduce_matrix(M))
     with pytest.raises(Rt70Error, match="no coordinate"):
         constraints.locking(["a"], ["z"])
 

@@ -361,6 +361,14 @@ def test_results_with_nan_are_refused():
         options.check_finite({"a": [1.0, {"b": math.nan}]}, "x")
     with pytest.raises(Rt70Error, match=r"x: d is NaN or infinite"):
         options.check_finite({"d": np.array([1.0, np.inf])}, "x")
+    # long lists and dicts of numbers (mode shapes) are checked at once, and still named
+    shape = {f"q{i}": float(i) for i in range(40)}
+    options.check_finite({"modes": [{"shape": shape, "kind": "elastic"}] * 20}, "x")
+    with pytest.raises(Rt70Error, match=r"x: modes\[0\]\.shape\.q39 is NaN"):
+        options.check_finite({"modes": [{"shape": {**shape, "q39": math.nan}}]}, "x")
+    with pytest.raises(Rt70Error, match=r"x: \[17\] is NaN"):
+        options.check_finite([1] * 17 + [math.inf], "x")
+    options.check_finite(["nan"] * 20 + [None], "x")  # text and None are not numbers
 
 
 def test_settling_metrics_nan_is_text_other_nan_is_an_error():

@@ -58,3 +58,25 @@ def test_text_explains_unstable_and_rigid_modes(capsys):
     assert main(["modes", "rt70_elevation"]) == 0
     out = capsys.readouterr().out
     assert "rigid-body motion" in out and "--lock-axes" not in out  # no axes to lock
+
+
+def test_a_large_chain_goes_the_compiled_way(capsys, tmp_path):
+    """540 coordinates: the compiled kernels linearise it, the damped system's eigenvalues
+    nearest zero are found by shift-invert, and the JSON says how many of them."""
+    from rt70.linear import compiled
+    from rt70.linear.damped_lowest import DENSE_MAX, LOWEST
+    from rt70.scenes.synthetic import elastic_chain
+
+    path = tmp_path / "chain90.urdf"
+    path.write_text(elastic_chain(90, seed=0, hanging=True))
+    assert 6 * 90 > max(DENSE_MAX, compiled.LARGE_NV)
+    assert main(["modes", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("chain90: 540 modes at static equilibrium")
+    assert f"among its {2 * LOWEST} eigenvalues nearest zero (of 1080)" in out
+    assert main(["modes", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    damped = data["damped"]
+    assert (damped["eigenvalues_found"], damped["eigenvalues_total"]) == (2 * LOWEST, 1080)
+    assert len(damped["oscillatory"]) == LOWEST
+    assert all(0.0 < o["zeta"] < 1.0 for o in damped["oscillatory"])  # 1 % bushing damping

@@ -57,3 +57,15 @@ def test_bad_reduce_options_exit_2_with_one_line(capsys, argv, message):
     code = _run(["plant", "rt70_servo", *argv])
     err = capsys.readouterr().err
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_long_signal_lists_are_cut_in_the_text_summary():
+    """Thousands of forces and coordinates are named in --json and --out, counted in text."""
+    from rt70.cli.plant import LISTED, _listed
+
+    few = [f"s{i}" for i in range(LISTED)]
+    assert _listed(few) == ", ".join(few)
+    many = [f"s{i}" for i in range(LISTED + 5)]
+    text = _listed(many)
+    assert text.startswith(", ".join(few) + ", … and 5 more")
+    assert f"s{LISTED}" not in text.split("…")[0]

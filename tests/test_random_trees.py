@@ -272,3 +272,19 @@ def test_inertias_are_valid_with_off_diagonal_terms():
 def test_bad_arguments_raise(call):
     with pytest.raises(ValueError):
         call()
+
+
+def test_hanging_elastic_chain_hangs_straight_down():
+    """The same draws as the standing chain, the construction frames straight below."""
+    import re
+
+    standing, hanging = elastic_chain(3, seed=5), elastic_chain(3, seed=5, hanging=True)
+    pattern = r'<origin xyz="([^"]+)" rpy="([^"]+)"/>\s*<axis xyz="1 0 0"/>\s*<limit[^>]*/>'
+    pattern = r'_x" type="prismatic">\s*<parent[^>]*/>\s*<child[^>]*/>\s*' + pattern
+    up = [list(map(float, x.split())) for x, _ in re.findall(pattern, standing)]
+    down = re.findall(pattern, hanging)
+    assert len(up) == len(down) == 3
+    for (x, rpy), (_, _, z) in zip(down, up, strict=True):
+        assert list(map(float, x.split())) == [0.0, 0.0, -z] and z > 0
+        assert list(map(float, rpy.split())) == [0.0, 0.0, 0.0]
+    assert elastic_chain(3, seed=5, hanging=False) == standing

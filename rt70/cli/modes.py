@@ -60,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     has_axes, elevation, azimuth, held = options.asked_pointing(args, scene, "modes")
     result, shapes, model, damped, constraints = _spectrum(args, scene, held)
     drives = bool(scene.description.drives) and not args.lock_axes
-    rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates)
+    rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates, args.json)
     damped_summary = mode_table.damped_summary(result, damped)
     options.check_finite({"modes": rows, "damped": damped_summary}, f"{scene.name}: modes")
     if args.plot is not None:
@@ -143,6 +143,7 @@ def _spectrum(args: argparse.Namespace, scene, held: dict) -> tuple:
 
     from rt70.linear import linearize as lin
     from rt70.linear import modal
+    from rt70.linear.damped_lowest import damped_spectrum
     from rt70.textbook.massless import require_diagonal
 
     constraints = None
@@ -161,7 +162,7 @@ def _spectrum(args: argparse.Namespace, scene, held: dict) -> tuple:
         require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
         result = modal.modes(model.M, model.K, model.D)
         shapes = result.shapes
-        damped = modal.damped_modes(model.M, model.K, model.D)
+        damped = damped_spectrum(model.M, model.K, model.D, result)
     return result, shapes, model, damped, constraints
 
 
@@ -225,7 +226,14 @@ def _print_table(rows: list[dict], result, damped) -> None:
         + ("" if result.proportional else " (approximate: the damping is not proportional)")
         + f"; the damped system has {len(damped.oscillatory)} oscillatory pairs and "
         f"{len(damped.real)} real eigenvalues (creeping motions: overdamped, rigid, unstable)"
+        + _found(damped, len(result.freq_hz))
     )
+
+
+def _found(damped, n: int) -> str:
+    """The note of a damped spectrum found in part (rt70.linear.damped_lowest)."""
+    found = len(damped.eigenvalues)
+    return "" if found == 2 * n else f" among its {found} eigenvalues nearest zero (of {2 * n})"
 
 
 def _print_unheld(rows: list[dict], held: dict, lock_axes: bool) -> None:

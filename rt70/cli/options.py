@@ -404,6 +404,10 @@ def json_text(result: object, what: str) -> str:
 
 def _non_finite(value: object, path: str) -> str | None:
     """The key path of the first NaN or infinity in ``value``, or None."""
+    from rt70.guards.arrays import finite_numbers
+
+    if finite_numbers(value):  # a mode shape: checked at once
+        return None
     if isinstance(value, dict):
         items = ((f"{path}.{k}" if path else str(k), v) for k, v in value.items())
     elif isinstance(value, list | tuple):

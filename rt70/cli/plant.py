@@ -229,6 +229,18 @@ def _write(args: argparse.Namespace, scene, ss, info: dict) -> None:
         write_plant(args.out, arrays, info)
 
 
+#: The text summary names this many signals of a kind, then counts the rest (--json: all).
+LISTED = 24
+
+
+def _listed(labels: list[str]) -> str:
+    """The signals' names, the first :data:`LISTED` of a long list and how many more."""
+    if len(labels) <= LISTED:
+        return ", ".join(labels)
+    more = len(labels) - LISTED
+    return ", ".join(labels[:LISTED]) + f", … and {more} more (--json or --out lists all)"
+
+
 def _print_text(args: argparse.Namespace, title: str, ss, info: dict) -> None:
     """The plant's summary: its size, unstable and rigid modes, signals, reduction."""
     print(
@@ -236,8 +248,8 @@ def _print_text(args: argparse.Namespace, title: str, ss, info: dict) -> None:
         f"{ss.noutputs} outputs; {info['unstable_modes']} unstable and "
         f"{info['rigid_modes']} rigid mode(s) (the loops the drives must close)"
     )
-    print("  inputs:  " + ", ".join(ss.input_labels))
-    print("  outputs: " + ", ".join(ss.output_labels))
+    print("  inputs:  " + _listed(ss.input_labels))
+    print("  outputs: " + _listed(ss.output_labels))
     if args.reduce is not None:
         r = info["reduced"]
         bound = "" if r["bound_2sum_hsv"] is None else f" (bound 2Σσ {r['bound_2sum_hsv']:.3g})"

@@ -173,4 +173,4 @@ def write_plant(out: str, arrays: dict, info: dict) -> None:
         atomic_write(out, lambda tmp: scipy.io.savemat(tmp, content, appendmat=False))
     else:
         plain = {k: np.array(v, dtype=str) for k, v in labels.items()}
-        atomic_write(out, lambda tmp: np.savez_compressed(tmp, **arrays, **plain))
+        atomic_write(out, lambda tmp: np.savez(tmp, **arrays, **plain))

@@ -43,3 +43,24 @@ def check_vector(name: str, x: np.ndarray, size: int) -> np.ndarray:
     if np.count_nonzero(np.isfinite(x)) != size:  # twice as fast as np.isfinite(x).all()
         raise NonFiniteError(f"{name} contains NaN or infinite values")
     return x
+
+
+def finite_numbers(value: object) -> bool:
+    """True for a dict, list or tuple of 16 or more plain numbers, all finite.
+
+    False for anything else (shorter, nested, text, None, or a NaN among the numbers):
+    the caller then walks it item by item to name what is wrong. A mode shape of
+    thousands of coordinates is thus checked in one array operation.
+
+    Parameters
+    ----------
+    value : object
+        What to check.
+    """
+    if not isinstance(value, dict | list | tuple) or len(value) < 16:
+        return False
+    try:
+        numbers = np.fromiter(value.values() if isinstance(value, dict) else value, float)
+    except (TypeError, ValueError):  # not numbers only
+        return False
+    return bool(np.isfinite(numbers).all())

@@ -34,6 +34,7 @@ import numpy as np
 import scipy.linalg
 
 from rt70.errors import Rt70Error
+from rt70.linear import compiled
 from rt70.model.scene import Scene
 from rt70.model.sides import Side, check_side, side_of
 from rt70.physics.constraints import HolonomicMap, locking
@@ -224,27 +225,39 @@ def equilibrium(
     nv = scene.textbook.nv
     q = np.zeros(nv) if q_start is None else np.array(q_start, dtype=float)
     q = hold.expand(hold.T.T @ q)  # the free values kept, the held ones set
-    scale = max(float(np.max(np.abs(static_force(scene, q)))), 1.0)
-    K, previous = None, np.inf
+    kernels = compiled.kernels_for(scene) if side == "reference" else None
+    if kernels is None:
+        force = lambda x: static_force(scene, x)  # noqa: E731
+        stiffness = lambda x: stiffness_matrix(scene, x, side=side)  # noqa: E731
+    else:  # a large scene: the compiled kernels (rt70.linear.compiled)
+        force, stiffness = kernels.static_force, kernels.stiffness_matrix
+    return _newton(scene, hold, q, force, stiffness, tol, max_iter)
+
+
+def _newton(scene: Scene, hold: HolonomicMap, q: np.ndarray, force, stiffness, tol: float,
+            max_iter: int) -> np.ndarray:  # fmt: skip
+    """:func:`equilibrium`'s Newton iteration with the callables ``force`` and ``stiffness``."""
+    scale = max(float(np.max(np.abs(force(q)))), 1.0)
+    solve, previous = None, np.inf
     for _ in range(max_iter):
-        residual, size = _free_residual(scene, hold, q)
+        residual, size = _free_residual(scene, hold, force(q))
         if size <= tol * scale:
             return q
-        if K is not None and size <= REUSE_RATIO * previous:
+        if solve is not None and size <= REUSE_RATIO * previous:
             previous = size  # the last K still converges fast: keep it (modified Newton)
         else:
-            K, previous = hold.reduce_matrix(stiffness_matrix(scene, q, side=side)), size
-        step = _newton_step(scene, K, residual, hold.names)
+            solve, previous = _factor(scene, hold.reduce_matrix(stiffness(q)), hold.names), size
+        step = solve(residual)
         q += hold.expand(step, offset=False)
         if float(np.max(np.abs(step), initial=0.0)) <= STEP_TOL * max(1.0, np.abs(q).max()):
             return q  # the position is fixed to rounding; what is left is the forces' rounding
     raise Rt70Error(f"{scene.name}: static equilibrium not found in {max_iter} Newton steps")
 
 
-def _free_residual(scene: Scene, hold: HolonomicMap, q: np.ndarray) -> tuple[np.ndarray, float]:
-    """The static force on the free coordinates at q and its largest magnitude (finite)."""
+def _free_residual(scene: Scene, hold: HolonomicMap, force: np.ndarray) -> tuple[np.ndarray, float]:
+    """The static ``force`` on the free coordinates and its largest magnitude (finite)."""
     with np.errstate(over="ignore", invalid="ignore"):  # checked just below
-        residual = hold.reduce_force(static_force(scene, q))
+        residual = hold.reduce_force(force)
     size = float(np.max(np.abs(residual), initial=0.0))
     if not np.isfinite(size):
         raise Rt70Error(
@@ -254,13 +267,12 @@ def _free_residual(scene: Scene, hold: HolonomicMap, q: np.ndarray) -> tuple[np.
     return residual, size
 
 
-def _newton_step(
-    scene: Scene, K: np.ndarray, residual: np.ndarray, names: tuple[str, ...]
-) -> np.ndarray:
-    """Newton's step ``K⁻¹ r`` on the free coordinates ``names``.
+def _factor(scene: Scene, K: np.ndarray, names: tuple[str, ...]):
+    """Newton's step ``r ↦ K⁻¹ r`` on the free coordinates ``names``, K factorised once.
 
-    A K singular to working precision (no equilibrium) is a clear error naming the
-    coordinates of its null space.
+    A K singular to working precision (reciprocal condition number below ε, the test of
+    :func:`scipy.linalg.solve`: no equilibrium) is a clear error naming the coordinates
+    of its null space.
     """
     if not np.isfinite(K).all():
         raise Rt70Error(
@@ -270,7 +282,10 @@ def _newton_step(
     with warnings.catch_warnings():
         warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
         try:
-            return scipy.linalg.solve(K, residual, assume_a="sym")
+            lu = scipy.linalg.lu_factor(K)
+            rcond, info = scipy.linalg.lapack.dgecon(lu[0], np.linalg.norm(K, 1), norm="1")
+            if info == 0 and rcond >= np.finfo(float).eps:
+                return lambda r: scipy.linalg.lu_solve(lu, r)
         except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
             pass
     raise Rt70Error(
@@ -330,17 +345,22 @@ def linearize(
         Whose static forces K is differenced from (:func:`stiffness_matrix`).
     """
     check_side(side)
-    model, data = scene.textbook, scene.textbook_data
     lock = locking_map(scene, list(locked))
-    M = dynamics.mass_matrix(model, data, q0)
+    kernels = compiled.kernels_for(scene) if side == "reference" else None
+    if kernels is None:
+        model, data = scene.textbook, scene.textbook_data
+        M, K = dynamics.mass_matrix(model, data, q0), stiffness_matrix(scene, q0, side=side)
+        D, K_gravity = damping_matrix(scene, q0), _gravity_stiffness(scene, q0, side=side)
+    else:  # a large scene: the compiled kernels (rt70.linear.compiled)
+        M, K, D, K_gravity = kernels.matrices(q0)
     return Linearization(
         scene=scene.name,
         q0=np.array(q0, dtype=float),
         coordinates=list(lock.names),
         M=lock.reduce_matrix(M),
-        K=lock.reduce_matrix(stiffness_matrix(scene, q0, side=side)),
-        D=lock.reduce_matrix(damping_matrix(scene, q0)),
-        K_gravity=lock.reduce_matrix(_gravity_stiffness(scene, q0, side=side)),
+        K=lock.reduce_matrix(K),
+        D=lock.reduce_matrix(D),
+        K_gravity=lock.reduce_matrix(K_gravity),
         locked=list(locked),
     )
 

@@ -228,7 +228,9 @@ def _diagonalise_clusters(
     for idx in _clusters(omega2, tol):
         _, R = np.linalg.eigh(Z[np.ix_(idx, idx)])
         V[:, idx] = V[:, idx] @ R
-    return V.T @ D @ V
+        Z[idx, :] = R.T @ Z[idx, :]  # Z ← Bᵀ Z B, B the rotation: rows, then columns
+        Z[:, idx] = Z[:, idx] @ R
+    return 0.5 * (Z + Z.T)
 
 
 def _fix_signs(V: np.ndarray, Z: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
@@ -448,7 +450,11 @@ def damped_modes(
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -scipy.linalg.solve(M, K, assume_a="pos")
     A[n:, n:] = -scipy.linalg.solve(M, D, assume_a="pos")
-    lam = scipy.linalg.eigvals(A)
+    return split_damped(scipy.linalg.eigvals(A), real_rtol)
+
+
+def split_damped(lam: np.ndarray, real_rtol: float = 1e-9) -> DampedModes:
+    """Eigenvalues ``lam`` of a damped system sorted by ``|λ|`` and split (:func:`damped_modes`)."""
     lam = lam[np.argsort(np.abs(lam), kind="stable")]
     scale = max(float(np.max(np.abs(lam))), 1.0)
     is_real = np.abs(lam.imag) <= real_rtol * np.maximum(np.abs(lam), 1e-12 * scale)

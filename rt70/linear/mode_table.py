@@ -15,7 +15,11 @@ from rt70.linear.modal import DampedModes, Modes
 
 
 def mode_rows(
-    result: Modes, shapes: np.ndarray, M: np.ndarray, coordinates: Sequence[str]
+    result: Modes,
+    shapes: np.ndarray,
+    M: np.ndarray,
+    coordinates: Sequence[str],
+    with_shapes: bool = True,
 ) -> list[dict]:
     """One dict per mode, as ``rt70 modes --json`` lists them.
 
@@ -32,6 +36,9 @@ def mode_rows(
         share names the dominant coordinate.
     coordinates : sequence of str
         Names of the n coordinates.
+    with_shapes : bool
+        Give each row its ``shape`` (the text table does not print them: n² numbers for
+        a model of n coordinates).
 
     Returns
     -------
@@ -60,9 +67,10 @@ def mode_rows(
                 "divergence_rate": float(np.sqrt(-result.omega2[i])) if unstable else None,
                 "zeta": zeta,
                 "dominant": coordinates[int(np.argmax(np.abs(energy[:, i])))],
-                "shape": dict(zip(coordinates, shapes[:, i].tolist(), strict=True)),
             }
         )
+        if with_shapes:
+            rows[-1]["shape"] = dict(zip(coordinates, shapes[:, i].tolist(), strict=True))
     return rows
 
 
@@ -75,4 +83,7 @@ def damped_summary(result: Modes, damped: DampedModes) -> dict:
         ],
         "real_eigenvalues": damped.real.tolist(),
         "proportional": bool(result.proportional),
+        # how many of the state matrix's 2n eigenvalues these are (rt70.linear.damped_lowest)
+        "eigenvalues_found": len(damped.eigenvalues),
+        "eigenvalues_total": 2 * len(result.freq_hz),
     }

@@ -112,6 +112,16 @@ class Scene:
         return Data(model)
 
     @cached_property
+    def static_kernels(self):  # -> rt70.textbook.static_kernel.StaticData | None
+        """The compiled static forces' arrays (:mod:`rt70.textbook.static_kernel`), or None.
+
+        None for a model the kernel does not cover (modal bodies, mimic joints).
+        """
+        from rt70.textbook.static_kernel import StaticData
+
+        return StaticData.of(self.textbook)
+
+    @cached_property
     def reference(self):  # -> rt70.reference.ReferenceModel (imported lazily: Pinocchio)
         """The Pinocchio reference model (:mod:`rt70.reference`)."""
         from rt70.reference import ReferenceModel

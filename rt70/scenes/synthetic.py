@@ -230,7 +230,7 @@ def balanced_tree(
     )
 
 
-def elastic_chain(n_bodies: int, seed: int = 0) -> str:
+def elastic_chain(n_bodies: int, seed: int = 0, hanging: bool = False) -> str:
     """URDF text of a chain of bodies on the book's 6-DOF elastic pairs (as ``rt70.urdf``).
 
     Body ``body<k>`` is joined to its parent (``world`` for k = 1, else ``body<k-1>``) by
@@ -251,6 +251,14 @@ def elastic_chain(n_bodies: int, seed: int = 0) -> str:
         Number of bodies (≥ 1); the scene has ``6 n_bodies`` coordinates.
     seed : int, optional
         Seed of the random generator.
+    hanging : bool, optional
+        Hang the chain from the world: each construction frame straight below its
+        parent's (z negated, x, y and the rotation dropped; the same draws otherwise),
+        so that gravity stretches the chain instead of buckling it. A standing chain of
+        more than some ten bodies has no stable equilibrium at these stiffnesses (nor
+        has one whose random frame rotations curl it upwards), and a crooked hanging
+        one sags by tens of degrees per pair; a straight hanging one hangs near its
+        drawn shape at any length.
 
     Returns
     -------
@@ -265,9 +273,10 @@ def elastic_chain(n_bodies: int, seed: int = 0) -> str:
     if n_bodies < 1:
         raise ValueError(f"n_bodies must be at least 1, got {n_bodies}")
     rng = np.random.default_rng(seed)
+    how = "hanging " if hanging else ""
     w = Writer(
-        f"elastic_chain_{n_bodies}_s{seed}",
-        f"Chain of {_bodies(n_bodies)} on 6-DOF elastic pairs, seed {seed}",
+        f"elastic_chain_{n_bodies}_s{seed}" + ("_hanging" if hanging else ""),
+        f"Chain of {_bodies(n_bodies)} on 6-DOF elastic pairs, {how}seed {seed}",
     )
     pairs = []
     parent = ROOT_LINK
@@ -275,20 +284,10 @@ def elastic_chain(n_bodies: int, seed: int = 0) -> str:
         body = f"body{k}"
         offset = np.array([*rng.uniform(-0.2, 0.2, 2), rng.uniform(0.5, 2.0)])
         offset_rpy = rng.uniform(-0.3, 0.3, 3)
+        if hanging:
+            offset, offset_rpy = np.array([0.0, 0.0, -offset[2]]), np.zeros(3)
         w.add(f"<!-- {body}: 6-DOF pair on {parent}, construction offset [{fmt_vec(offset)}] -->")
-        previous = parent
-        for step, (suffix, jtype, axis) in enumerate(PAIR_JOINTS):
-            last = step == len(PAIR_JOINTS) - 1
-            child = body if last else f"{body}_{suffix}_link"
-            link = Body(child, f"{body}_{suffix}", jtype, previous)
-            if step == 0:
-                link.xyz, link.rpy = offset, offset_rpy
-            link.axis = np.array(axis)
-            if last:
-                link.inertial = random_inertial(rng)
-            write_joint(w, link)
-            write_link(w, link)
-            previous = link.name
+        _write_pair(w, rng, parent, body, offset, offset_rpy)
         stiffness = np.concatenate(
             [log_uniform(rng, 1.0e4, 1.0e5, 3), log_uniform(rng, 1.0e3, 1.0e4, 3)]
         )
@@ -305,6 +304,42 @@ def elastic_chain(n_bodies: int, seed: int = 0) -> str:
             0.01 * stiffness,
         )
     return w.text()
+
+
+def _write_pair(
+    w: Writer,
+    rng: np.random.Generator,
+    parent: str,
+    body: str,
+    offset: np.ndarray,
+    offset_rpy: np.ndarray,
+) -> None:
+    """The six joints and links of ``body``'s elastic pair on ``parent`` (:func:`elastic_chain`).
+
+    Parameters
+    ----------
+    w : Writer
+        The URDF text being written.
+    rng : numpy.random.Generator
+        Draws the body's inertial.
+    parent, body : str
+        The pair's two links.
+    offset, offset_rpy : numpy.ndarray
+        The construction frame's origin (m) and rotation (rad) in ``parent``.
+    """
+    previous = parent
+    for step, (suffix, jtype, axis) in enumerate(PAIR_JOINTS):
+        last = step == len(PAIR_JOINTS) - 1
+        child = body if last else f"{body}_{suffix}_link"
+        link = Body(child, f"{body}_{suffix}", jtype, previous)
+        if step == 0:
+            link.xyz, link.rpy = offset, offset_rpy
+        link.axis = np.array(axis)
+        if last:
+            link.inertial = random_inertial(rng)
+        write_joint(w, link)
+        write_link(w, link)
+        previous = link.name
 
 
 def random_tree(

@@ -108,7 +108,37 @@ def _pair_motion(
 
 
 @numba.njit(cache=True)
-def _mass_matrix_one(
+def _ground_inertia(
+    Cj: np.ndarray, pj: np.ndarray, Theta_j: np.ndarray, L: np.ndarray, T: np.ndarray, out
+) -> None:
+    """Step 3 for one pair: ``Θ⁰_j = L Θ_j Lᵀ`` with ``L = L_0^j = [[C, 0], [<p> C, C]]`` (4.77).
+
+    Into ``out`` (6, 6); ``L`` and ``T`` are 6 × 6 scratch.
+    """
+    L[:3, 3:] = 0.0
+    for m in range(3):
+        L[m, :3] = Cj[m]
+        L[3 + m, 3:] = Cj[m]
+        L[3, m] = pj[1] * Cj[2, m] - pj[2] * Cj[1, m]
+        L[4, m] = pj[2] * Cj[0, m] - pj[0] * Cj[2, m]
+        L[5, m] = pj[0] * Cj[1, m] - pj[1] * Cj[0, m]
+    for a in range(6):  # T = L Θ_j (the upper right block of L is zero)
+        for b in range(6):
+            acc = 0.0
+            for k in range(3 if a < 3 else 6):
+                acc += L[a, k] * Theta_j[k, b]
+            T[a, b] = acc
+    for a in range(6):  # Θ⁰_j = T Lᵀ (symmetric: the upper triangle, mirrored)
+        for b in range(a, 6):
+            acc = 0.0
+            for k in range(3 if b < 3 else 6):
+                acc += T[a, k] * L[b, k]
+            out[a, b] = acc
+            out[b, a] = acc
+
+
+@numba.njit(cache=True)
+def forward_pass(
     qf: np.ndarray,
     parent: np.ndarray,
     kind: np.ndarray,
@@ -125,17 +155,34 @@ def _mass_matrix_one(
     m6: np.ndarray,
     m3: np.ndarray,
     v3: np.ndarray,
-    out: np.ndarray,
+    inertias: bool = True,
 ) -> None:
-    """``A_full`` at one configuration into ``out`` (module docstring, steps 1–4).
+    """Steps 1–3 at one configuration: ``C``, ``p``, ``σ`` and the composite ``Θᶜ``.
 
-    ``m6`` (3, 6, 6), ``m3`` (2, 3, 3) and ``v3`` (6, 3) are work arrays (contiguous
-    slices, so that the compiled loops stay simple); nothing is allocated here.
+    Nothing is allocated here; the scratch arrays are contiguous slices, so that the
+    compiled loops stay simple.
+
+    Parameters
+    ----------
+    qf : numpy.ndarray, shape (n,)
+        The full coordinates (mimic joints included), rad or m.
+    parent, kind, q_start, ndof, axis, r_c, c_c, Theta : numpy.ndarray
+        The model's arrays (:class:`KernelModel`).
+    C, p : numpy.ndarray, shapes (nb, 3, 3) and (nb, 3)
+        Out: each pair's absolute rotation and origin ``L_0^j``.
+    theta_c : numpy.ndarray, shape (nb, 6, 6)
+        Out: the composite inertias ``Θᶜ_k`` in E0 (untouched without ``inertias``).
+    sigma : numpy.ndarray, shape (n, 6)
+        Out: the mobility axes ``σ_a`` seen from E0.
+    m6, m3, v3 : numpy.ndarray, shapes (3, 6, 6), (2, 3, 3), (6, 3)
+        Scratch.
+    inertias : bool
+        Step 3 too (False: steps 1–2 only).
     """
     nb = parent.shape[0]
     rows, L, T = m6[0], m6[1], m6[2]
     c, cc = m3[0], m3[1]
-    r, rr, w, v, F = v3[0], v3[1], v3[2], v3[3], v3[4:].reshape(6)
+    r, rr, w, v = v3[0], v3[1], v3[2], v3[3]
     for j in range(nb):  # steps 1 and 2, parents first
         s0 = q_start[j]
         _pair_motion(kind[j], axis[j], qf[s0 : s0 + ndof[j]], c, r, rows)
@@ -160,29 +207,37 @@ def _mass_matrix_one(
             sigma[s0 + a, 1] = v[1] + pj[2] * w[0] - pj[0] * w[2]
             sigma[s0 + a, 2] = v[2] + pj[0] * w[1] - pj[1] * w[0]
             sigma[s0 + a, 3:] = w
-        # step 3: Θ⁰_j = L Θ_j Lᵀ with L = L_0^j = [[C, 0], [<p> C, C]]
-        L[:3, 3:] = 0.0
-        for m in range(3):
-            L[m, :3] = Cj[m]
-            L[3 + m, 3:] = Cj[m]
-            L[3, m] = pj[1] * Cj[2, m] - pj[2] * Cj[1, m]
-            L[4, m] = pj[2] * Cj[0, m] - pj[0] * Cj[2, m]
-            L[5, m] = pj[0] * Cj[1, m] - pj[1] * Cj[0, m]
-        for a in range(6):  # T = L Θ_j (the upper right block of L is zero)
-            for b in range(6):
-                acc = 0.0
-                for k in range(3 if a < 3 else 6):
-                    acc += L[a, k] * Theta[j, k, b]
-                T[a, b] = acc
-        for a in range(6):  # Θ⁰_j = T Lᵀ (symmetric: the upper triangle, mirrored)
-            for b in range(a, 6):
-                acc = 0.0
-                for k in range(3 if b < 3 else 6):
-                    acc += T[a, k] * L[b, k]
-                theta_c[j, a, b] = acc
-                theta_c[j, b, a] = acc
-    _composite_inertias(parent, theta_c)
-    _mass_entries(parent, q_start, ndof, theta_c, sigma, F, out)
+        if inertias:
+            _ground_inertia(Cj, pj, Theta[j], L, T, theta_c[j])
+    if inertias:
+        _composite_inertias(parent, theta_c)
+
+
+@numba.njit(cache=True)
+def _mass_matrix_one(
+    qf: np.ndarray,
+    parent: np.ndarray,
+    kind: np.ndarray,
+    q_start: np.ndarray,
+    ndof: np.ndarray,
+    axis: np.ndarray,
+    r_c: np.ndarray,
+    c_c: np.ndarray,
+    Theta: np.ndarray,
+    C: np.ndarray,
+    p: np.ndarray,
+    theta_c: np.ndarray,
+    sigma: np.ndarray,
+    m6: np.ndarray,
+    m3: np.ndarray,
+    v3: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """``A_full`` at one configuration into ``out`` (module docstring, steps 1–4)."""
+    forward_pass(
+        qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c, sigma, m6, m3, v3
+    )
+    _mass_entries(parent, q_start, ndof, theta_c, sigma, v3[4:].reshape(6), out)
 
 
 @numba.njit(cache=True)

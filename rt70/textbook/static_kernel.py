@@ -1,0 +1,380 @@
+"""Compiled static forces of the book's model: gravity ``S G``, springs, and their K.
+
+For models of thousands of coordinates, where the dense textbook form and Pinocchio's
+``Data`` (four ``nv³`` tensors) are out of reach, the static force and its derivatives
+are needed at every Newton step of an equilibrium and for the stiffness matrix of the
+linear model. This kernel computes them with the mass kernel's forward pass
+(:func:`rt70.textbook.mass_kernel.forward_pass`: the absolute placements ``C_j``, ``p_j``,
+the mobility axes ``σ_a`` seen from E0 and the composite inertias ``Θᶜ_k``):
+
+- gravity (4.113)–(4.128): ``Q_g,a = σ_aᵀ Θᶜ_k [g0; 0]`` for coordinate a of pair k —
+  ``S G`` summed over the subtree at once, since ``Θᶜ_k [g0; 0]`` is the subtree's weight
+  and its moment about E0;
+- a bushing (the book's elastic pair (4.83) and strut package (4.85)): frame i at
+  ``R_i = C_b c_i``, ``p_i = p_b + C_b r_i``; ``δ = [R1ᵀ (p2 − p1); φ(R1ᵀ R2)]`` with φ the
+  1–2–3 angles (as :func:`rt70.textbook.forces.bushing_deformation`). A coordinate a on
+  the path from the two bodies' lowest common ancestor to body 2 (sign s = +1) or to
+  body 1 (s = −1) moves frame 2 relative to frame 1 by the twist ``s σ_a``:
+  ``∂δ/∂q_a = s [R1ᵀ (v_a + w_a × p2); ε⁻¹(φ) R2ᵀ w_a]`` (1.38). Its generalised force
+  ``−Jᵀ C δ`` is a wrench in E0: ``F = R1 (Cδ)_t``, ``N = p2 × F + R2 ε⁻ᵀ (Cδ)_r``, and
+  ``Q_a −= s (v_a · F + w_a · N)``;
+- a joint spring: ``Q_a −= k q_a`` (4.83).
+
+``stiffness_matrices`` differences this force centrally inside the kernel (one evaluation
+is O(bodies + bushing paths), so K costs O(n²)); ``element_gains`` gives the exact
+``Σ Jᵀ C J`` and ``Σ Jᵀ D J``. Models with modal bodies or mimic joints have no kernel
+(:meth:`StaticData.of` gives None). Compiled on first use and cached on disk.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from rt70.errors import SingularConfigurationError
+from rt70.guards.arrays import check_vector
+from rt70.textbook.mass_kernel import KernelModel, forward_pass
+from rt70.textbook.model import Model
+from rt70.textbook.spatial import GIMBAL_LOCK_COS
+
+
+@numba.njit(cache=True)
+def _frame(b: int, r: np.ndarray, c: np.ndarray, C: np.ndarray, p: np.ndarray, R, x) -> None:
+    """Frame (``c``, ``r``) of body ``b`` (−1 = ground) in E0: rotation ``R``, origin ``x``."""
+    for i in range(3):
+        for m in range(3):
+            if b < 0:
+                R[i, m] = c[i, m]
+            else:
+                R[i, m] = C[b, i, 0] * c[0, m] + C[b, i, 1] * c[1, m] + C[b, i, 2] * c[2, m]
+        x[i] = (
+            r[i] if b < 0 else p[b, i] + C[b, i, 0] * r[0] + C[b, i, 1] * r[1] + C[b, i, 2] * r[2]
+        )
+
+
+@numba.njit(cache=True)
+def _bushing_rows(b, k, body1, body2, r1, c1, r2, c2, C, p, W) -> bool:
+    """δ and the 6 × 6 map of a twist to ``∂δ`` of bushing ``k``; False at gimbal lock.
+
+    Into ``W``: row 0 δ; rows 1–3 ``R1`` (translation rows: ``∂δ_t = R1ᵀ (v + w × p2)``);
+    rows 4–6 ``R2 ε⁻ᵀ`` as its transpose acts (``∂δ_r = ε⁻¹ R2ᵀ w``); row 7 ``p2``.
+    """
+    R1, R2, x1 = W[1:4, :3], W[4:7, :3], W[8, :3]
+    _frame(body1[k], r1[k], c1[k], C, p, R1, x1)
+    _frame(body2[k], r2[k], c2[k], C, p, R2, W[7, :3])
+    d = W[0]
+    for i in range(3):
+        d[i] = 0.0
+        for m in range(3):
+            d[i] += R1[m, i] * (W[7, m] - x1[m])
+    c12 = W[9:12, :3]
+    for i in range(3):
+        for m in range(3):
+            c12[i, m] = R1[0, i] * R2[0, m] + R1[1, i] * R2[1, m] + R1[2, i] * R2[2, m]
+    ct = np.hypot(c12[0, 0], c12[0, 1])
+    if ct < GIMBAL_LOCK_COS:
+        return False
+    st = min(1.0, max(-1.0, c12[0, 2]))
+    d[3] = np.arctan2(-c12[1, 2], c12[2, 2])
+    d[4] = np.arctan2(st, ct)
+    d[5] = np.arctan2(-c12[0, 1], c12[0, 0])
+    ca, sa = np.cos(d[5]), np.sin(d[5])
+    ct, st = np.cos(d[4]), np.sin(d[4])
+    Einv = W[12:15, :3]  # ε⁻¹ of (1.38)
+    Einv[0, 0], Einv[0, 1], Einv[0, 2] = ca / ct, -sa / ct, 0.0
+    Einv[1, 0], Einv[1, 1], Einv[1, 2] = sa, ca, 0.0
+    Einv[2, 0], Einv[2, 1], Einv[2, 2] = -st * ca / ct, st * sa / ct, 1.0
+    G = W[4:7, 3:6]  # R2 ε⁻ᵀ: rotation rows of ∂δ are (G ᵀ w)
+    for i in range(3):
+        for m in range(3):
+            G[i, m] = R2[i, 0] * Einv[m, 0] + R2[i, 1] * Einv[m, 1] + R2[i, 2] * Einv[m, 2]
+    return True
+
+
+@numba.njit(cache=True)
+def _twist_rows(W: np.ndarray, sig: np.ndarray, s: float, out: np.ndarray) -> None:
+    """``∂δ/∂q_a`` (6) of the bushing in ``W`` for the axis ``sig`` = σ_a with sign s."""
+    p2 = W[7, :3]
+    t0 = sig[0] + sig[4] * p2[2] - sig[5] * p2[1]
+    t1 = sig[1] + sig[5] * p2[0] - sig[3] * p2[2]
+    t2 = sig[2] + sig[3] * p2[1] - sig[4] * p2[0]
+    for i in range(3):
+        out[i] = s * (W[1, i] * t0 + W[2, i] * t1 + W[3, i] * t2)
+        out[3 + i] = s * (W[4, 3 + i] * sig[3] + W[5, 3 + i] * sig[4] + W[6, 3 + i] * sig[5])
+
+
+@numba.njit(cache=True)
+def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoord, sk, work, out,
+                  gout):  # fmt: skip
+    """``Q_g + Q_c`` at ``qf`` into ``out`` (and ``Q_g`` into ``gout`` unless it is empty).
+
+    Returns −1, or the bushing at gimbal lock.
+    """
+    parent, kind, q_start, ndof, axis, r_c, c_c, Theta, mass, moment = arrays
+    C, p, theta_c, sigma, m6, m3, v3, W, rows = work
+    body1, body2, r1, c1, r2, c2, Cb = bushes
+    forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
+                 sigma, m6, m3, v3, False)  # fmt: skip
+    nb = parent.shape[0]
+    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]  # subtree mass and first moment
+    for j in range(nb):  # the body's own: m and m (p + C c)
+        m_sub[j] = mass[j]
+        for i in range(3):
+            h_sub[j, i] = mass[j] * p[j, i]
+            for m in range(3):
+                h_sub[j, i] += C[j, i, m] * moment[j, m]
+    for j in range(nb - 1, -1, -1):  # children follow parents
+        if parent[j] >= 0:
+            m_sub[parent[j]] += m_sub[j]
+            for i in range(3):
+                h_sub[parent[j], i] += h_sub[j, i]
+    out[:] = 0.0
+    for k in range(nb):  # the subtree's weight m g and its moment h × g about E0
+        f0, f1, f2 = m_sub[k] * gravity[0], m_sub[k] * gravity[1], m_sub[k] * gravity[2]
+        h = h_sub[k]
+        n0 = h[1] * gravity[2] - h[2] * gravity[1]
+        n1 = h[2] * gravity[0] - h[0] * gravity[2]
+        n2 = h[0] * gravity[1] - h[1] * gravity[0]
+        for a in range(q_start[k], q_start[k] + ndof[k]):
+            s = sigma[a]
+            out[a] = s[0] * f0 + s[1] * f1 + s[2] * f2 + s[3] * n0 + s[4] * n1 + s[5] * n2
+    if gout.shape[0] > 0:
+        gout[:] = out
+    if not springs:
+        return -1
+    f = rows[0]
+    for k in range(body1.shape[0]):
+        if not _bushing_rows(0, k, body1, body2, r1, c1, r2, c2, C, p, W):
+            return k
+        for i in range(6):
+            f[i] = 0.0
+            for m in range(6):
+                f[i] += Cb[k, i, m] * W[0, m]
+        for e in range(ptr[k], ptr[k + 1]):
+            j, s = pbody[e], psign[e]
+            for a in range(q_start[j], q_start[j] + ndof[j]):
+                _twist_rows(W, sigma[a], s, rows[1])
+                acc = 0.0
+                for i in range(6):
+                    acc += rows[1, i] * f[i]
+                out[a] -= acc
+    for i in range(scoord.shape[0]):
+        out[scoord[i]] -= sk[i] * qf[scoord[i]]
+    return -1
+
+
+@numba.njit(cache=True)
+def _stiffness(qf, h, gravity, arrays, bushes, ptr, pbody, psign, scoord, sk, work, f, g, K,
+               Kg) -> int:  # fmt: skip
+    """``K = −∂(Q_g + Q_c)/∂q`` and ``K_g = −∂Q_g/∂q`` by central differences (step h).
+
+    Into ``K`` and ``Kg``; ``f`` and ``g`` (2, n) are scratch. Returns −1, or a bushing at
+    gimbal lock.
+    """
+    for i in range(qf.shape[0]):
+        x = qf[i]
+        for side in range(2):
+            qf[i] = x + h if side == 0 else x - h
+            bad = _static_force(qf, gravity, True, arrays, bushes, ptr, pbody, psign, scoord,
+                                sk, work, f[side], g[side])  # fmt: skip
+            if bad >= 0:
+                qf[i] = x
+                return bad
+        qf[i] = x
+        for m in range(qf.shape[0]):
+            K[m, i] = -(f[0, m] - f[1, m]) / (2.0 * h)
+            Kg[m, i] = -(g[0, m] - g[1, m]) / (2.0 * h)
+    return -1
+
+
+@numba.njit(cache=True)
+def _gains(qf, arrays, bushes, X, ptr, pbody, psign, scoord, sk, work, jac, cols, out) -> int:
+    """``Σ Jᵀ X J`` over the bushings (X = C or D per bushing) and ``Σ k`` of the joint springs.
+
+    Into ``out`` (n, n); returns −1, or the bushing at gimbal lock.
+    """
+    parent, kind, q_start, ndof, axis, r_c, c_c, Theta, _, _ = arrays
+    C, p, theta_c, sigma, m6, m3, v3, W, rows = work
+    body1, body2, r1, c1, r2, c2, _ = bushes
+    forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
+                 sigma, m6, m3, v3, False)  # fmt: skip
+    out[:] = 0.0
+    for k in range(body1.shape[0]):
+        if not _bushing_rows(0, k, body1, body2, r1, c1, r2, c2, C, p, W):
+            return k
+        m = 0
+        for e in range(ptr[k], ptr[k + 1]):
+            j = pbody[e]
+            for a in range(q_start[j], q_start[j] + ndof[j]):
+                _twist_rows(W, sigma[a], psign[e], jac[m])
+                cols[m] = a
+                m += 1
+        for u in range(m):
+            for i in range(6):  # rows[0] = X J_u
+                acc = 0.0
+                for n in range(6):
+                    acc += X[k, i, n] * jac[u, n]
+                rows[0, i] = acc
+            for v in range(m):
+                acc = 0.0
+                for i in range(6):
+                    acc += jac[v, i] * rows[0, i]
+                out[cols[v], cols[u]] += acc
+    for i in range(scoord.shape[0]):
+        out[scoord[i], scoord[i]] += sk[i]
+    return -1
+
+
+class StaticData:
+    """The kernel's model arrays (bushing paths included) and work buffers for one model.
+
+    Build with :meth:`of`, which gives None for a model the kernel does not cover.
+    """
+
+    def __init__(self, model: Model) -> None:
+        k = KernelModel.of(model)
+        # Θ = [[m 1, −m<c>], [m<c>, J]] (4.77): m and the first moment m c from its block
+        moment = np.ascontiguousarray(k.Theta[:, [5, 3, 4], [1, 2, 0]])
+        self.arrays = (k.parent, k.kind, k.q_start, k.ndof, k.axis, k.r_c, k.c_c, k.Theta,
+                       np.ascontiguousarray(k.Theta[:, 0, 0]), moment)  # fmt: skip
+        bs = model.bushings
+        stack = [np.ascontiguousarray([getattr(b, a) for b in bs], dtype=float).reshape(shape)
+                 for a, shape in (("r1", (-1, 3)), ("c1", (-1, 3, 3)), ("r2", (-1, 3)),
+                                  ("c2", (-1, 3, 3)), ("stiffness", (-1, 6, 6)))]  # fmt: skip
+        body = [np.array([getattr(b, a) for b in bs], dtype=np.int64) for a in ("body1", "body2")]
+        self.bushes = (body[0], body[1], stack[0], stack[1], stack[2], stack[3], stack[4])
+        self.damping = np.ascontiguousarray([b.damping for b in bs], dtype=float).reshape(-1, 6, 6)
+        self.ptr, self.pbody, self.psign = _paths(model)
+        self.scoord = np.ascontiguousarray(model.spring_coords, dtype=np.int64)
+        self.sk = np.ascontiguousarray(model.spring_stiffness, dtype=float)
+        self.gravity = np.ascontiguousarray(model.gravity, dtype=float)
+        nb, n = model.nb, model.n_full
+        self.work = (
+            np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 6, 6)), np.empty((n, 6)),
+            np.empty((3, 6, 6)), np.empty((2, 3, 3)), np.empty((6, 3)), np.empty((15, 6)),
+            np.empty((2, 6)),
+        )  # fmt: skip
+        widest = max([int(np.sum(k.ndof[self.pbody[a:b]])) for a, b in
+                      zip(self.ptr[:-1], self.ptr[1:], strict=True)], default=0)  # fmt: skip
+        self.jac = np.empty((widest, 6))
+        self.cols = np.empty(widest, dtype=np.int64)
+        self.names = [b.name for b in bs]
+
+    @classmethod
+    def of(cls, model: Model) -> StaticData | None:
+        """The kernel's data for ``model``, or None with modal bodies or mimic joints."""
+        if model.modal or model.G is not None:
+            return None
+        return cls(model)
+
+
+def _paths(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each bushing's pairs below the lowest common ancestor of its bodies, with signs.
+
+    Compressed rows: bushing k's pairs are ``pbody[ptr[k]:ptr[k + 1]]``, sign +1 on body
+    2's branch and −1 on body 1's.
+    """
+    parent = np.asarray(model.parent)
+
+    def up(b: int) -> list[int]:
+        chain = []
+        while b >= 0:
+            chain.append(b)
+            b = int(parent[b])
+        return chain
+
+    ptr, pbody, psign = [0], [], []
+    for b in model.bushings:
+        one, two = up(b.body1), up(b.body2)
+        common = set(one) & set(two)
+        for chain, sign in ((two, 1.0), (one, -1.0)):
+            own = [j for j in chain if j not in common]
+            pbody += own
+            psign += [sign] * len(own)
+        ptr.append(len(pbody))
+    return (np.array(ptr, dtype=np.int64), np.array(pbody, dtype=np.int64),
+            np.array(psign, dtype=float))  # fmt: skip
+
+
+def _check(data: StaticData, bad: int) -> None:
+    if bad >= 0:
+        raise SingularConfigurationError(
+            f"bushing '{data.names[bad]}': Euler angles 1-2-3 at gimbal lock "
+            f"(|cos θ| < {GIMBAL_LOCK_COS:g})"
+        )
+
+
+def static_force(model: Model, data: StaticData, q: np.ndarray, springs: bool = True) -> np.ndarray:
+    """``Q_g + Q_c`` at rest (4.113), (4.83): gravity and the springs' force, a new array.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : StaticData
+        ``StaticData.of(model)``.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order.
+    springs : bool
+        Include the springs (False: gravity alone).
+    """
+    qf = np.array(check_vector("q", q, model.nv), dtype=float)
+    out = np.empty(model.nv)
+    bad = _static_force(qf, data.gravity, springs, data.arrays, data.bushes, data.ptr,
+                        data.pbody, data.psign, data.scoord, data.sk, data.work, out,
+                        np.empty(0))  # fmt: skip
+    _check(data, bad)
+    return out
+
+
+def stiffness_matrices(
+    model: Model, data: StaticData, q: np.ndarray, h: float = 1e-6
+) -> tuple[np.ndarray, np.ndarray]:
+    """``K = −∂(Q_g + Q_c)/∂q`` and gravity's ``K_g = −∂Q_g/∂q``, central differences, symmetrised.
+
+    Both from the same evaluations (gravity is the first part of each).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : StaticData
+        ``StaticData.of(model)``.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order.
+    h : float
+        The difference step per coordinate, m or rad.
+    """
+    qf = np.array(check_vector("q", q, model.nv), dtype=float)
+    n = model.nv
+    K, Kg = np.empty((n, n)), np.empty((n, n))
+    _check(data, _stiffness(qf, h, data.gravity, data.arrays, data.bushes, data.ptr, data.pbody,
+                            data.psign, data.scoord, data.sk, data.work, np.empty((2, n)),
+                            np.empty((2, n)), K, Kg))  # fmt: skip
+    for X in (K, Kg):
+        X += X.T
+        X *= 0.5
+    return K, Kg
+
+
+def element_gains(model: Model, data: StaticData, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(Σ Jᵀ C J, Σ Jᵀ D J)`` of the bushings and joint springs at ``q``, exact.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : StaticData
+        ``StaticData.of(model)``.
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the model's order.
+    """
+    qf = np.array(check_vector("q", q, model.nv), dtype=float)
+    out = []
+    for X, k in ((data.bushes[6], data.sk), (data.damping, np.asarray(model.spring_damping))):
+        G = np.empty((model.nv, model.nv))
+        _check(data, _gains(qf, data.arrays, data.bushes, X, data.ptr, data.pbody, data.psign,
+                            data.scoord, np.ascontiguousarray(k, dtype=float), data.work,
+                            data.jac, data.cols, G))  # fmt: skip
+        out.append(G)
+    return out[0], out[1]
