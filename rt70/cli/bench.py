@@ -27,8 +27,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "what",
         nargs="?",
         default="mass-matrix",
-        choices=("mass-matrix", "simulate"),
-        help="mass-matrix (default) or simulate (the work-precision report)",
+        choices=("mass-matrix", "simulate", "large"),
+        help="mass-matrix (default), simulate (the work-precision report) or large (modes, "
+        "plant and simulate on a 2004-coordinate chain)",
     )
     ben.add_argument("--K", type=options.batch_size, default=1000, help="batch size")
     ben.add_argument("--quick", action="store_true", help="small sizes, few rounds (a smoke run)")
@@ -54,6 +55,14 @@ def run(args: argparse.Namespace) -> int:
             print(check.line())
         for path in work_precision_results.write_results(rows, Path(args.out)):
             print(f"wrote {path}")
+        return 0
+
+    if args.what == "large":
+        from rt70.reports import large_targets
+
+        say = lambda msg: print(f"  {msg}", file=sys.stderr, flush=True)  # noqa: E731
+        for check in large_targets.check(quick=args.quick, progress=say):
+            print(check.line())
         return 0
 
     from rt70.reports import bench

@@ -7,16 +7,16 @@ the arithmetic. :func:`rt70.linear.linearize.equilibrium` and
 compiled kernels of the book's model, which hold O(nb) work arrays and produce each
 matrix in O(nv²):
 
-- the static force ``Q_g + Q_c`` and ``K = −∂(Q_g + Q_c)/∂q`` by central differences
-  inside the kernel (:mod:`rt70.textbook.static_kernel`), the geometric stiffness of
-  gravity the same way;
+- the static force ``Q_g + Q_c``, and ``K = −∂(Q_g + Q_c)/∂q`` with its gravity part:
+  gravity's exact, each bushing's by central differences over its own path
+  (:mod:`rt70.textbook.static_kernel`);
 - ``M = A(q0)`` (4.79) from the mass kernel (:mod:`rt70.textbook.mass_kernel`);
 - ``D = Σ Jᵀ D J`` exact (:func:`rt70.textbook.static_kernel.element_gains`).
 
 The kernels compute the same quantities as the textbook side's readable form: the tests
-hold them equal on every scene they cover, and hold the whole linear model and its
-modes equal to the standard path (which differences Pinocchio's forces) on chains that
-Pinocchio can hold. A scene the kernels do not cover (modal bodies, mimic joints,
+hold them equal on every scene they cover and on random trees, and hold the whole linear
+model and its modes equal to the standard path (which differences Pinocchio's forces) on
+a chain that Pinocchio can hold. A scene the kernels do not cover (modal bodies, mimic joints,
 closed loops) keeps the standard path at any size.
 """
 

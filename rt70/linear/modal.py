@@ -191,6 +191,24 @@ def modes(
     )
 
 
+def unheld_counts(M: np.ndarray, K: np.ndarray) -> tuple[int, int]:
+    """``(unstable, rigid)``: how many modes of ``K v = ω² M v`` are each, eigenvalues only.
+
+    The same test as :func:`modes` (rigid: ``|ω²| ≤ RIGID_RTOL · max|ω²|``; unstable: ω²
+    below minus that), without the mode shapes (a third of the work for thousands of
+    coordinates).
+
+    Parameters
+    ----------
+    M, K : ndarray, shape (n, n)
+        Mass (symmetric positive definite) and stiffness matrices.
+    """
+    M, _ = _mass(M)
+    omega2 = scipy.linalg.eigh(_symmetric("K", K, M.shape[0]), M, eigvals_only=True)
+    tol = _rigid_tolerance(None, float(np.max(np.abs(omega2))))
+    return int(np.sum(omega2 < -tol)), int(np.sum(np.abs(omega2) <= tol))
+
+
 def _eigh(
     M: np.ndarray, K: np.ndarray, D: np.ndarray | None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:

@@ -27,6 +27,7 @@ by 24 dB at 1 Hz on the RT-70); evaluate the state space
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -168,7 +169,7 @@ def plant(
     output_names = [name for _, names in blocks for name in names]
     input_names = [u.name for u in inputs]
     for kind, names in (("input", input_names), ("output", output_names)):
-        repeated = sorted({n for n in names if names.count(n) > 1})
+        repeated = sorted(n for n, count in Counter(names).items() if count > 1)
         if repeated:
             raise Rt70Error(f"{scene.name}: {kind} names used twice: {', '.join(repeated)}")
     return state_space(

@@ -138,6 +138,62 @@ def _ground_inertia(
 
 
 @numba.njit(cache=True)
+def place_pair(
+    j: int,
+    qf: np.ndarray,
+    parent: np.ndarray,
+    kind: np.ndarray,
+    q_start: np.ndarray,
+    ndof: np.ndarray,
+    axis: np.ndarray,
+    r_c: np.ndarray,
+    c_c: np.ndarray,
+    C: np.ndarray,
+    p: np.ndarray,
+    sigma: np.ndarray,
+    rows: np.ndarray,
+    m3: np.ndarray,
+    v3: np.ndarray,
+) -> None:
+    """Steps 1–2 for pair ``j``, its parent already placed: ``C[j]``, ``p[j]`` and its ``σ``.
+
+    Parameters
+    ----------
+    j : int
+        The pair.
+    qf, parent, kind, q_start, ndof, axis, r_c, c_c : numpy.ndarray
+        The full coordinates and the model's arrays (:func:`forward_pass`).
+    C, p, sigma : numpy.ndarray
+        In: the parent's placement; out: pair j's (:func:`forward_pass`).
+    rows, m3, v3 : numpy.ndarray, shapes (6, 6), (2, 3, 3), (6, 3)
+        Scratch.
+    """
+    (c, cc), (r, rr, w, v), s0 = m3, v3[:4], q_start[j]
+    _pair_motion(kind[j], axis[j], qf[s0 : s0 + ndof[j]], c, r, rows)
+    _matmul3(c_c[j], c, cc)  # the construction frame's rotation, then the pair's
+    _matvec3(c_c[j], r, rr)
+    for m in range(3):
+        rr[m] += r_c[j, m]
+    i = parent[j]
+    if i < 0:
+        C[j] = cc
+        p[j] = rr
+    else:
+        _matmul3(C[i], cc, C[j])
+        _matvec3(C[i], rr, p[j])
+        for m in range(3):
+            p[j, m] += p[i, m]
+    Cj, pj = C[j], p[j]
+    for a in range(ndof[j]):  # σ = [C v + p × C w; C w]
+        _matvec3(Cj, rows[a, 3:], w)
+        _matvec3(Cj, rows[a, :3], v)
+        sigma[s0 + a, 0] = v[0] + pj[1] * w[2] - pj[2] * w[1]
+        sigma[s0 + a, 1] = v[1] + pj[2] * w[0] - pj[0] * w[2]
+        sigma[s0 + a, 2] = v[2] + pj[0] * w[1] - pj[1] * w[0]
+        sigma[s0 + a, 3:] = w
+
+
+@numba.njit(cache=True)
 def forward_pass(
     qf: np.ndarray,
     parent: np.ndarray,
@@ -179,36 +235,11 @@ def forward_pass(
     inertias : bool
         Step 3 too (False: steps 1–2 only).
     """
-    nb = parent.shape[0]
     rows, L, T = m6[0], m6[1], m6[2]
-    c, cc = m3[0], m3[1]
-    r, rr, w, v = v3[0], v3[1], v3[2], v3[3]
-    for j in range(nb):  # steps 1 and 2, parents first
-        s0 = q_start[j]
-        _pair_motion(kind[j], axis[j], qf[s0 : s0 + ndof[j]], c, r, rows)
-        _matmul3(c_c[j], c, cc)  # the construction frame's rotation, then the pair's
-        _matvec3(c_c[j], r, rr)
-        for m in range(3):
-            rr[m] += r_c[j, m]
-        i = parent[j]
-        if i < 0:
-            C[j] = cc
-            p[j] = rr
-        else:
-            _matmul3(C[i], cc, C[j])
-            _matvec3(C[i], rr, p[j])
-            for m in range(3):
-                p[j, m] += p[i, m]
-        Cj, pj = C[j], p[j]
-        for a in range(ndof[j]):  # σ = [C v + p × C w; C w]
-            _matvec3(Cj, rows[a, 3:], w)
-            _matvec3(Cj, rows[a, :3], v)
-            sigma[s0 + a, 0] = v[0] + pj[1] * w[2] - pj[2] * w[1]
-            sigma[s0 + a, 1] = v[1] + pj[2] * w[0] - pj[0] * w[2]
-            sigma[s0 + a, 2] = v[2] + pj[0] * w[1] - pj[1] * w[0]
-            sigma[s0 + a, 3:] = w
+    for j in range(parent.shape[0]):  # steps 1 and 2, parents first
+        place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma, rows, m3, v3)
         if inertias:
-            _ground_inertia(Cj, pj, Theta[j], L, T, theta_c[j])
+            _ground_inertia(C[j], p[j], Theta[j], L, T, theta_c[j])
     if inertias:
         _composite_inertias(parent, theta_c)
 

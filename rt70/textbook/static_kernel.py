@@ -3,27 +3,37 @@
 For models of thousands of coordinates, where the dense textbook form and Pinocchio's
 ``Data`` (four ``nv³`` tensors) are out of reach, the static force and its derivatives
 are needed at every Newton step of an equilibrium and for the stiffness matrix of the
-linear model. This kernel computes them with the mass kernel's forward pass
-(:func:`rt70.textbook.mass_kernel.forward_pass`: the absolute placements ``C_j``, ``p_j``,
-the mobility axes ``σ_a`` seen from E0 and the composite inertias ``Θᶜ_k``):
+linear model. This kernel computes them on the mass kernel's placements
+(:func:`rt70.textbook.mass_kernel.forward_pass`, steps 1–2: the absolute placements
+``C_j``, ``p_j`` and the mobility axes ``σ_a = [v_a; w_a]`` seen from E0):
 
-- gravity (4.113)–(4.128): ``Q_g,a = σ_aᵀ Θᶜ_k [g0; 0]`` for coordinate a of pair k —
-  ``S G`` summed over the subtree at once, since ``Θᶜ_k [g0; 0]`` is the subtree's weight
-  and its moment about E0;
+- gravity (4.113)–(4.128): ``Q_g,a = σ_aᵀ [m_k g; h_k × g]`` for coordinate a of pair k,
+  with ``m_k`` and ``h_k = Σ m x`` the mass and first moment about E0 of k's subtree —
+  ``S G`` summed over the subtree at once (``Θᶜ_k [g; 0]`` needs only these);
 - a bushing (the book's elastic pair (4.83) and strut package (4.85)): frame i at
   ``R_i = C_b c_i``, ``p_i = p_b + C_b r_i``; ``δ = [R1ᵀ (p2 − p1); φ(R1ᵀ R2)]`` with φ the
   1–2–3 angles (as :func:`rt70.textbook.forces.bushing_deformation`). A coordinate a on
   the path from the two bodies' lowest common ancestor to body 2 (sign s = +1) or to
   body 1 (s = −1) moves frame 2 relative to frame 1 by the twist ``s σ_a``:
-  ``∂δ/∂q_a = s [R1ᵀ (v_a + w_a × p2); ε⁻¹(φ) R2ᵀ w_a]`` (1.38). Its generalised force
-  ``−Jᵀ C δ`` is a wrench in E0: ``F = R1 (Cδ)_t``, ``N = p2 × F + R2 ε⁻ᵀ (Cδ)_r``, and
-  ``Q_a −= s (v_a · F + w_a · N)``;
+  ``∂δ/∂q_a = s [R1ᵀ (v_a + w_a × p2); ε⁻¹(φ) R2ᵀ w_a]`` (1.38), and the force on it is
+  ``Q_a = −(∂δ/∂q_a) · C δ``;
 - a joint spring: ``Q_a −= k q_a`` (4.83).
 
-``stiffness_matrices`` differences this force centrally inside the kernel (one evaluation
-is O(bodies + bushing paths), so K costs O(n²)); ``element_gains`` gives the exact
-``Σ Jᵀ C J`` and ``Σ Jᵀ D J``. Models with modal bodies or mimic joints have no kernel
-(:meth:`StaticData.of` gives None). Compiled on first use and cached on disk.
+``stiffness_matrices`` gives ``K = −∂(Q_g + Q_c)/∂q`` and its gravity part ``K_g`` in
+O(nv · depth) work:
+
+- ``K_g`` exactly: coordinate b moves its pair's subtree S by the twist ``σ_b``, which
+  turns the weight's moment by ``D_b = (m_S v_b + w_b × h_S) × g`` (h the first moment
+  about E0); for a coordinate a at or above b, ``K_g[a, b] = −w_a · D_b``, and K_g is
+  symmetric;
+- each bushing's part by central differences over its own path's coordinates, re-placing
+  only the path's pairs (its δ depends on nothing else), so the springs' preload terms
+  ``(∂Jᵀ/∂q) C δ`` are in K as well as ``Jᵀ C J``;
+- the joint springs' k on the diagonal.
+
+``element_gains`` gives the exact ``Σ Jᵀ C J`` and ``Σ Jᵀ D J``. Models with modal bodies
+or mimic joints have no kernel (:meth:`StaticData.of` gives None). Compiled on first use
+and cached on disk.
 """
 
 from __future__ import annotations
@@ -33,7 +43,7 @@ import numpy as np
 
 from rt70.errors import SingularConfigurationError
 from rt70.guards.arrays import check_vector
-from rt70.textbook.mass_kernel import KernelModel, forward_pass
+from rt70.textbook.mass_kernel import KernelModel, forward_pass, place_pair
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import GIMBAL_LOCK_COS
 
@@ -104,19 +114,55 @@ def _twist_rows(W: np.ndarray, sig: np.ndarray, s: float, out: np.ndarray) -> No
 
 
 @numba.njit(cache=True)
-def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoord, sk, work, out,
-                  gout):  # fmt: skip
-    """``Q_g + Q_c`` at ``qf`` into ``out`` (and ``Q_g`` into ``gout`` unless it is empty).
+def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoord, sk, work, fbuf,
+                  out) -> int:  # fmt: skip
+    """``Q_g + Q_c`` at ``qf`` into ``out`` (``fbuf``: scratch as long as the widest path).
 
     Returns −1, or the bushing at gimbal lock.
     """
+    parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
+    C, p, theta_c, sigma, _, _, _, W, rows = work
+    _subtree_weights(qf, arrays, work)
+    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]
+    out[:] = 0.0
+    for k in range(parent.shape[0]):  # the subtree's weight m g and its moment h × g about E0
+        f0, f1, f2 = m_sub[k] * gravity[0], m_sub[k] * gravity[1], m_sub[k] * gravity[2]
+        h = h_sub[k]
+        n0 = h[1] * gravity[2] - h[2] * gravity[1]
+        n1 = h[2] * gravity[0] - h[0] * gravity[2]
+        n2 = h[0] * gravity[1] - h[1] * gravity[0]
+        for a in range(q_start[k], q_start[k] + ndof[k]):
+            s = sigma[a]
+            out[a] = s[0] * f0 + s[1] * f1 + s[2] * f2 + s[3] * n0 + s[4] * n1 + s[5] * n2
+    if not springs:
+        return -1
+    for k in range(ptr.shape[0] - 1):
+        if not _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma, W, rows,
+                              fbuf):  # fmt: skip
+            return k
+        u = 0
+        for e in range(ptr[k], ptr[k + 1]):
+            for a in range(q_start[pbody[e]], q_start[pbody[e]] + ndof[pbody[e]]):
+                out[a] += fbuf[u]
+                u += 1
+    for i in range(scoord.shape[0]):
+        out[scoord[i]] -= sk[i] * qf[scoord[i]]
+    return -1
+
+
+@numba.njit(cache=True)
+def _subtree_weights(qf, arrays, work) -> None:
+    """Steps 1–2 of the forward pass, then each subtree's mass and first moment in E0.
+
+    Into ``work``: ``theta_c[:, 0, 0]`` the subtree masses, ``theta_c[:, 1, :3]`` their
+    first moments ``h = Σ m x`` about E0.
+    """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta, mass, moment = arrays
     C, p, theta_c, sigma, m6, m3, v3, W, rows = work
-    body1, body2, r1, c1, r2, c2, Cb = bushes
     forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
                  sigma, m6, m3, v3, False)  # fmt: skip
     nb = parent.shape[0]
-    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]  # subtree mass and first moment
+    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]
     for j in range(nb):  # the body's own: m and m (p + C c)
         m_sub[j] = mass[j]
         for i in range(3):
@@ -128,62 +174,104 @@ def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoor
             m_sub[parent[j]] += m_sub[j]
             for i in range(3):
                 h_sub[parent[j], i] += h_sub[j, i]
-    out[:] = 0.0
-    for k in range(nb):  # the subtree's weight m g and its moment h × g about E0
-        f0, f1, f2 = m_sub[k] * gravity[0], m_sub[k] * gravity[1], m_sub[k] * gravity[2]
-        h = h_sub[k]
-        n0 = h[1] * gravity[2] - h[2] * gravity[1]
-        n1 = h[2] * gravity[0] - h[0] * gravity[2]
-        n2 = h[0] * gravity[1] - h[1] * gravity[0]
-        for a in range(q_start[k], q_start[k] + ndof[k]):
-            s = sigma[a]
-            out[a] = s[0] * f0 + s[1] * f1 + s[2] * f2 + s[3] * n0 + s[4] * n1 + s[5] * n2
-    if gout.shape[0] > 0:
-        gout[:] = out
-    if not springs:
-        return -1
-    f = rows[0]
-    for k in range(body1.shape[0]):
-        if not _bushing_rows(0, k, body1, body2, r1, c1, r2, c2, C, p, W):
-            return k
-        for i in range(6):
-            f[i] = 0.0
-            for m in range(6):
-                f[i] += Cb[k, i, m] * W[0, m]
-        for e in range(ptr[k], ptr[k + 1]):
-            j, s = pbody[e], psign[e]
-            for a in range(q_start[j], q_start[j] + ndof[j]):
-                _twist_rows(W, sigma[a], s, rows[1])
-                acc = 0.0
-                for i in range(6):
-                    acc += rows[1, i] * f[i]
-                out[a] -= acc
-    for i in range(scoord.shape[0]):
-        out[scoord[i]] -= sk[i] * qf[scoord[i]]
-    return -1
 
 
 @numba.njit(cache=True)
-def _stiffness(qf, h, gravity, arrays, bushes, ptr, pbody, psign, scoord, sk, work, f, g, K,
-               Kg) -> int:  # fmt: skip
-    """``K = −∂(Q_g + Q_c)/∂q`` and ``K_g = −∂Q_g/∂q`` by central differences (step h).
+def _gravity_stiffness(gravity, arrays, work, Dv, K) -> None:
+    """``K_g = −∂Q_g/∂q`` exactly, after :func:`_subtree_weights`, into ``K`` (overwritten).
 
-    Into ``K`` and ``Kg``; ``f`` and ``g`` (2, n) are scratch. Returns −1, or a bushing at
-    gimbal lock.
+    Coordinate b moves the subtree S of its pair by the twist σ_b, so the first moment
+    changes by ``dh = m_S v_b + w_b × h_S`` and the weight's moment by ``D_b = dh × g``;
+    a coordinate a at or above b (of an ancestor pair, or before b in b's own pair) has
+    ``Q_a = σ_a · [m g; h × g]`` over its subtree, which contains S, and b does not move
+    σ_a: ``K_g[a, b] = −w_a · D_b``. K_g is symmetric (gravity is conservative), so this
+    gives the other half too.
     """
-    for i in range(qf.shape[0]):
-        x = qf[i]
-        for side in range(2):
-            qf[i] = x + h if side == 0 else x - h
-            bad = _static_force(qf, gravity, True, arrays, bushes, ptr, pbody, psign, scoord,
-                                sk, work, f[side], g[side])  # fmt: skip
-            if bad >= 0:
-                qf[i] = x
-                return bad
-        qf[i] = x
-        for m in range(qf.shape[0]):
-            K[m, i] = -(f[0, m] - f[1, m]) / (2.0 * h)
-            Kg[m, i] = -(g[0, m] - g[1, m]) / (2.0 * h)
+    parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
+    theta_c, sigma = work[2], work[3]
+    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]
+    g0, g1, g2 = gravity[0], gravity[1], gravity[2]
+    for j in range(parent.shape[0]):
+        h = h_sub[j]
+        for b in range(q_start[j], q_start[j] + ndof[j]):
+            s = sigma[b]
+            x0 = m_sub[j] * s[0] + s[4] * h[2] - s[5] * h[1]
+            x1 = m_sub[j] * s[1] + s[5] * h[0] - s[3] * h[2]
+            x2 = m_sub[j] * s[2] + s[3] * h[1] - s[4] * h[0]
+            Dv[b, 0], Dv[b, 1], Dv[b, 2] = x1 * g2 - x2 * g1, x2 * g0 - x0 * g2, x0 * g1 - x1 * g0
+    K[:] = 0.0
+    for j in range(parent.shape[0]):
+        k = j
+        while k >= 0:  # the pair itself, then its ancestors
+            for a in range(q_start[k], q_start[k] + ndof[k]):
+                for b in range(max(a, q_start[j]) if k == j else q_start[j], q_start[j] + ndof[j]):
+                    x = -(sigma[a, 3] * Dv[b, 0] + sigma[a, 4] * Dv[b, 1] + sigma[a, 5] * Dv[b, 2])
+                    K[a, b] = x
+                    K[b, a] = x
+            k = parent[k]
+
+
+@numba.njit(cache=True)
+def _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma, W, rows, out) -> bool:
+    """Bushing k's generalised force ``−Jᵀ C δ`` on its path's coordinates, in path order.
+
+    Into ``out`` (as many as the path has coordinates); False at gimbal lock.
+    """
+    body1, body2, r1, c1, r2, c2, Cb = bushes
+    if not _bushing_rows(0, k, body1, body2, r1, c1, r2, c2, C, p, W):
+        return False
+    f = rows[0]
+    for i in range(6):
+        f[i] = 0.0
+        for m in range(6):
+            f[i] += Cb[k, i, m] * W[0, m]
+    u = 0
+    for e in range(ptr[k], ptr[k + 1]):
+        j = pbody[e]
+        for a in range(q_start[j], q_start[j] + ndof[j]):
+            _twist_rows(W, sigma[a], psign[e], rows[1])
+            acc = 0.0
+            for i in range(6):
+                acc += rows[1, i] * f[i]
+            out[u] = -acc
+            u += 1
+    return True
+
+
+@numba.njit(cache=True)
+def _spring_stiffness(qf, h, arrays, bushes, ptr, pbody, psign, work, cols, fp, fm, K) -> int:
+    """``−∂Q_c/∂q`` of the bushings added into ``K``, after a forward pass at ``qf``.
+
+    A bushing's force on its path depends on its path's coordinates only (its δ is the
+    pose of frame 2 in frame 1), so each is differenced centrally (step h) over those
+    alone, re-placing only the path's pairs (parents first: pair indices ascending).
+    Returns −1, or a bushing at gimbal lock.
+    """
+    parent, kind, q_start, ndof, axis, r_c, c_c = arrays[:7]
+    C, p, _, sigma, m6, m3, v3, W, rows = work
+    for k in range(ptr.shape[0] - 1):
+        path = np.sort(pbody[ptr[k] : ptr[k + 1]])
+        u = 0
+        for e in range(ptr[k], ptr[k + 1]):
+            for a in range(q_start[pbody[e]], q_start[pbody[e]] + ndof[pbody[e]]):
+                cols[u] = a
+                u += 1
+        for b in cols[:u]:
+            x = qf[b]
+            for side in range(3):
+                qf[b] = x + h if side == 0 else x - h if side == 1 else x
+                for j in path:
+                    place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma,
+                               m6[0], m3, v3)  # fmt: skip
+                if side == 2:
+                    continue
+                out = fp if side == 0 else fm
+                if not _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma,
+                                      W, rows, out):  # fmt: skip
+                    qf[b] = x
+                    return k
+            for v in range(u):
+                K[cols[v], b] -= (fp[v] - fm[v]) / (2.0 * h)
     return -1
 
 
@@ -321,8 +409,8 @@ def static_force(model: Model, data: StaticData, q: np.ndarray, springs: bool = 
     qf = np.array(check_vector("q", q, model.nv), dtype=float)
     out = np.empty(model.nv)
     bad = _static_force(qf, data.gravity, springs, data.arrays, data.bushes, data.ptr,
-                        data.pbody, data.psign, data.scoord, data.sk, data.work, out,
-                        np.empty(0))  # fmt: skip
+                        data.pbody, data.psign, data.scoord, data.sk, data.work,
+                        np.empty(data.cols.shape[0]), out)  # fmt: skip
     _check(data, bad)
     return out
 
@@ -330,9 +418,10 @@ def static_force(model: Model, data: StaticData, q: np.ndarray, springs: bool = 
 def stiffness_matrices(
     model: Model, data: StaticData, q: np.ndarray, h: float = 1e-6
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``K = −∂(Q_g + Q_c)/∂q`` and gravity's ``K_g = −∂Q_g/∂q``, central differences, symmetrised.
+    """``K = −∂(Q_g + Q_c)/∂q`` and gravity's ``K_g = −∂Q_g/∂q``, symmetrised.
 
-    Both from the same evaluations (gravity is the first part of each).
+    ``K_g`` exact (:func:`_gravity_stiffness`); the bushings' part by central differences
+    over each one's path (:func:`_spring_stiffness`); the joint springs' k on the diagonal.
 
     Parameters
     ----------
@@ -346,11 +435,15 @@ def stiffness_matrices(
         The difference step per coordinate, m or rad.
     """
     qf = np.array(check_vector("q", q, model.nv), dtype=float)
-    n = model.nv
-    K, Kg = np.empty((n, n)), np.empty((n, n))
-    _check(data, _stiffness(qf, h, data.gravity, data.arrays, data.bushes, data.ptr, data.pbody,
-                            data.psign, data.scoord, data.sk, data.work, np.empty((2, n)),
-                            np.empty((2, n)), K, Kg))  # fmt: skip
+    n, widest = model.nv, data.cols.shape[0]
+    Kg = np.empty((n, n))
+    _subtree_weights(qf, data.arrays, data.work)
+    _gravity_stiffness(data.gravity, data.arrays, data.work, np.empty((n, 3)), Kg)
+    K = Kg.copy()
+    np.add.at(K, (data.scoord, data.scoord), data.sk)
+    _check(data, _spring_stiffness(qf, h, data.arrays, data.bushes, data.ptr, data.pbody,
+                                   data.psign, data.work, data.cols, np.empty(widest),
+                                   np.empty(widest), K))  # fmt: skip
     for X in (K, Kg):
         X += X.T
         X *= 0.5
