@@ -8,6 +8,7 @@ import pytest
 from rt70 import reference
 from rt70.cli.main import main
 from rt70.crosscheck import validate
+from rt70.crosscheck.compiled_check import ROWS as COMPILED_ROWS
 from rt70.crosscheck.validate import QUANTITIES, cross_check, quantities
 from rt70.model.scene import URDF_DIR, load_scene, scene_names
 from rt70.testing import MIN_REL, assert_close
@@ -135,7 +136,7 @@ def test_cli_validate_all_scenes_exit_0(capsys):
 def test_cli_validate_json(capsys):
     assert main(["validate", "--json", "--samples", "2", str(URDF_DIR / "rt70.urdf")]) == 0
     records = json.loads(capsys.readouterr().out)
-    assert len(records) == len(QUANTITIES)
+    assert [r["quantity"] for r in records] == list(QUANTITIES + COMPILED_ROWS)
     keys = {
         "target",
         "nv",
@@ -161,7 +162,7 @@ def test_every_row_states_its_unit():
     from rt70.crosscheck.samples import WIND
     from rt70.mechanics.nonholonomic_scene import ROWS
 
-    rows = {*QUANTITIES, WIND, *LOOP_QUANTITIES, *ROWS}
+    rows = {*QUANTITIES, WIND, *LOOP_QUANTITIES, *ROWS, *COMPILED_ROWS}
     assert set(validate.QUANTITY_UNITS) == rows
 
 

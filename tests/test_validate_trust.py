@@ -21,6 +21,7 @@ import pytest
 import rt70.crosscheck.validate as validate
 from rt70 import reference
 from rt70.cli.main import main
+from rt70.crosscheck.compiled_check import ROWS as COMPILED_ROWS
 from rt70.crosscheck.samples import random_state
 from rt70.crosscheck.scales import natural_scales
 from rt70.crosscheck.validate import QUANTITIES, cross_check
@@ -60,7 +61,7 @@ def two_body():
 @pytest.mark.slow
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf], ids=["nan", "inf", "-inf"])
 @pytest.mark.parametrize("side", [0, 1], ids=["textbook", "reference"])
-@pytest.mark.parametrize("quantity", QUANTITIES)
+@pytest.mark.parametrize("quantity", QUANTITIES + COMPILED_ROWS)
 def test_nonfinite_value_fails_its_row(two_body, monkeypatch, quantity, side, value):
     _corrupt(monkeypatch, quantity, side, value)
     records = {r.quantity: r for r in cross_check(two_body, samples=2, seed=0, repeat=0)}
@@ -126,7 +127,7 @@ def test_natural_scales_are_positive_and_finite(two_body):
         for name, (a, b) in validate._pairs(two_body, q, qd).items()
     }
     scales = natural_scales(two_body, values, q, qd)
-    assert set(scales) == set(QUANTITIES)
+    assert set(scales) == set(QUANTITIES + COMPILED_ROWS)  # the kernels cover it
     assert all(np.all(np.isfinite(v)) and np.all(np.asarray(v) > 0.0) for v in scales.values())
     # q̈: per coordinate, |A⁻¹| (f + |A||q̈|) ≥ |A⁻¹| |Q_g| ≥ |q̈ from gravity alone|
     A, Q_g = values["mass_matrix"][1], values["gravity"][1]

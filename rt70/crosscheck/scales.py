@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rt70.crosscheck.compiled_check import compiled_scales
 from rt70.crosscheck.impact_check import impact_scales
 from rt70.crosscheck.loop_check import loop_scales
 from rt70.crosscheck.reaction_check import reaction_scale
@@ -115,6 +116,7 @@ def natural_scales(scene: Scene, values: dict, q: np.ndarray, qd: np.ndarray) ->
         **({WIND: _wind_scale(scene, q)} if WIND in values else {}),
         **loop_scales(scene, values, q, qd, qdd_scale),
         **{row: norm(row) for row in NONHOLONOMIC if row in values},
+        **compiled_scales(values, g0, Sc, Sd),
     }
 
 

@@ -24,6 +24,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from rt70.crosscheck.compiled_check import UNITS as COMPILED_UNITS
+from rt70.crosscheck.compiled_check import compiled_pairs, compiled_quantities
 from rt70.crosscheck.impact_check import impact_pairs
 from rt70.crosscheck.loop_check import loop_pairs, loop_quantities
 from rt70.crosscheck.reaction_check import reaction_pair
@@ -93,18 +95,21 @@ QUANTITY_UNITS = {
     "loop_reaction": "N·m or N (per coordinate)",
     "no_slip": "1 or m per coordinate (A), then m/s² or rad/s² (Ȧq̇)",
     "reduced_dynamics": "rad/s² or m/s² (per coordinate), then N or N·m (multipliers)",
+    **COMPILED_UNITS,
 }
 
 
 def quantities(scene: Scene) -> tuple[str, ...]:
     """The rows of ``scene``'s report.
 
-    :data:`QUANTITIES`, :data:`rt70.crosscheck.samples.WIND` if it has wind, the loop rows
-    (:func:`rt70.crosscheck.loop_check.loop_quantities`) if it has ``<rt70:loop>`` closures, and
-    :data:`rt70.mechanics.nonholonomic_scene.ROWS` if it has ``<rt70:no_slip>`` constraints.
+    :data:`QUANTITIES`, :data:`rt70.crosscheck.samples.WIND` if it has wind,
+    :data:`rt70.crosscheck.compiled_check.ROWS` if the compiled kernels cover it, the loop
+    rows (:func:`rt70.crosscheck.loop_check.loop_quantities`) if it has ``<rt70:loop>``
+    closures, and :data:`rt70.mechanics.nonholonomic_scene.ROWS` if it has
+    ``<rt70:no_slip>`` constraints.
     """
-    rows = QUANTITIES + ((WIND,) if scene.description.winds else ()) + loop_quantities(scene)
-    return rows + (NONHOLONOMIC if scene.description.no_slips else ())
+    rows = QUANTITIES + ((WIND,) if scene.description.winds else ()) + compiled_quantities(scene)
+    return rows + loop_quantities(scene) + (NONHOLONOMIC if scene.description.no_slips else ())
 
 
 @dataclass(frozen=True)
@@ -187,8 +192,6 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
     from rt70 import reference
     from rt70.reference import drives as ref_drives
     from rt70.reference import points as ref_points
-    from rt70.reference import wind as ref_wind
-    from rt70.textbook import wind as tb_wind
 
     tm, td = scene.textbook, scene.textbook_data
     ref, rd = scene.reference, scene.reference_data
@@ -248,17 +251,30 @@ def _pairs(scene: Scene, q: np.ndarray, qd: np.ndarray) -> dict[str, tuple[Calla
         # joint reaction wrenches, source 004 (9)–(13) (rt70.crosscheck.reaction_check)
         "reactions": reaction_pair(scene, q, qd, wrench),
     }
-    pairs.update(impact_pairs(scene, q, qd))  # a random brake and stow pin (15)
-    if scene.description.winds:  # Q_w = S W and Jᵀ f (4.132)–(4.136), a random wind
-        wind = state_wind(q)
-        pairs[WIND] = (
-            lambda: tb_wind.wind_force(tm, td, q, wind),
-            lambda: ref_wind.wind_force(ref, rd, q, wind),
-        )
-    pairs.update(loop_pairs(scene, q, qd))  # rt70.crosscheck.loop_check: Φ, B_c, C, (14) with (2.2)
+    pairs |= impact_pairs(scene, q, qd)  # a random brake and stow pin (15)
+    pairs |= _wind_pairs(scene, q)
+    pairs |= compiled_pairs(scene, q, qd)  # the large-model path's kernels
+    pairs |= loop_pairs(scene, q, qd)  # rt70.crosscheck.loop_check: Φ, B_c, C, (14) with (2.2)
     if scene.description.no_slips:  # A(q), Ȧq̇; reduced q̈ and reactions (source 002)
         pairs.update(nonholonomic_pairs(scene, q, qd))
     return pairs
+
+
+def _wind_pairs(scene: Scene, q: np.ndarray) -> dict[str, tuple[Callable, Callable]]:
+    """``Q_w = S W`` and ``Jᵀ f`` (4.132)–(4.136) of a random wind, if the scene has wind."""
+    if not scene.description.winds:
+        return {}
+    from rt70.reference import wind as ref_wind
+    from rt70.textbook import wind as tb_wind
+
+    tm, td, ref, rd = scene.textbook, scene.textbook_data, scene.reference, scene.reference_data
+    wind = state_wind(q)
+    return {
+        WIND: (
+            lambda: tb_wind.wind_force(tm, td, q, wind),
+            lambda: ref_wind.wind_force(ref, rd, q, wind),
+        )
+    }
 
 
 def _stacked_drives(drive_force: Callable, model, data, q: np.ndarray, drives) -> np.ndarray:

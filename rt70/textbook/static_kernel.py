@@ -347,6 +347,9 @@ class StaticData:
         self.jac = np.empty((widest, 6))
         self.cols = np.empty(widest, dtype=np.int64)
         self.names = [b.name for b in bs]
+        #: Whether the kernels have run once in this process (numba loads their cached
+        #: code on a first call; a caller that times them calls them once first).
+        self.loaded = False
 
     @classmethod
     def of(cls, model: Model) -> StaticData | None:
