@@ -63,7 +63,7 @@ def _frame(b: int, r: np.ndarray, c: np.ndarray, C: np.ndarray, p: np.ndarray, R
 
 
 @numba.njit(cache=True)
-def _bushing_rows(b, k, body1, body2, r1, c1, r2, c2, C, p, W) -> bool:
+def _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W) -> bool:
     """δ and the 6 × 6 map of a twist to ``∂δ`` of bushing ``k``; False at gimbal lock.
 
     Into ``W``: row 0 δ; rows 1–3 ``R1`` (translation rows: ``∂δ_t = R1ᵀ (v + w × p2)``);
@@ -218,7 +218,7 @@ def _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma, W, 
     Into ``out`` (as many as the path has coordinates); False at gimbal lock.
     """
     body1, body2, r1, c1, r2, c2, Cb = bushes
-    if not _bushing_rows(0, k, body1, body2, r1, c1, r2, c2, C, p, W):
+    if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
         return False
     f = rows[0]
     for i in range(6):
@@ -288,7 +288,7 @@ def _gains(qf, arrays, bushes, X, ptr, pbody, psign, scoord, sk, work, jac, cols
                  sigma, m6, m3, v3, False)  # fmt: skip
     out[:] = 0.0
     for k in range(body1.shape[0]):
-        if not _bushing_rows(0, k, body1, body2, r1, c1, r2, c2, C, p, W):
+        if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
             return k
         m = 0
         for e in range(ptr[k], ptr[k + 1]):
