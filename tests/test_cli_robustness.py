@@ -137,7 +137,17 @@ def test_cli_refuses_a_model_too_large(monkeypatch, tmp_path, capsys):
         assert main(argv) == 2
         assert str(path) in one_error_line(capsys.readouterr().err)
     assert main(["simulate", str(path)]) == 2
-    assert "--side textbook" in one_error_line(capsys.readouterr().err)
+    line = one_error_line(capsys.readouterr().err)
+    assert "--side textbook" in line and "not available" not in line  # 150 coordinates
+
+
+def test_a_large_refused_simulation_names_the_textbook_sides_cost():
+    """Above 500 coordinates the dense textbook side is not recommended without its cost."""
+    from rt70.cli.simulate import TEXTBOOK_PRACTICAL_NV, _textbook_hint
+
+    assert _textbook_hint(TEXTBOOK_PRACTICAL_NV) == "'--side textbook' does without Pinocchio"
+    hint = _textbook_hint(2004)
+    assert "6.3 s per evaluation" in hint and "not available yet" in hint
 
 
 _MEASURE = r"""

@@ -60,7 +60,7 @@ def _simulate(args: argparse.Namespace) -> int:
     except ResourceError as exc:  # Pinocchio's Data too large: the textbook side may do
         if args.side != "reference":
             raise
-        raise ResourceError(f"{exc}; '--side textbook' does without Pinocchio") from None
+        raise ResourceError(f"{exc}; {_textbook_hint(scene.textbook.nv)}") from None
     print(
         f"{scene.name}: {result.method} ({args.side}), rtol {args.rtol:g}, "
         f"0 … {result.t[-1]:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"
@@ -99,6 +99,22 @@ def _servo_scenario(args: argparse.Namespace, scene):
             f"{SERVO_SCENE}' runs the telescope held by its servo"
         )
     return sc
+
+
+#: Above this many coordinates the textbook side's dense right-hand side is too slow to
+#: recommend (measured 0.35 s per evaluation at 540 coordinates, 6.3 s at 2004).
+TEXTBOOK_PRACTICAL_NV = 500
+
+
+def _textbook_hint(nv: int) -> str:
+    """What a refused reference-side simulation can do instead, for ``nv`` coordinates."""
+    if nv <= TEXTBOOK_PRACTICAL_NV:
+        return "'--side textbook' does without Pinocchio"
+    return (
+        "'--side textbook' does without Pinocchio, but its dense right-hand side is written "
+        "to be read: it took 6.3 s per evaluation at 2004 coordinates (docs/performance.md), "
+        "and a simulation needs thousands; a simulation of this size is not available yet"
+    )
 
 
 def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
