@@ -113,3 +113,22 @@ def test_validation_script_writes_the_committed_results(monkeypatch):
         ["bench", "--quick", "--out", str(script.parent / "results")],
         ["bench", "--out", "elsewhere"],
     ]
+
+
+def test_large_targets_time_a_subprocess_and_judge_it(tmp_path):
+    """`rt70 bench large`'s pieces: a whole command's wall time and peak memory, and the verdict
+    (a failed command is never met; a quick run is not judged)."""
+    from rt70.reports import large_targets as lt
+
+    wall, peak, code, last = lt.run_command(["--version"], tmp_path)
+    assert code == 0 and last.startswith("rt70 ")
+    assert wall > 0.0 and 0.0 < peak < lt.MEMORY_TARGET_GB
+    ok = lt._judged(["modes", "x"], 5.0, (1.0, 0.5, 0, ""), 2004, quick=False)
+    slow = lt._judged(["modes", "x"], 5.0, (9.0, 0.5, 0, ""), 2004, quick=False)
+    big = lt._judged(["modes", "x"], 5.0, (1.0, 5.0, 0, ""), 2004, quick=False)
+    failed = lt._judged(["simulate", "x"], 30.0, (0.1, 0.1, 2, "rt70: error: no"), 2004, False)
+    assert (ok.met, slow.met, big.met, failed.met) == (True, False, False, False)
+    assert "rt70: error: no" in failed.measured
+    assert lt._judged(["modes", "x"], 5.0, (1.0, 0.5, 0, ""), 360, quick=True).met is None
+    code = lt.run_command(["modes", str(tmp_path / "missing.urdf")], tmp_path)[2]
+    assert code == 2
