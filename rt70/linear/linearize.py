@@ -23,6 +23,11 @@ stiffness only steers Newton's steps.
 Coordinates held by drives (for the RT-70 its azimuth and elevation axes,
 :func:`rt70.scenes.rt70_state.rt70_pointing`) are given by name: held at given values
 while the equilibrium is solved, and locked (removed) or left free in the linear model.
+
+A scene of :data:`rt70.linear.compiled.LARGE_NV` coordinates or more that the compiled
+kernels cover takes its static force, M, K, K_gravity and D from them instead
+(:mod:`rt70.linear.compiled`: no Pinocchio ``Data``, no dense textbook form); the tests
+hold the two paths equal.
 """
 
 from __future__ import annotations
@@ -207,7 +212,8 @@ def equilibrium(
     max_iter : int
         Newton steps allowed.
     side : {"reference", "textbook"}
-        Whose static forces the stiffness is differenced from.
+        Whose static forces the stiffness is differenced from (with "reference", a large
+        scene the compiled kernels cover uses them: module docstring).
 
     Returns
     -------
@@ -342,7 +348,8 @@ def linearize(
     locked : tuple of str
         Coordinates removed from the model (the drives infinitely stiff).
     side : {"reference", "textbook"}
-        Whose static forces K is differenced from (:func:`stiffness_matrix`).
+        Whose static forces K is differenced from (:func:`stiffness_matrix`; with
+        "reference", a large scene the compiled kernels cover uses them).
     """
     check_side(side)
     lock = locking_map(scene, list(locked))
