@@ -140,3 +140,18 @@ def test_lowest_damped_modes_equal_the_dense_ones(chain20):
 def test_large_path_is_not_taken_with_loops_or_small_models():
     assert compiled.kernels_for(load_scene("four_bar")) is None
     assert compiled.kernels_for(load_scene("rt70")) is None  # 42 coordinates
+
+
+def test_large_path_with_held_and_locked_coordinates(chain20, monkeypatch):
+    """Held coordinates (a drive holding an axis) and locked ones take the same way."""
+    scene, held = chain20, {"body1_rz": 0.1, "body3_x": -0.01}
+    q0 = lin.equilibrium(scene, held)
+    standard = lin.linearize(scene, q0, locked=tuple(held))
+    monkeypatch.setattr(compiled, "LARGE_NV", 1)
+    q_large = lin.equilibrium(scene, held)
+    assert q_large[scene.textbook.coordinate_names.index("body1_rz")] == 0.1
+    assert_close(q_large, q0, rel=1e-9, scale=max(np.abs(q0).max(), 1.0))
+    large = lin.linearize(scene, q0, locked=tuple(held))
+    assert large.coordinates == standard.coordinates and len(large.coordinates) == 118
+    assert_close(large.K, standard.K, rel=1e-8)
+    assert_close(large.M, standard.M, rel=1e-13)
