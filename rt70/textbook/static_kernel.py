@@ -114,20 +114,19 @@ def _twist_rows(W: np.ndarray, sig: np.ndarray, s: float, out: np.ndarray) -> No
 
 
 @numba.njit(cache=True)
-def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoord, sk, work, fbuf,
-                  out) -> int:  # fmt: skip
+def _static_force(qf, gravity, springs, arrays, bushes, paths, scoord, sk, work, fbuf, out) -> int:
     """``Q_g + Q_c`` at ``qf`` into ``out`` (``fbuf``: scratch as long as the widest path).
 
     Returns −1, or the bushing at gimbal lock.
     """
     parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
-    C, p, theta_c, sigma, _, _, _, W, rows = work
+    cptr, ccol = paths[2], paths[3]
+    C, p, _, sigma, _, _, _, W, rows, weights = work
     _subtree_weights(qf, arrays, work)
-    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]
     out[:] = 0.0
     for k in range(parent.shape[0]):  # the subtree's weight m g and its moment h × g about E0
-        f0, f1, f2 = m_sub[k] * gravity[0], m_sub[k] * gravity[1], m_sub[k] * gravity[2]
-        h = h_sub[k]
+        m, h = weights[k, 0], weights[k, 1:]
+        f0, f1, f2 = m * gravity[0], m * gravity[1], m * gravity[2]
         n0 = h[1] * gravity[2] - h[2] * gravity[1]
         n1 = h[2] * gravity[0] - h[0] * gravity[2]
         n2 = h[0] * gravity[1] - h[1] * gravity[0]
@@ -136,15 +135,11 @@ def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoor
             out[a] = s[0] * f0 + s[1] * f1 + s[2] * f2 + s[3] * n0 + s[4] * n1 + s[5] * n2
     if not springs:
         return -1
-    for k in range(ptr.shape[0] - 1):
-        if not _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma, W, rows,
-                              fbuf):  # fmt: skip
+    for k in range(cptr.shape[0] - 1):
+        if not _bushing_force(k, bushes, paths, C, p, sigma, W, rows, fbuf):
             return k
-        u = 0
-        for e in range(ptr[k], ptr[k + 1]):
-            for a in range(q_start[pbody[e]], q_start[pbody[e]] + ndof[pbody[e]]):
-                out[a] += fbuf[u]
-                u += 1
+        for u in range(cptr[k], cptr[k + 1]):
+            out[ccol[u]] += fbuf[u - cptr[k]]
     for i in range(scoord.shape[0]):
         out[scoord[i]] -= sk[i] * qf[scoord[i]]
     return -1
@@ -154,26 +149,24 @@ def _static_force(qf, gravity, springs, arrays, bushes, ptr, pbody, psign, scoor
 def _subtree_weights(qf, arrays, work) -> None:
     """Steps 1–2 of the forward pass, then each subtree's mass and first moment in E0.
 
-    Into ``work``: ``theta_c[:, 0, 0]`` the subtree masses, ``theta_c[:, 1, :3]`` their
-    first moments ``h = Σ m x`` about E0.
+    Into ``work``'s ``weights`` (nb, 4): per pair, its subtree's mass m and first moment
+    ``h = Σ m x`` about E0.
     """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta, mass, moment = arrays
-    C, p, theta_c, sigma, m6, m3, v3, W, rows = work
+    C, p, theta_c, sigma, m6, m3, v3, _, _, weights = work
     forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
                  sigma, m6, m3, v3, False)  # fmt: skip
     nb = parent.shape[0]
-    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]
     for j in range(nb):  # the body's own: m and m (p + C c)
-        m_sub[j] = mass[j]
+        weights[j, 0] = mass[j]
         for i in range(3):
-            h_sub[j, i] = mass[j] * p[j, i]
+            weights[j, 1 + i] = mass[j] * p[j, i]
             for m in range(3):
-                h_sub[j, i] += C[j, i, m] * moment[j, m]
+                weights[j, 1 + i] += C[j, i, m] * moment[j, m]
     for j in range(nb - 1, -1, -1):  # children follow parents
         if parent[j] >= 0:
-            m_sub[parent[j]] += m_sub[j]
-            for i in range(3):
-                h_sub[parent[j], i] += h_sub[j, i]
+            for i in range(4):
+                weights[parent[j], i] += weights[j, i]
 
 
 @numba.njit(cache=True)
@@ -188,16 +181,15 @@ def _gravity_stiffness(gravity, arrays, work, Dv, K) -> None:
     gives the other half too.
     """
     parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
-    theta_c, sigma = work[2], work[3]
-    m_sub, h_sub = theta_c[:, 0, 0], theta_c[:, 1, :3]
+    sigma, weights = work[3], work[9]
     g0, g1, g2 = gravity[0], gravity[1], gravity[2]
     for j in range(parent.shape[0]):
-        h = h_sub[j]
+        m, h = weights[j, 0], weights[j, 1:]
         for b in range(q_start[j], q_start[j] + ndof[j]):
             s = sigma[b]
-            x0 = m_sub[j] * s[0] + s[4] * h[2] - s[5] * h[1]
-            x1 = m_sub[j] * s[1] + s[5] * h[0] - s[3] * h[2]
-            x2 = m_sub[j] * s[2] + s[3] * h[1] - s[4] * h[0]
+            x0 = m * s[0] + s[4] * h[2] - s[5] * h[1]
+            x1 = m * s[1] + s[5] * h[0] - s[3] * h[2]
+            x2 = m * s[2] + s[3] * h[1] - s[4] * h[0]
             Dv[b, 0], Dv[b, 1], Dv[b, 2] = x1 * g2 - x2 * g1, x2 * g0 - x0 * g2, x0 * g1 - x1 * g0
     K[:] = 0.0
     for j in range(parent.shape[0]):
@@ -212,12 +204,13 @@ def _gravity_stiffness(gravity, arrays, work, Dv, K) -> None:
 
 
 @numba.njit(cache=True)
-def _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma, W, rows, out) -> bool:
+def _bushing_force(k, bushes, paths, C, p, sigma, W, rows, out) -> bool:
     """Bushing k's generalised force ``−Jᵀ C δ`` on its path's coordinates, in path order.
 
     Into ``out`` (as many as the path has coordinates); False at gimbal lock.
     """
     body1, body2, r1, c1, r2, c2, Cb = bushes
+    cptr, ccol, csign = paths[2], paths[3], paths[4]
     if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
         return False
     f = rows[0]
@@ -225,21 +218,17 @@ def _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma, W, 
         f[i] = 0.0
         for m in range(6):
             f[i] += Cb[k, i, m] * W[0, m]
-    u = 0
-    for e in range(ptr[k], ptr[k + 1]):
-        j = pbody[e]
-        for a in range(q_start[j], q_start[j] + ndof[j]):
-            _twist_rows(W, sigma[a], psign[e], rows[1])
-            acc = 0.0
-            for i in range(6):
-                acc += rows[1, i] * f[i]
-            out[u] = -acc
-            u += 1
+    for u in range(cptr[k], cptr[k + 1]):
+        _twist_rows(W, sigma[ccol[u]], csign[u], rows[1])
+        acc = 0.0
+        for i in range(6):
+            acc += rows[1, i] * f[i]
+        out[u - cptr[k]] = -acc
     return True
 
 
 @numba.njit(cache=True)
-def _spring_stiffness(qf, h, arrays, bushes, ptr, pbody, psign, work, cols, fp, fm, K) -> int:
+def _spring_stiffness(qf, h, arrays, bushes, paths, work, fp, fm, K) -> int:
     """``−∂Q_c/∂q`` of the bushings added into ``K``, after a forward pass at ``qf``.
 
     A bushing's force on its path depends on its path's coordinates only (its δ is the
@@ -248,62 +237,54 @@ def _spring_stiffness(qf, h, arrays, bushes, ptr, pbody, psign, work, cols, fp, 
     Returns −1, or a bushing at gimbal lock.
     """
     parent, kind, q_start, ndof, axis, r_c, c_c = arrays[:7]
-    C, p, _, sigma, m6, m3, v3, W, rows = work
-    for k in range(ptr.shape[0] - 1):
-        path = np.sort(pbody[ptr[k] : ptr[k + 1]])
-        u = 0
-        for e in range(ptr[k], ptr[k + 1]):
-            for a in range(q_start[pbody[e]], q_start[pbody[e]] + ndof[pbody[e]]):
-                cols[u] = a
-                u += 1
-        for b in cols[:u]:
+    ptr, pbody, cptr, ccol = paths[0], paths[1], paths[2], paths[3]
+    C, p, _, sigma, m6, m3, v3, W, rows, _ = work
+    for k in range(cptr.shape[0] - 1):
+        cols = ccol[cptr[k] : cptr[k + 1]]
+        for b in cols:
             x = qf[b]
             for side in range(3):
                 qf[b] = x + h if side == 0 else x - h if side == 1 else x
-                for j in path:
+                for j in pbody[ptr[k] : ptr[k + 1]]:
                     place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma,
                                m6[0], m3, v3)  # fmt: skip
                 if side == 2:
                     continue
                 out = fp if side == 0 else fm
-                if not _bushing_force(k, bushes, ptr, pbody, psign, q_start, ndof, C, p, sigma,
-                                      W, rows, out):  # fmt: skip
+                if not _bushing_force(k, bushes, paths, C, p, sigma, W, rows, out):
                     qf[b] = x
                     return k
-            for v in range(u):
+            for v in range(cols.shape[0]):
                 K[cols[v], b] -= (fp[v] - fm[v]) / (2.0 * h)
     return -1
 
 
 @numba.njit(cache=True)
-def _gains(qf, arrays, bushes, X, ptr, pbody, psign, scoord, sk, work, jac, cols, out) -> int:
+def _gains(qf, arrays, bushes, X, paths, scoord, sk, work, jac, out) -> int:
     """``Σ Jᵀ X J`` over the bushings (X = C or D per bushing) and ``Σ k`` of the joint springs.
 
     Into ``out`` (n, n); returns −1, or the bushing at gimbal lock.
     """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta, _, _ = arrays
-    C, p, theta_c, sigma, m6, m3, v3, W, rows = work
+    C, p, theta_c, sigma, m6, m3, v3, W, rows, _ = work
     body1, body2, r1, c1, r2, c2, _ = bushes
+    cptr, ccol, csign = paths[2], paths[3], paths[4]
     forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
                  sigma, m6, m3, v3, False)  # fmt: skip
     out[:] = 0.0
     for k in range(body1.shape[0]):
         if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
             return k
-        m = 0
-        for e in range(ptr[k], ptr[k + 1]):
-            j = pbody[e]
-            for a in range(q_start[j], q_start[j] + ndof[j]):
-                _twist_rows(W, sigma[a], psign[e], jac[m])
-                cols[m] = a
-                m += 1
-        for u in range(m):
+        cols = ccol[cptr[k] : cptr[k + 1]]
+        for u in range(cols.shape[0]):
+            _twist_rows(W, sigma[cols[u]], csign[cptr[k] + u], jac[u])
+        for u in range(cols.shape[0]):
             for i in range(6):  # rows[0] = X J_u
                 acc = 0.0
                 for n in range(6):
                     acc += X[k, i, n] * jac[u, n]
                 rows[0, i] = acc
-            for v in range(m):
+            for v in range(cols.shape[0]):
                 acc = 0.0
                 for i in range(6):
                     acc += jac[v, i] * rows[0, i]
@@ -332,24 +313,22 @@ class StaticData:
         body = [np.array([getattr(b, a) for b in bs], dtype=np.int64) for a in ("body1", "body2")]
         self.bushes = (body[0], body[1], stack[0], stack[1], stack[2], stack[3], stack[4])
         self.damping = np.ascontiguousarray([b.damping for b in bs], dtype=float).reshape(-1, 6, 6)
-        self.ptr, self.pbody, self.psign = _paths(model)
+        self.paths = _paths(model)
         self.scoord = np.ascontiguousarray(model.spring_coords, dtype=np.int64)
         self.sk = np.ascontiguousarray(model.spring_stiffness, dtype=float)
+        self.sd = np.ascontiguousarray(model.spring_damping, dtype=float)
         self.gravity = np.ascontiguousarray(model.gravity, dtype=float)
         nb, n = model.nb, model.n_full
         self.work = (
             np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 6, 6)), np.empty((n, 6)),
             np.empty((3, 6, 6)), np.empty((2, 3, 3)), np.empty((6, 3)), np.empty((15, 6)),
-            np.empty((2, 6)),
+            np.empty((2, 6)), np.empty((nb, 4)),
         )  # fmt: skip
-        widest = max([int(np.sum(k.ndof[self.pbody[a:b]])) for a, b in
-                      zip(self.ptr[:-1], self.ptr[1:], strict=True)], default=0)  # fmt: skip
-        self.jac = np.empty((widest, 6))
-        self.cols = np.empty(widest, dtype=np.int64)
+        cptr = self.paths[2]
+        #: Coordinates on the longest bushing path (the size of the path buffers).
+        self.widest = int(np.max(np.diff(cptr), initial=0))
+        self.jac = np.empty((self.widest, 6))
         self.names = [b.name for b in bs]
-        #: Whether the kernels have run once in this process (numba loads their cached
-        #: code on a first call; a caller that times them calls them once first).
-        self.loaded = False
 
     @classmethod
     def of(cls, model: Model) -> StaticData | None:
@@ -359,11 +338,13 @@ class StaticData:
         return cls(model)
 
 
-def _paths(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each bushing's pairs below the lowest common ancestor of its bodies, with signs.
+def _paths(model: Model) -> tuple[np.ndarray, ...]:
+    """Each bushing's path: its pairs below the lowest common ancestor of its bodies.
 
-    Compressed rows: bushing k's pairs are ``pbody[ptr[k]:ptr[k + 1]]``, sign +1 on body
-    2's branch and −1 on body 1's.
+    Compressed rows ``(ptr, pbody, cptr, ccol, csign)``: bushing k's pairs are
+    ``pbody[ptr[k]:ptr[k + 1]]``, parents first (indices ascending: children follow
+    parents); its coordinates are ``ccol[cptr[k]:cptr[k + 1]]``, each with the sign
+    ``csign`` of its branch, +1 on body 2's and −1 on body 1's.
     """
     parent = np.asarray(model.parent)
 
@@ -374,17 +355,21 @@ def _paths(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             b = int(parent[b])
         return chain
 
-    ptr, pbody, psign = [0], [], []
+    ptr, pbody, cptr, ccol, csign = [0], [], [0], [], []
     for b in model.bushings:
         one, two = up(b.body1), up(b.body2)
         common = set(one) & set(two)
         for chain, sign in ((two, 1.0), (one, -1.0)):
-            own = [j for j in chain if j not in common]
-            pbody += own
-            psign += [sign] * len(own)
+            for j in chain:
+                if j not in common:
+                    start = int(model.q_start[j])
+                    ccol += range(start, start + int(model.ndof[j]))
+                    csign += [sign] * int(model.ndof[j])
+        pbody += sorted(j for j in {*one, *two} if j not in common)
         ptr.append(len(pbody))
-    return (np.array(ptr, dtype=np.int64), np.array(pbody, dtype=np.int64),
-            np.array(psign, dtype=float))  # fmt: skip
+        cptr.append(len(ccol))
+    ints = [np.array(x, dtype=np.int64) for x in (ptr, pbody, cptr, ccol)]
+    return (*ints, np.array(csign, dtype=float))
 
 
 def _check(data: StaticData, bad: int) -> None:
@@ -411,9 +396,8 @@ def static_force(model: Model, data: StaticData, q: np.ndarray, springs: bool = 
     """
     qf = np.array(check_vector("q", q, model.nv), dtype=float)
     out = np.empty(model.nv)
-    bad = _static_force(qf, data.gravity, springs, data.arrays, data.bushes, data.ptr,
-                        data.pbody, data.psign, data.scoord, data.sk, data.work,
-                        np.empty(data.cols.shape[0]), out)  # fmt: skip
+    bad = _static_force(qf, data.gravity, springs, data.arrays, data.bushes, data.paths,
+                        data.scoord, data.sk, data.work, np.empty(data.widest), out)  # fmt: skip
     _check(data, bad)
     return out
 
@@ -438,15 +422,14 @@ def stiffness_matrices(
         The difference step per coordinate, m or rad.
     """
     qf = np.array(check_vector("q", q, model.nv), dtype=float)
-    n, widest = model.nv, data.cols.shape[0]
+    n, widest = model.nv, data.widest
     Kg = np.empty((n, n))
     _subtree_weights(qf, data.arrays, data.work)
     _gravity_stiffness(data.gravity, data.arrays, data.work, np.empty((n, 3)), Kg)
     K = Kg.copy()
     np.add.at(K, (data.scoord, data.scoord), data.sk)
-    _check(data, _spring_stiffness(qf, h, data.arrays, data.bushes, data.ptr, data.pbody,
-                                   data.psign, data.work, data.cols, np.empty(widest),
-                                   np.empty(widest), K))  # fmt: skip
+    _check(data, _spring_stiffness(qf, h, data.arrays, data.bushes, data.paths, data.work,
+                                   np.empty(widest), np.empty(widest), K))  # fmt: skip
     for X in (K, Kg):
         X += X.T
         X *= 0.5
@@ -467,10 +450,9 @@ def element_gains(model: Model, data: StaticData, q: np.ndarray) -> tuple[np.nda
     """
     qf = np.array(check_vector("q", q, model.nv), dtype=float)
     out = []
-    for X, k in ((data.bushes[6], data.sk), (data.damping, np.asarray(model.spring_damping))):
+    for X, k in ((data.bushes[6], data.sk), (data.damping, data.sd)):
         G = np.empty((model.nv, model.nv))
-        _check(data, _gains(qf, data.arrays, data.bushes, X, data.ptr, data.pbody, data.psign,
-                            data.scoord, np.ascontiguousarray(k, dtype=float), data.work,
-                            data.jac, data.cols, G))  # fmt: skip
+        _check(data, _gains(qf, data.arrays, data.bushes, X, data.paths, data.scoord, k,
+                            data.work, data.jac, G))  # fmt: skip
         out.append(G)
     return out[0], out[1]
