@@ -22,7 +22,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse.linalg
 
-from rt70.linear.modal import DampedModes, split_damped
+from rt70.linear.modal import DampedModes, damped_modes, split_damped
 
 
 def lowest_damped_modes(
@@ -79,8 +79,6 @@ def damped_spectrum(M: np.ndarray, K: np.ndarray, D: np.ndarray, modes) -> Dampe
     modes : rt70.linear.modal.Modes
         The undamped modes of (M, K) (their lowest ``|ω|`` sets the shift).
     """
-    from rt70.linear.modal import damped_modes
-
     if M.shape[0] <= DENSE_MAX:
         return damped_modes(M, K, D)
     omega = np.sqrt(np.abs(modes.omega2[~modes.rigid]))
