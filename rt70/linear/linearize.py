@@ -243,10 +243,11 @@ def equilibrium(
 def _newton(scene: Scene, hold: HolonomicMap, q: np.ndarray, force, stiffness, tol: float,
             max_iter: int) -> np.ndarray:  # fmt: skip
     """:func:`equilibrium`'s Newton iteration with the callables ``force`` and ``stiffness``."""
-    scale = max(float(np.max(np.abs(force(q)))), 1.0)
+    Q = force(q)
+    scale = max(float(np.max(np.abs(Q))), 1.0)
     solve, previous = None, np.inf
     for _ in range(max_iter):
-        residual, size = _free_residual(scene, hold, force(q))
+        residual, size = _free_residual(scene, hold, Q)
         if size <= tol * scale:
             return q
         if solve is not None and size <= REUSE_RATIO * previous:
@@ -257,6 +258,7 @@ def _newton(scene: Scene, hold: HolonomicMap, q: np.ndarray, force, stiffness, t
         q += hold.expand(step, offset=False)
         if float(np.max(np.abs(step), initial=0.0)) <= STEP_TOL * max(1.0, np.abs(q).max()):
             return q  # the position is fixed to rounding; what is left is the forces' rounding
+        Q = force(q)
     raise Rt70Error(f"{scene.name}: static equilibrium not found in {max_iter} Newton steps")
 
 
