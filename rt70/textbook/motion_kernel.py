@@ -1,0 +1,483 @@
+"""Compiled equations of motion of the book's model in O(nv): residual and iteration matrix.
+
+An implicit integrator of a model of thousands of coordinates
+(:mod:`rt70.simulation.generalized_alpha`) needs, at every Newton iterate, the residual
+of the equations of motion (1.73), (4.79)
+
+    r = A(q) q̈ + B(q, q̇) q̇ − Q_g(q) − Q_c(q) − Q_d(q, q̇)
+
+and, at every step, solutions of ``(A + X) x = r`` with X a pair-local stiffness and
+damping. Forming A costs O(nv²) memory and its factorisation O(nv³); this kernel does
+neither. It works on the mass kernel's placements (:mod:`rt70.textbook.mass_kernel`:
+each pair's ``C_j``, ``p_j`` and the mobility axes ``σ_a`` seen from E0) and on each
+body's inertia in E0, ``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` (4.77), with spatial vectors in E0
+(``[v; w]`` for motions, ``[f; n]`` about the origin for forces):
+
+- **The residual** by the recursive Newton–Euler algorithm in E0 (Featherstone,
+  *Rigid Body Dynamics Algorithms*, 2008, §5.3 in ground coordinates). A pair is a
+  series of elementary motions in the order of its coordinates (euler6: x, y, z in the
+  construction frame, then β, θ, α; planar: x, y, then α), so axis a is fixed in the
+  frame moved by its pair's earlier coordinates, whose velocity is
+  ``W_a = V_parent + Σ_{b<a} σ_b q̇_b``, and ``σ̇_a = W_a ×ₘ σ_a``. Forward:
+  ``V_j = V_parent + Σ σ_a q̇_a``, ``Ȧ_j = Ȧ_parent + Σ (σ̇_a q̇_a + σ_a q̈_a)`` from the
+  ground's ``[−g; 0]`` (gravity as a ground acceleration); ``F_j = Θ⁰_j Ȧ_j +
+  V_j ×* Θ⁰_j V_j``. Backward: ``τ_a = σ_aᵀ F_j``, ``F_parent += F_j``. Then
+  ``r = τ − Q_c − Q_d`` with the bushings' ``Q = −Jᵀ (C δ + D J q̇)`` over their paths
+  (as :mod:`rt70.textbook.static_kernel`) and the joint springs' ``−k q − d q̇``.
+- **The iteration matrix** ``A + X`` by the articulated-body algorithm in E0
+  (Featherstone §7.3, zero velocity): from the leaves, ``U = Iᴬ σ``,
+  ``D_j = σᵀ U + X_j``, ``Iᴬ_parent += Iᴬ_j − U D_j⁻¹ Uᵀ``; a solve passes the bias
+  ``pᴬ`` up and the accelerations down. ``X_j`` is pair j's own block, so bushings
+  whose path is more than one pair have no place in it (:func:`pair_gains` says so).
+
+Compiled on first use and cached on disk, like the other kernels. Models with modal
+bodies or mimic joints have no kernel (:meth:`MotionData.of` gives None).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from rt70.errors import Rt70Error
+from rt70.guards.arrays import check_vector
+from rt70.textbook.mass_kernel import _ground_inertia, place_pair
+from rt70.textbook.model import Model
+from rt70.textbook.static_kernel import StaticData, _bushing_rows, _check, _twist_rows
+
+
+@numba.njit(cache=True)
+def _cross_motion(m: np.ndarray, s: np.ndarray, out: np.ndarray) -> None:
+    """``out = m ×ₘ s = [w × s_v + v × s_w; w × s_w]`` for ``m = [v; w]``."""
+    out[0] = m[4] * s[2] - m[5] * s[1] + m[1] * s[5] - m[2] * s[4]
+    out[1] = m[5] * s[0] - m[3] * s[2] + m[2] * s[3] - m[0] * s[5]
+    out[2] = m[3] * s[1] - m[4] * s[0] + m[0] * s[4] - m[1] * s[3]
+    out[3] = m[4] * s[5] - m[5] * s[4]
+    out[4] = m[5] * s[3] - m[3] * s[5]
+    out[5] = m[3] * s[4] - m[4] * s[3]
+
+
+@numba.njit(cache=True)
+def _add_cross_force(m: np.ndarray, f: np.ndarray, out: np.ndarray) -> None:
+    """``out += m ×* f = [w × f_f; w × f_n + v × f_f]`` for ``m = [v; w]``, ``f = [f_f; f_n]``."""
+    out[0] += m[4] * f[2] - m[5] * f[1]
+    out[1] += m[5] * f[0] - m[3] * f[2]
+    out[2] += m[3] * f[1] - m[4] * f[0]
+    out[3] += m[4] * f[5] - m[5] * f[4] + m[1] * f[2] - m[2] * f[1]
+    out[4] += m[5] * f[3] - m[3] * f[5] + m[2] * f[0] - m[0] * f[2]
+    out[5] += m[3] * f[4] - m[4] * f[3] + m[0] * f[1] - m[1] * f[0]
+
+
+@numba.njit(cache=True)
+def _place(qf, arrays, work, I0) -> None:
+    """Every pair's placement and axes (into ``work``) and its body's ``Θ⁰_j`` into ``I0``."""
+    parent, kind, q_start, ndof, axis, r_c, c_c, Theta = arrays[:8]
+    C, p, _, sigma, m6, m3, v3 = work[:7]
+    for j in range(parent.shape[0]):
+        place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma, m6[0], m3, v3)
+        _ground_inertia(C[j], p[j], Theta[j], m6[1], m6[2], I0[j])
+
+
+@numba.njit(cache=True)
+def _newton_euler(v, acc, gravity, arrays, sigma, I0, V, Ad, F, tmp, out) -> float:
+    """``τ = A q̈ + B q̇ − Q_g`` into ``out`` after :func:`_place`; returns T (module docstring)."""
+    parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
+    T = 0.0
+    for j in range(parent.shape[0]):
+        i = parent[j]
+        for m in range(6):
+            V[j, m] = V[i, m] if i >= 0 else 0.0
+            Ad[j, m] = Ad[i, m] if i >= 0 else (-gravity[m] if m < 3 else 0.0)
+        for a in range(q_start[j], q_start[j] + ndof[j]):
+            s = sigma[a]
+            _cross_motion(V[j], s, tmp[0])  # σ̇_a = W_a ×ₘ σ_a; V[j] holds W_a here
+            for m in range(6):
+                Ad[j, m] += tmp[0, m] * v[a] + s[m] * acc[a]
+                V[j, m] += s[m] * v[a]
+        h = tmp[1]
+        for m in range(6):  # h = Θ⁰ V (momentum), F = Θ⁰ Ȧ + V ×* h
+            x, y = 0.0, 0.0
+            for n in range(6):
+                x += I0[j, m, n] * V[j, n]
+                y += I0[j, m, n] * Ad[j, n]
+            h[m] = x
+            F[j, m] = y
+        for m in range(6):
+            T += 0.5 * V[j, m] * h[m]
+        _add_cross_force(V[j], h, F[j])
+    for j in range(parent.shape[0] - 1, -1, -1):
+        for a in range(q_start[j], q_start[j] + ndof[j]):
+            x = 0.0
+            for m in range(6):
+                x += sigma[a, m] * F[j, m]
+            out[a] = x
+        if parent[j] >= 0:
+            for m in range(6):
+                F[parent[j], m] += F[j, m]
+    return T
+
+
+@numba.njit(cache=True)
+def _elements(qf, v, bushes, damping, paths, scoord, sk, sd, work, jac, out, sums) -> int:
+    """``out −= Q_c + Q_d`` of the bushings and joint springs; U_c and P_d into ``sums``.
+
+    ``sums[0] = Σ ½ δᵀ C δ`` (J), ``sums[1] = Σ δ̇ᵀ D δ̇`` (W, the dampers' power).
+    Returns −1, or the bushing at gimbal lock.
+    """
+    C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
+    body1, body2, r1, c1, r2, c2, Cb = bushes
+    cptr, ccol, csign = paths[2], paths[3], paths[4]
+    sums[0], sums[1] = 0.0, 0.0
+    for k in range(body1.shape[0]):
+        if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
+            return k
+        rate, f = rows[0], rows[1]
+        rate[:] = 0.0
+        for u in range(cptr[k], cptr[k + 1]):
+            _twist_rows(W, sigma[ccol[u]], csign[u], jac[u - cptr[k]])
+            for i in range(6):
+                rate[i] += jac[u - cptr[k], i] * v[ccol[u]]
+        for i in range(6):
+            x, y = 0.0, 0.0
+            for m in range(6):
+                x += Cb[k, i, m] * W[0, m]
+                y += damping[k, i, m] * rate[m]
+            sums[0] += 0.5 * W[0, i] * x
+            sums[1] += rate[i] * y
+            f[i] = x + y
+        for u in range(cptr[k], cptr[k + 1]):
+            x = 0.0
+            for i in range(6):
+                x += jac[u - cptr[k], i] * f[i]
+            out[ccol[u]] += x
+    for i in range(scoord.shape[0]):
+        a = scoord[i]
+        out[a] += sk[i] * qf[a] + sd[i] * v[a]
+        sums[0] += 0.5 * sk[i] * qf[a] * qf[a]
+        sums[1] += sd[i] * v[a] * v[a]
+    return -1
+
+
+@numba.njit(cache=True)
+def _pair_gains(bushes, X, paths, scoord, sk, pair_of, q_start, work, jac, out) -> None:
+    """Each pair's own block of ``Σ Jᵀ X J`` (bushings on one pair) and its joint springs' k.
+
+    Into ``out`` (nb, 6, 6), after :func:`_place`; a bushing whose path is more than one
+    pair is left out (:func:`pair_gains` reports those).
+    """
+    C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
+    body1, body2, r1, c1, r2, c2, _ = bushes
+    ptr, pbody, cptr, ccol, csign = paths
+    out[:] = 0.0
+    for k in range(body1.shape[0]):
+        if ptr[k + 1] - ptr[k] != 1:
+            continue
+        j = pbody[ptr[k]]
+        _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W)  # lock: caught by the residual
+        n = cptr[k + 1] - cptr[k]
+        for u in range(n):
+            _twist_rows(W, sigma[ccol[cptr[k] + u]], csign[cptr[k] + u], jac[u])
+        for u in range(n):
+            for i in range(6):
+                x = 0.0
+                for m in range(6):
+                    x += X[k, i, m] * jac[u, m]
+                rows[0, i] = x
+            for w in range(n):
+                x = 0.0
+                for i in range(6):
+                    x += jac[w, i] * rows[0, i]
+                out[j, ccol[cptr[k] + w] - q_start[j], ccol[cptr[k] + u] - q_start[j]] += x
+    for i in range(scoord.shape[0]):
+        a = scoord[i]
+        j = pair_of[a]
+        out[j, a - q_start[j], a - q_start[j]] += sk[i]
+
+
+@numba.njit(cache=True)
+def _spd_inverse(D: np.ndarray, out: np.ndarray) -> bool:
+    """``out = D⁻¹`` by Cholesky (D = L Lᵀ); False unless D is symmetric positive definite."""
+    n = D.shape[0]
+    L = np.zeros((n, n))
+    for i in range(n):
+        for k in range(i + 1):
+            x = D[i, k]
+            for m in range(k):
+                x -= L[i, m] * L[k, m]
+            if i == k:
+                if not x > 0.0:  # also False for NaN
+                    return False
+                L[i, i] = np.sqrt(x)
+            else:
+                L[i, k] = x / L[k, k]
+    for c in range(n):  # columns of D⁻¹: L y = e_c, then Lᵀ x = y
+        y = np.zeros(n)
+        for i in range(n):
+            x = 1.0 if i == c else 0.0
+            for m in range(i):
+                x -= L[i, m] * y[m]
+            y[i] = x / L[i, i]
+        for i in range(n - 1, -1, -1):
+            x = y[i]
+            for m in range(i + 1, n):
+                x -= L[m, i] * out[m, c]
+            out[i, c] = x / L[i, i]
+    return True
+
+
+@numba.njit(cache=True)
+def _articulated_factor(parent, q_start, ndof, sigma, I0, X, IA, U, Dinv) -> bool:
+    """``Iᴬ``, ``U = Iᴬ σ`` and ``D_j⁻¹ = (σᵀ U + X_j)⁻¹`` from the leaves; False if singular."""
+    IA[:] = I0
+    for j in range(parent.shape[0] - 1, -1, -1):
+        s0, nd = q_start[j], ndof[j]
+        for a in range(s0, s0 + nd):
+            for m in range(6):
+                x = 0.0
+                for n in range(6):
+                    x += IA[j, m, n] * sigma[a, n]
+                U[a, m] = x
+        D = np.empty((nd, nd))
+        for a in range(nd):
+            for b in range(nd):
+                x = X[j, a, b]
+                for m in range(6):
+                    x += sigma[s0 + a, m] * U[s0 + b, m]
+                D[a, b] = x
+        Di = Dinv[j, :nd, :nd]
+        if not _spd_inverse(D, Di):
+            return False
+        i = parent[j]
+        if i < 0:
+            continue
+        for m in range(6):  # Iᴬ_parent += Iᴬ_j − U D⁻¹ Uᵀ
+            for n in range(6):
+                x = IA[j, m, n]
+                for a in range(nd):
+                    for b in range(nd):
+                        x -= U[s0 + a, m] * Di[a, b] * U[s0 + b, n]
+                IA[i, m, n] += x
+    return True
+
+
+@numba.njit(cache=True)
+def _articulated_solve(parent, q_start, ndof, sigma, U, Dinv, r, pA, acc6, u, out) -> None:
+    """``x = (A + X)⁻¹ r`` after :func:`_articulated_factor` (module docstring)."""
+    pA[:] = 0.0
+    nb = parent.shape[0]
+    for j in range(nb - 1, -1, -1):
+        s0, nd = q_start[j], ndof[j]
+        for a in range(s0, s0 + nd):
+            x = r[a]
+            for m in range(6):
+                x -= sigma[a, m] * pA[j, m]
+            u[a] = x
+        i = parent[j]
+        if i < 0:
+            continue
+        for a in range(nd):  # pᴬ_parent += pᴬ_j + U D⁻¹ u
+            x = 0.0
+            for b in range(nd):
+                x += Dinv[j, a, b] * u[s0 + b]
+            for m in range(6):
+                pA[i, m] += U[s0 + a, m] * x
+        for m in range(6):
+            pA[i, m] += pA[j, m]
+    for j in range(nb):
+        i = parent[j]
+        s0, nd = q_start[j], ndof[j]
+        for m in range(6):
+            acc6[j, m] = acc6[i, m] if i >= 0 else 0.0
+        for a in range(nd):  # y = u − Uᵀ a_parent
+            x = u[s0 + a]
+            for m in range(6):
+                x -= U[s0 + a, m] * acc6[j, m]
+            out[s0 + a] = x
+        for a in range(nd):
+            x = 0.0
+            for b in range(nd):
+                x += Dinv[j, a, b] * out[s0 + b]
+            pA[j, a] = x  # pᴬ_j is spent: scratch for x
+        for a in range(nd):
+            out[s0 + a] = pA[j, a]
+            for m in range(6):
+                acc6[j, m] += sigma[s0 + a, m] * pA[j, a]
+
+
+class MotionData:
+    """The static kernel's arrays and the work buffers of this kernel, for one model.
+
+    Build with :meth:`of`, which gives None for a model the kernels do not cover.
+
+    Attributes
+    ----------
+    static : StaticData
+        The model's arrays, bushing paths and placement buffers
+        (:class:`rt70.textbook.static_kernel.StaticData`).
+    local : bool
+        Every bushing's path is one pair: :func:`pair_gains` holds all of Σ JᵀCJ and Σ JᵀDJ.
+    """
+
+    def __init__(self, static: StaticData) -> None:
+        self.static = static
+        parent, q_start, ndof = static.arrays[0], static.arrays[2], static.arrays[3]
+        nb, n = parent.shape[0], int(q_start[-1] + ndof[-1]) if parent.size else 0
+        self.pair_of = np.repeat(np.arange(nb, dtype=np.int64), ndof)
+        self.I0, self.IA, self.X = (np.zeros((nb, 6, 6)) for _ in range(3))
+        self.Dinv = np.zeros((nb, 6, 6))
+        self.V, self.Ad, self.F, self.pA, self.acc6 = (np.zeros((nb, 6)) for _ in range(5))
+        self.U, self.u = np.zeros((n, 6)), np.zeros(n)
+        self.tmp, self.sums = np.zeros((2, 6)), np.zeros(2)
+        ptr = static.paths[0]
+        self.local = bool(np.all(np.diff(ptr) == 1))
+        self.placed = np.full(n, np.nan)
+
+    @classmethod
+    def of(cls, model: Model) -> MotionData | None:
+        """The kernel's data for ``model``, or None with modal bodies or mimic joints."""
+        static = StaticData.of(model)
+        return None if static is None else cls(static)
+
+
+def _placed(model: Model, data: MotionData, q: np.ndarray) -> np.ndarray:
+    """Place the pairs at ``q`` unless they are placed there already; q as floats."""
+    q = np.asarray(q, dtype=float)
+    if not np.array_equal(q, data.placed):
+        _place(q, data.static.arrays, data.static.work, data.I0)
+        data.placed[:] = q
+    return q
+
+
+def residual(
+    model: Model, data: MotionData, q: np.ndarray, v: np.ndarray, acc: np.ndarray
+) -> tuple[np.ndarray, float, float, float]:
+    """``r = A q̈ + B q̇ − Q_g − Q_c − Q_d`` and the energies: ``(r, T, U_c, P_d)``.
+
+    T is the kinetic energy, U_c the springs' ``Σ ½ δᵀ C δ`` (J), P_d the dampers' power
+    ``−q̇ᵀ Q_d`` (W).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : MotionData
+        ``MotionData.of(model)``.
+    q, v, acc : numpy.ndarray, shape (nv,)
+        Coordinates (rad or m), velocities (rad/s or m/s) and accelerations
+        (rad/s² or m/s²) in the model's order.
+
+    Raises
+    ------
+    SingularConfigurationError
+        A bushing's Euler angles at gimbal lock.
+    """
+    st = data.static
+    q = _placed(model, data, q)
+    out = np.empty(model.nv)
+    T = _newton_euler(np.asarray(v, dtype=float), np.asarray(acc, dtype=float), st.gravity,
+                      st.arrays, st.work[3], data.I0, data.V, data.Ad, data.F, data.tmp,
+                      out)  # fmt: skip
+    bad = _elements(q, np.asarray(v, dtype=float), st.bushes, st.damping, st.paths, st.scoord,
+                    st.sk, st.sd, st.work, st.jac, out, data.sums)  # fmt: skip
+    _check(st, bad)
+    return out, T, float(data.sums[0]), float(data.sums[1])
+
+
+def pair_gains(model: Model, data: MotionData, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair's own blocks of ``Σ Jᵀ C J`` and ``Σ Jᵀ D J``, shape (nb, 6, 6) each.
+
+    Exact for a model whose bushings each act on one pair (``data.local``); otherwise the
+    bushings across pairs are left out.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : MotionData
+        ``MotionData.of(model)``.
+    q : numpy.ndarray, shape (nv,)
+        Coordinates in the model's order, rad or m.
+    """
+    st = data.static
+    q = _placed(model, data, q)
+    out = []
+    for X, k in ((st.bushes[6], st.sk), (st.damping, st.sd)):
+        G = np.empty((model.nb, 6, 6))
+        _pair_gains(st.bushes, X, st.paths, st.scoord, k, data.pair_of, st.arrays[2], st.work,
+                    st.jac, G)  # fmt: skip
+        out.append(G)
+    return out[0], out[1]
+
+
+def articulated_factor(model: Model, data: MotionData, q: np.ndarray, X: np.ndarray) -> None:
+    """Factor ``A(q) + X`` (X: pair-local blocks, (nb, 6, 6)) for :func:`articulated_solve`.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : MotionData
+        ``MotionData.of(model)``; holds the factor.
+    q : numpy.ndarray, shape (nv,)
+        Coordinates in the model's order, rad or m.
+    X : numpy.ndarray, shape (nb, 6, 6)
+        Each pair's own block (upper left ``ndof × ndof`` used), in A's units.
+
+    Raises
+    ------
+    Rt70Error
+        If a pair's articulated inertia is not positive definite.
+    """
+    st = data.static
+    _placed(model, data, q)
+    parent, q_start, ndof = st.arrays[0], st.arrays[2], st.arrays[3]
+    ok = _articulated_factor(parent, q_start, ndof, st.work[3], data.I0,
+                             np.ascontiguousarray(X, dtype=float), data.IA, data.U,
+                             data.Dinv)  # fmt: skip
+    if not ok:
+        raise Rt70Error(
+            f"{model.name}: the articulated inertia of a pair is singular or not positive definite"
+        )
+
+
+def articulated_solve(model: Model, data: MotionData, r: np.ndarray) -> np.ndarray:
+    """``x = (A + X)⁻¹ r`` with the factor of :func:`articulated_factor`, a new array.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : MotionData
+        The data :func:`articulated_factor` filled.
+    r : numpy.ndarray, shape (nv,)
+        The right-hand side, in A's force units (N or N·m).
+    """
+    st = data.static
+    parent, q_start, ndof = st.arrays[0], st.arrays[2], st.arrays[3]
+    out = np.empty(model.nv)
+    _articulated_solve(parent, q_start, ndof, st.work[3], data.U, data.Dinv,
+                       np.ascontiguousarray(r, dtype=float), data.pA, data.acc6, data.u,
+                       out)  # fmt: skip
+    return out
+
+
+def gravity_potential(model: Model, data: MotionData, q: np.ndarray) -> float:
+    """``U_g = −Σ m g · x_cm`` over the bodies, J (as the textbook side's).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : MotionData
+        ``MotionData.of(model)``.
+    q : numpy.ndarray, shape (nv,)
+        Coordinates in the model's order, rad or m.
+    """
+    from rt70.textbook.static_kernel import _subtree_weights
+
+    st = data.static
+    q = check_vector("q", q, model.nv)
+    _subtree_weights(np.array(q, dtype=float), st.arrays, st.work)
+    data.placed[:] = np.nan  # the placements were overwritten without Θ⁰
+    roots = st.arrays[0] < 0
+    return -float(np.sum(st.work[9][roots, 1:] @ st.gravity))
