@@ -138,16 +138,17 @@ def test_cli_refuses_a_model_too_large(monkeypatch, tmp_path, capsys):
         assert str(path) in one_error_line(capsys.readouterr().err)
     assert main(["simulate", str(path)]) == 2
     line = one_error_line(capsys.readouterr().err)
-    assert "--side textbook" in line and "not available" not in line  # 150 coordinates
+    assert "--method generalized-alpha" in line  # the compiled kernels cover the chain
 
 
-def test_a_large_refused_simulation_names_the_textbook_sides_cost():
-    """Above 500 coordinates the dense textbook side is not recommended without its cost."""
-    from rt70.cli.simulate import TEXTBOOK_PRACTICAL_NV, _textbook_hint
+def test_a_refused_simulation_names_what_can_run_it():
+    """The compiled kernels where they cover the model, the textbook side otherwise."""
+    from rt70.cli.simulate import _textbook_hint
 
-    assert _textbook_hint(TEXTBOOK_PRACTICAL_NV) == "'--side textbook' does without Pinocchio"
-    hint = _textbook_hint(2004)
-    assert "6.3 s per evaluation" in hint and "not available yet" in hint
+    chain = scene_from_text(serial_chain(3), "chain.urdf")
+    assert "--method generalized-alpha" in _textbook_hint(chain)
+    closed = load_scene("four_bar")  # a closed loop: not covered
+    assert _textbook_hint(closed).startswith("'--side textbook'")
 
 
 _MEASURE = r"""

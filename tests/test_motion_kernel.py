@@ -38,7 +38,7 @@ def _check(scene, seed=2, spread=0.1):
     m = scene.textbook
     data = motion_kernel.MotionData.of(m)
     q, v, a = _state(m.nv, seed, spread)
-    r, T, U_c, P_d = motion_kernel.residual(m, data, q, v, a)
+    r, (T, U_g_kernel, U_c, P_d) = motion_kernel.residual(m, data, q, v, a)
     A = mass_kernel.mass_matrix(m, mass_kernel.KernelData(m), q)
     B = structured.bias_force(m, structured.BatchData(m, 1), q, v)
     Qc, Qd = forces.spring_damper_force(m, scene.textbook_data, q, v)
@@ -53,7 +53,7 @@ def _check(scene, seed=2, spread=0.1):
     assert_close(P_d, -v @ Qd, rel=1e-12, scale=max(abs(v @ Qd), 1e-300), what="P_d")
     U_g = dynamics.gravity_potential(m, scene.textbook_data, q)
     weight = float(np.sum(np.reshape(m.Theta, (m.nb, 6, 6))[:, 0, 0])) * np.linalg.norm(m.gravity)
-    assert_close(motion_kernel.gravity_potential(m, data, q), U_g, rel=1e-12,
+    assert_close(U_g_kernel, U_g, rel=1e-12,
                  scale=max(abs(U_g), weight), what="U_g")  # fmt: skip
     K_loc, D_loc = motion_kernel.pair_gains(m, data, q)
     X = _dense(m, 0.3 * K_loc + 0.7 * D_loc)

@@ -53,16 +53,17 @@ def _simulate(args: argparse.Namespace) -> int:
             (0.0, 10.0 if args.t_end is None else args.t_end),
             start_state(scene),
             side=args.side,
-            method=args.method or "BDF",
+            method=args.method or _default_method(scene),
             rtol=args.rtol,
             progress=args.progress or sys.stderr.isatty(),
         )
     except ResourceError as exc:  # Pinocchio's Data too large: the textbook side may do
         if args.side != "reference":
             raise
-        raise ResourceError(f"{exc}; {_textbook_hint(scene.textbook.nv)}") from None
+        raise ResourceError(f"{exc}; {_textbook_hint(scene)}") from None
+    side = "compiled kernels" if result.side == "compiled" else args.side
     print(
-        f"{scene.name}: {result.method} ({args.side}), rtol {args.rtol:g}, "
+        f"{scene.name}: {result.method} ({side}), rtol {args.rtol:g}, "
         f"0 … {result.t[-1]:g} s: {'ok' if result.success else 'FAILED: ' + result.message}"
     )
     _print_solver(result)
@@ -101,20 +102,25 @@ def _servo_scenario(args: argparse.Namespace, scene):
     return sc
 
 
-#: Above this many coordinates the textbook side's dense right-hand side is too slow to
-#: recommend (measured 0.35 s per evaluation at 540 coordinates, 6.3 s at 2004).
-TEXTBOOK_PRACTICAL_NV = 500
+def _default_method(scene) -> str:
+    """BDF; the generalized-α method on the compiled kernels for a large scene they cover.
+
+    (:func:`rt70.linear.compiled.kernels_for`: from ``LARGE_NV`` coordinates on, where
+    Pinocchio's ``Data`` and the dense Jacobian of 2 nv states grow as nv³ and nv².)
+    """
+    from rt70.linear.compiled import kernels_for
+    from rt70.simulation.compiled_run import METHOD
+
+    return "BDF" if kernels_for(scene) is None else METHOD
 
 
-def _textbook_hint(nv: int) -> str:
-    """What a refused reference-side simulation can do instead, for ``nv`` coordinates."""
-    if nv <= TEXTBOOK_PRACTICAL_NV:
-        return "'--side textbook' does without Pinocchio"
-    return (
-        "'--side textbook' does without Pinocchio, but its dense right-hand side is written "
-        "to be read: it took 6.3 s per evaluation at 2004 coordinates (docs/performance.md), "
-        "and a simulation needs thousands; a simulation of this size is not available yet"
-    )
+def _textbook_hint(scene) -> str:
+    """What a refused reference-side simulation can do instead."""
+    from rt70.textbook.motion_kernel import MotionData
+
+    if MotionData.of(scene.textbook) is not None and not scene.description.loops:
+        return "'--method generalized-alpha' integrates it on the compiled kernels, in O(nv) memory"
+    return "'--side textbook' does without Pinocchio (its dense right-hand side is slow)"
 
 
 def _simulate_scenario(args: argparse.Namespace, scene, sc) -> int:
@@ -237,9 +243,11 @@ def add_parser(
     )
     sim.add_argument(
         "--method",
-        choices=METHODS,
-        help="integrator: a solve_ivp method, or CVODE / CVODE_ADAMS (SUNDIALS) "
-        "(default BDF; LSODA for the servo scenarios)",
+        choices=(*METHODS, "generalized-alpha"),
+        help="integrator: a solve_ivp method, CVODE / CVODE_ADAMS (SUNDIALS), or "
+        "generalized-alpha on the compiled kernels, in O(nv) memory and work per step "
+        "(default BDF; generalized-alpha from 200 coordinates on where the kernels cover "
+        "the model; LSODA for the servo scenarios)",
     )
     options.add_side_argument(sim, what="q̈ and its Jacobian")
     sim.add_argument(

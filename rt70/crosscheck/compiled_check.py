@@ -10,7 +10,12 @@ with Pinocchio at each sampled state:
   Pinocchio's gravity and spring force at rest, on the scale of gravity's weight moment
   plus the springs' terms (:func:`rt70.reference.spring_damper_magnitudes`);
 - ``compiled_damping``: ``D q̇`` with the kernel's ``D = Σ Jᵀ D J`` against minus
-  Pinocchio's damper force at (q, q̇), on the scale of the dampers' terms.
+  Pinocchio's damper force at (q, q̇), on the scale of the dampers' terms;
+- ``compiled_dynamics``: the residual ``A q̈ + B q̇ − Q_g − Q_c − Q_d`` of
+  :mod:`rt70.textbook.motion_kernel` (what ``--method generalized-alpha`` integrates)
+  against Pinocchio's ``A q̈ + B q̇ − Q_g`` (CRBA and RNEA) less its spring and damper
+  force, with q̈ taken equal to the sampled q̇'s numbers (so that A is in it), on the
+  scale of the static row's terms plus the dampers' and the residual's own size.
 
 The textbook column of these rows times the compiled kernels.
 """
@@ -24,12 +29,13 @@ import numpy as np
 from rt70.model.scene import Scene
 
 #: Rows compared for a scene the kernels cover, after the others.
-ROWS = ("compiled_static", "compiled_damping")
+ROWS = ("compiled_static", "compiled_damping", "compiled_dynamics")
 
 #: Their units, as :data:`rt70.crosscheck.validate.QUANTITY_UNITS` states them.
 UNITS = {
     "compiled_static": "N·m or N (per coordinate)",
     "compiled_damping": "N·m or N (per coordinate)",
+    "compiled_dynamics": "N·m or N (per coordinate)",
 }
 
 
@@ -55,7 +61,7 @@ def compiled_pairs(
     if not compiled_quantities(scene):
         return {}
     from rt70 import reference
-    from rt70.textbook import static_kernel
+    from rt70.textbook import motion_kernel, static_kernel
 
     tm, data = scene.textbook, scene.static_kernels
     ref, rd = scene.reference, scene.reference_data
@@ -64,6 +70,8 @@ def compiled_pairs(
     # here, so that the timed calls time the computation, not the loading
     static_kernel.static_force(tm, data, q)
     static_kernel.element_gains(tm, data, q)
+    motion = motion_kernel.MotionData(data)
+    motion_kernel.residual(tm, motion, q, qd, qd)
 
     def ref_static() -> np.ndarray:
         springs = reference.spring_damper_force(ref, rd, q, rest)[0]
@@ -75,7 +83,21 @@ def compiled_pairs(
             lambda: static_kernel.element_gains(tm, data, q)[1] @ qd,
             lambda: -reference.spring_damper_force(ref, rd, q, qd)[1],
         ),
+        "compiled_dynamics": (
+            lambda: motion_kernel.residual(tm, motion, q, qd, qd)[0],
+            lambda: _pinocchio_residual(scene, q, qd),
+        ),
     }
+
+
+def _pinocchio_residual(scene: Scene, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """Pinocchio's ``A q̈ + B q̇ − Q_g − Q_c − Q_d`` at q̈ = q̇'s numbers (module docstring)."""
+    from rt70 import reference
+
+    ref, rd = scene.reference, scene.reference_data
+    Qc, Qd = reference.spring_damper_force(ref, rd, q, qd)
+    inertial = reference.mass_matrix(ref, rd, q) @ qd + reference.bias_force(ref, rd, q, qd)
+    return inertial - reference.gravity_force(ref, rd, q) - Qc - Qd
 
 
 def compiled_scales(values: dict, g0: float, Sc: np.ndarray, Sd: np.ndarray) -> dict:
@@ -93,4 +115,6 @@ def compiled_scales(values: dict, g0: float, Sc: np.ndarray, Sd: np.ndarray) -> 
     if ROWS[0] not in values:
         return {}
     static = g0 + float(np.max(Sc, initial=0.0)) + float(np.max(np.abs(values[ROWS[0]][1])))
-    return {ROWS[0]: static, ROWS[1]: float(np.max(Sd, initial=0.0))}
+    damping = float(np.max(Sd, initial=0.0))
+    dynamics = static + damping + float(np.max(np.abs(values[ROWS[2]][1]), initial=0.0))
+    return {ROWS[0]: static, ROWS[1]: damping, ROWS[2]: dynamics}

@@ -32,6 +32,7 @@ from rt70.model.outputs import Output, evaluate, evaluate_trajectory
 from rt70.model.scene import Scene
 from rt70.model.sides import check_side, refuses_backend
 from rt70.physics.baumgarte import DEFAULT_STABILIZATION, Baumgarte
+from rt70.simulation import compiled_run
 from rt70.simulation.backends import BACKENDS, Backend
 from rt70.simulation.closed_chains import constrained_start, residual_trajectory
 from rt70.simulation.integrators import (
@@ -96,7 +97,8 @@ def simulate(
         (:mod:`rt70.simulation.backends`).
     method : str
         A ``scipy.integrate.solve_ivp`` method or "CVODE" / "CVODE_ADAMS" (SUNDIALS;
-        :data:`METHODS`, :mod:`rt70.simulation.integrators`).
+        :data:`METHODS`, :mod:`rt70.simulation.integrators`), or "generalized-alpha" on
+        the compiled kernels, for any ``side`` (:mod:`rt70.simulation.compiled_run`).
     rtol, atol : float
         Tolerances; ``atol`` defaults to ``1e-3 · rtol`` on q and q̇ (m, rad) and
         ``rtol`` of the initial energy scale on the two energy states.
@@ -119,6 +121,9 @@ def simulate(
         Zero crossings located, with the optional solve_ivp attributes ``terminal`` and
         ``direction``, for every method; their times in ``result.t_events``.
     """
+    if method == compiled_run.METHOD:  # the compiled kernels (large models)
+        extras = {"t_eval": t_eval, "outputs": outputs, "components": components, "events": events}
+        return compiled_run.run(scene, t_span, x0, (rtol, atol), inputs, progress, extras)
     t0, t1, t_eval = _checked_request(side, method, rtol, atol, t_span, t_eval, events)
     backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
     evaluate(scene, q0, outputs, side)  # refuses an unknown link before the run

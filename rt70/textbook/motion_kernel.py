@@ -40,7 +40,6 @@ import numba
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.guards.arrays import check_vector
 from rt70.textbook.mass_kernel import _ground_inertia, place_pair
 from rt70.textbook.model import Model
 from rt70.textbook.static_kernel import StaticData, _bushing_rows, _check, _twist_rows
@@ -79,11 +78,16 @@ def _place(qf, arrays, work, I0) -> None:
 
 
 @numba.njit(cache=True)
-def _newton_euler(v, acc, gravity, arrays, sigma, I0, V, Ad, F, tmp, out) -> float:
-    """``τ = A q̈ + B q̇ − Q_g`` into ``out`` after :func:`_place`; returns T (module docstring)."""
+def _newton_euler(v, acc, gravity, arrays, sigma, I0, V, Ad, F, tmp, out, sums) -> None:
+    """``τ = A q̈ + B q̇ − Q_g`` into ``out`` after :func:`_place` (module docstring).
+
+    ``sums[0]`` = T, ``sums[1] = U_g = −Σ g · m x_cm`` (the first moment ``m x_cm`` is
+    ``Θ⁰``'s lower left block ``m <x_cm>``).
+    """
     parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
-    T = 0.0
+    T, U = 0.0, 0.0
     for j in range(parent.shape[0]):
+        U -= gravity[0] * I0[j, 5, 1] + gravity[1] * I0[j, 3, 2] + gravity[2] * I0[j, 4, 0]
         i = parent[j]
         for m in range(6):
             V[j, m] = V[i, m] if i >= 0 else 0.0
@@ -114,7 +118,7 @@ def _newton_euler(v, acc, gravity, arrays, sigma, I0, V, Ad, F, tmp, out) -> flo
         if parent[j] >= 0:
             for m in range(6):
                 F[parent[j], m] += F[j, m]
-    return T
+    sums[0], sums[1] = T, U
 
 
 @numba.njit(cache=True)
@@ -229,6 +233,7 @@ def _spd_inverse(D: np.ndarray, out: np.ndarray) -> bool:
 def _articulated_factor(parent, q_start, ndof, sigma, I0, X, IA, U, Dinv) -> bool:
     """``Iᴬ``, ``U = Iᴬ σ`` and ``D_j⁻¹ = (σᵀ U + X_j)⁻¹`` from the leaves; False if singular."""
     IA[:] = I0
+    Y = np.empty((6, 6))
     for j in range(parent.shape[0] - 1, -1, -1):
         s0, nd = q_start[j], ndof[j]
         for a in range(s0, s0 + nd):
@@ -250,12 +255,17 @@ def _articulated_factor(parent, q_start, ndof, sigma, I0, X, IA, U, Dinv) -> boo
         i = parent[j]
         if i < 0:
             continue
-        for m in range(6):  # Iᴬ_parent += Iᴬ_j − U D⁻¹ Uᵀ
+        for m in range(6):  # Y = U D⁻¹ (6 × nd), then Iᴬ_parent += Iᴬ_j − Y Uᵀ
+            for b in range(nd):
+                x = 0.0
+                for a in range(nd):
+                    x += U[s0 + a, m] * Di[a, b]
+                Y[m, b] = x
+        for m in range(6):
             for n in range(6):
                 x = IA[j, m, n]
-                for a in range(nd):
-                    for b in range(nd):
-                        x -= U[s0 + a, m] * Di[a, b] * U[s0 + b, n]
+                for b in range(nd):
+                    x -= Y[m, b] * U[s0 + b, n]
                 IA[i, m, n] += x
     return True
 
@@ -327,7 +337,7 @@ class MotionData:
         self.Dinv = np.zeros((nb, 6, 6))
         self.V, self.Ad, self.F, self.pA, self.acc6 = (np.zeros((nb, 6)) for _ in range(5))
         self.U, self.u = np.zeros((n, 6)), np.zeros(n)
-        self.tmp, self.sums = np.zeros((2, 6)), np.zeros(2)
+        self.tmp = np.zeros((2, 6))
         ptr = static.paths[0]
         self.local = bool(np.all(np.diff(ptr) == 1))
         self.placed = np.full(n, np.nan)
@@ -350,11 +360,11 @@ def _placed(model: Model, data: MotionData, q: np.ndarray) -> np.ndarray:
 
 def residual(
     model: Model, data: MotionData, q: np.ndarray, v: np.ndarray, acc: np.ndarray
-) -> tuple[np.ndarray, float, float, float]:
-    """``r = A q̈ + B q̇ − Q_g − Q_c − Q_d`` and the energies: ``(r, T, U_c, P_d)``.
+) -> tuple[np.ndarray, np.ndarray]:
+    """``r = A q̈ + B q̇ − Q_g − Q_c − Q_d`` and the energies ``[T, U_g, U_c, P_d]``.
 
-    T is the kinetic energy, U_c the springs' ``Σ ½ δᵀ C δ`` (J), P_d the dampers' power
-    ``−q̇ᵀ Q_d`` (W).
+    T is the kinetic energy, U_g gravity's (as the textbook side's), U_c the springs'
+    ``Σ ½ δᵀ C δ`` (J), P_d the dampers' power ``−q̇ᵀ Q_d`` (W).
 
     Parameters
     ----------
@@ -373,14 +383,14 @@ def residual(
     """
     st = data.static
     q = _placed(model, data, q)
-    out = np.empty(model.nv)
-    T = _newton_euler(np.asarray(v, dtype=float), np.asarray(acc, dtype=float), st.gravity,
-                      st.arrays, st.work[3], data.I0, data.V, data.Ad, data.F, data.tmp,
-                      out)  # fmt: skip
-    bad = _elements(q, np.asarray(v, dtype=float), st.bushes, st.damping, st.paths, st.scoord,
-                    st.sk, st.sd, st.work, st.jac, out, data.sums)  # fmt: skip
+    out, energies = np.empty(model.nv), np.empty(4)
+    v = np.asarray(v, dtype=float)
+    _newton_euler(v, np.asarray(acc, dtype=float), st.gravity, st.arrays, st.work[3], data.I0,
+                  data.V, data.Ad, data.F, data.tmp, out, energies)  # fmt: skip
+    bad = _elements(q, v, st.bushes, st.damping, st.paths, st.scoord, st.sk, st.sd, st.work,
+                    st.jac, out, energies[2:])  # fmt: skip
     _check(st, bad)
-    return out, T, float(data.sums[0]), float(data.sums[1])
+    return out, energies
 
 
 def pair_gains(model: Model, data: MotionData, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -459,25 +469,3 @@ def articulated_solve(model: Model, data: MotionData, r: np.ndarray) -> np.ndarr
                        np.ascontiguousarray(r, dtype=float), data.pA, data.acc6, data.u,
                        out)  # fmt: skip
     return out
-
-
-def gravity_potential(model: Model, data: MotionData, q: np.ndarray) -> float:
-    """``U_g = −Σ m g · x_cm`` over the bodies, J (as the textbook side's).
-
-    Parameters
-    ----------
-    model : Model
-        The textbook model.
-    data : MotionData
-        ``MotionData.of(model)``.
-    q : numpy.ndarray, shape (nv,)
-        Coordinates in the model's order, rad or m.
-    """
-    from rt70.textbook.static_kernel import _subtree_weights
-
-    st = data.static
-    q = check_vector("q", q, model.nv)
-    _subtree_weights(np.array(q, dtype=float), st.arrays, st.work)
-    data.placed[:] = np.nan  # the placements were overwritten without Θ⁰
-    roots = st.arrays[0] < 0
-    return -float(np.sum(st.work[9][roots, 1:] @ st.gravity))
