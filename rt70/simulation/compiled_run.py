@@ -28,7 +28,8 @@ from rt70.errors import Rt70Error, ShapeError, SimulationError
 from rt70.guards.arrays import check_vector
 from rt70.model.scene import Scene
 from rt70.simulation.generalized_alpha import SPECTRAL_RADIUS, integrate
-from rt70.simulation.result import SimulationResult
+from rt70.simulation.integrators import MIN_RTOL
+from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
 from rt70.textbook import motion_kernel
 from rt70.textbook.spatial import check_euler_pairs
 
@@ -113,8 +114,6 @@ def run(
     extras : dict
         ``t_eval``, ``outputs``, ``components``, ``events``: refused unless None or empty.
     """
-    from rt70.simulation.simulate import MIN_RTOL
-
     asked = [name for name, value in extras.items() if value is not None and len(value)]
     if asked:
         raise Rt70Error(f"method '{METHOD}' keeps every step and has no {', '.join(asked)}")
@@ -183,8 +182,6 @@ def simulate_compiled(
 
 def _result(scene: Scene, run, tolerances, wall: float, rho: float) -> SimulationResult:
     """The run as a :class:`SimulationResult` with its energy audit (module docstring)."""
-    from rt70.simulation.simulate import DRIFT_FACTOR, coordinate_units
-
     t = np.array(run.t)
     rec = np.array(run.records)
     T, U_g, U_c, P_d, P_u = rec.T

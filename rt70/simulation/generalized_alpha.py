@@ -88,10 +88,26 @@ class Problem(Protocol):
     nv: int
 
     def residual(self, t: float, q: np.ndarray, v: np.ndarray, qdd: np.ndarray):
-        """``(r, energies)``: ``r = A q̈ − f``, and what is recorded at each sample."""
+        """``(r, record)``: ``r = A q̈ − f``, and what is recorded at each sample.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, v, qdd : numpy.ndarray, shape (nv,)
+            Coordinates, velocities and accelerations.
+        """
 
     def factor(self, q: np.ndarray, v: np.ndarray, c_v: float, c_q: float) -> None:
-        """Factor ``S = A + c_v D + c_q K`` at (q, q̇) (D, K: −∂f/∂q̇, −∂f/∂q, or parts)."""
+        """Factor ``S = A + c_v D + c_q K`` at (q, q̇) (D, K: −∂f/∂q̇, −∂f/∂q, or parts).
+
+        Parameters
+        ----------
+        q, v : numpy.ndarray, shape (nv,)
+            The state the matrix is taken at.
+        c_v, c_q : float
+            The weights γ′h (s) and β′h² (s²).
+        """
 
     def solve(self, r: np.ndarray) -> np.ndarray:
         """``S⁻¹ r`` with the last factor."""

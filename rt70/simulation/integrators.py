@@ -33,6 +33,8 @@ from rt70.guards import stop
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
 #: SUNDIALS CVODE methods, by rt70's name: CVODE's linear multistep family.
 CVODE_METHODS = {"CVODE": "BDF", "CVODE_ADAMS": "Adams"}
+#: Smallest rtol solve_ivp honours (it raises smaller ones to 100 machine epsilons).
+MIN_RTOL = 100 * np.finfo(float).eps
 #: Every method :func:`rt70.simulation.simulate.simulate` takes (scipy's, then SUNDIALS').
 METHODS = SCIPY_METHODS + tuple(CVODE_METHODS)
 #: Largest number of CVODE steps between two output times (CVODE's default, 500, is

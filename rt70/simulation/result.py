@@ -20,6 +20,9 @@ from rt70.errors import OutputError
 from rt70.model.outputs import column_labels
 from rt70.simulation.states import EnergyAudit
 
+#: A drift of the energy balance larger than this many times rtol (relative to the energy
+#: exchanged during the run) is flagged: more than the tolerance explains.
+DRIFT_FACTOR = 100.0
 #: Output formats of :meth:`SimulationResult.save`, by suffix.
 OUTPUT_SUFFIXES = (".csv", ".npz")
 
@@ -33,7 +36,7 @@ class SimulationResult:
     ``input_work`` W_u; ``balance = T + U_g + U_c + E_ψ − W_u − (its value at t0)`` and
     ``balance_scale`` the energy exchanged in the run (what ``relative_drift`` is
     relative to). ``drift_flagged`` is set when a passive run drifts by more than
-    ``DRIFT_FACTOR · rtol`` of it (:data:`rt70.simulation.simulate.DRIFT_FACTOR`).
+    ``DRIFT_FACTOR · rtol`` of it (:data:`DRIFT_FACTOR`).
     ``states`` holds the trajectory of every extra state by name
     (:mod:`rt70.simulation.states`; the energy audit's ``dissipated`` and ``input_work``
     first). ``constraint_residual`` is ``max |Φ|`` per sample for a scene with closed
@@ -203,3 +206,15 @@ def check_output_suffix(path: str | Path) -> str:
     if suffix not in OUTPUT_SUFFIXES:
         raise OutputError(f"{path}: output must end in {' or '.join(OUTPUT_SUFFIXES)}")
     return suffix
+
+
+def coordinate_units(scene) -> list[str]:
+    """Each coordinate's unit: "m" for a prismatic joint's, "rad" for any other's.
+
+    Parameters
+    ----------
+    scene : rt70.model.scene.Scene
+        The scene simulated.
+    """
+    kinds = {j.name: j.type for j in scene.description.joints}
+    return ["m" if kinds.get(c) == "prismatic" else "rad" for c in scene.textbook.coordinate_names]

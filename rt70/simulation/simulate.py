@@ -38,24 +38,20 @@ from rt70.simulation.closed_chains import constrained_start, residual_trajectory
 from rt70.simulation.integrators import (
     CVODE_METHODS,
     METHODS,
+    MIN_RTOL,
     Integration,
     Stopwatch,
     budget_limit,
     integrate,
     load,
 )
-from rt70.simulation.result import SimulationResult
+from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
 from rt70.simulation.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import check_euler_pairs
 
-#: Smallest rtol solve_ivp honours (it raises smaller ones to 100 machine epsilons).
-MIN_RTOL = 100 * np.finfo(float).eps
 #: solve_ivp methods that use the Jacobian of the right-hand side (CVODE's all do).
 IMPLICIT = ("Radau", "BDF", "LSODA")
-#: A drift of the energy balance larger than this many times rtol (relative to the energy
-#: exchanged during the run) is flagged: more than the tolerance explains.
-DRIFT_FACTOR = 100.0
 
 Inputs = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 #: An event function g(t, q, q̇), with optional ``terminal`` and ``direction`` attributes.
@@ -96,9 +92,8 @@ def simulate(
         analytic (Pinocchio's) or differenced by the solver
         (:mod:`rt70.simulation.backends`).
     method : str
-        A ``scipy.integrate.solve_ivp`` method or "CVODE" / "CVODE_ADAMS" (SUNDIALS;
-        :data:`METHODS`, :mod:`rt70.simulation.integrators`), or "generalized-alpha" on
-        the compiled kernels, for any ``side`` (:mod:`rt70.simulation.compiled_run`).
+        A method of :data:`METHODS` (scipy's, SUNDIALS': :mod:`~.integrators`) or
+        "generalized-alpha", on any side (:mod:`rt70.simulation.compiled_run`).
     rtol, atol : float
         Tolerances; ``atol`` defaults to ``1e-3 · rtol`` on q and q̇ (m, rad) and
         ``rtol`` of the initial energy scale on the two energy states.
@@ -122,7 +117,7 @@ def simulate(
         ``direction``, for every method; their times in ``result.t_events``.
     """
     if method == compiled_run.METHOD:  # the compiled kernels (large models)
-        extras = {"t_eval": t_eval, "outputs": outputs, "components": components, "events": events}
+        extras = dict(t_eval=t_eval, outputs=outputs, components=components, events=events)
         return compiled_run.run(scene, t_span, x0, (rtol, atol), inputs, progress, extras)
     t0, t1, t_eval = _checked_request(side, method, rtol, atol, t_span, t_eval, events)
     backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
@@ -137,19 +132,13 @@ def simulate(
     x_start = np.concatenate([q0, qd0, *layout.initial()])
     sol, clock = _integrate(scene, method, rhs, x_start, (rtol, atol_vec), t_eval, events, limit)
     result = _result(scene, method, (rtol, atol_q), sol, clock, rhs, energy_scale)
-    passive = inputs is None and not rhs.pushed
+    passive = inputs is None and not rhs.pushed  # only a passive run's drift is flagged
     result.drift_flagged = passive and result.relative_drift > DRIFT_FACTOR * rtol
     result.outputs = evaluate_trajectory(scene, result.q, outputs, side)
     result.output_units = {o.name: o.unit for o in outputs}
     result.state_units = {n: c.unit(n) for c in layout.components for n in c.names}
     result.coordinate_units = coordinate_units(scene)
     return result
-
-
-def coordinate_units(scene: Scene) -> list[str]:
-    """Each coordinate's unit: "m" for a prismatic joint's, "rad" for any other's."""
-    kinds = {j.name: j.type for j in scene.description.joints}
-    return ["m" if kinds.get(c) == "prismatic" else "rad" for c in scene.textbook.coordinate_names]
 
 
 def _checked_request(
