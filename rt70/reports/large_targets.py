@@ -11,9 +11,9 @@ as subprocesses, each timed (wall) with its peak resident memory (``os.wait4``'s
 - ``rt70 simulate FILE --t-end 1``: ≤ :data:`SIMULATE_TARGET_S`;
 
 each within :data:`MEMORY_TARGET_GB` of peak memory. A command that fails is reported
-with its last line and not met. One warm-up run of ``rt70 modes`` on a 40-body chain
-first fills numba's on-disk cache, so that no timed run compiles the kernels (a fresh
-install compiles them once, some 20–40 s). ``--quick`` runs a 60-body chain (360
+with its last line and not met. One warm-up run of ``rt70 modes`` and of ``rt70 simulate``
+on a 40-body chain first fills numba's on-disk cache, so that no timed run compiles the
+kernels (a fresh install compiles them once, some 20–40 s). ``--quick`` runs a 60-body chain (360
 coordinates) and judges nothing.
 """
 
@@ -85,8 +85,9 @@ def check(quick: bool = False, progress: Callable[[str], None] | None = None) ->
         where = Path(tmp)
         (where / "warm.urdf").write_text(elastic_chain(40, hanging=True))
         (where / "chain.urdf").write_text(elastic_chain(bodies, hanging=True))
-        say("warm-up: rt70 modes on a 40-body chain (fills the kernels' cache)")
+        say("warm-up: rt70 modes and simulate on a 40-body chain (fills the kernels' cache)")
         run_command(["modes", "warm.urdf"], where)
+        run_command(["simulate", "warm.urdf", "--t-end", "0.001"], where)
         runs = (
             (["modes", "chain.urdf"], MODES_TARGET_S),
             (["plant", "chain.urdf", "--out", "plant.npz"], PLANT_TARGET_S),
