@@ -127,3 +127,19 @@ def test_cli_runs_a_large_model_by_default_on_the_kernels(tmp_path, capsys):
     assert stop.value.code == 2
     err = capsys.readouterr().err
     assert "--rtol" in err and "Traceback" not in err
+
+
+def test_the_evaluation_budget_stops_a_run(chain):
+    from rt70.errors import SimulationError
+    from rt70.simulation.integrators import EvaluationBudget, evaluation_budget
+
+    with evaluation_budget(EvaluationBudget(minimum=100, per_second=10)):
+        with pytest.raises(SimulationError, match="stopped after 110 right-hand-side"):
+            simulate(chain, (0.0, 1.0), method=GA)
+
+
+def test_a_run_too_long_for_memory_is_stopped_at_its_pace(chain):
+    from rt70.errors import SimulationError
+
+    with pytest.raises(SimulationError, match="at the pace of its first"):
+        simulate(chain, (0.0, 1e9), method=GA)

@@ -26,9 +26,10 @@ import numpy as np
 
 from rt70.errors import Rt70Error, ShapeError, SimulationError
 from rt70.guards.arrays import check_vector
+from rt70.guards.resources import time_series_samples
 from rt70.model.scene import Scene
 from rt70.simulation.generalized_alpha import SPECTRAL_RADIUS, integrate
-from rt70.simulation.integrators import MIN_RTOL
+from rt70.simulation.integrators import MIN_RTOL, budgeted
 from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
 from rt70.textbook import motion_kernel
 from rt70.textbook.spatial import check_euler_pairs
@@ -53,6 +54,7 @@ class CompiledEquations:
                 "cover modal bodies, mimic joints or closed loops; use BDF or LSODA"
             )
         self.nv, self.inputs = self.model.nv, inputs
+        self.count: Callable = lambda t, x: None  # the run's budget (simulate_compiled)
 
     def residual(self, t: float, q: np.ndarray, v: np.ndarray, qdd: np.ndarray):
         """``(r, record)``: ``r = A q̈ + B q̇ − Q_g − Q_c − Q_d − Q_u`` and the record.
@@ -64,6 +66,7 @@ class CompiledEquations:
         q, v, qdd : numpy.ndarray, shape (nv,)
             Coordinates, velocities and accelerations in the model's order.
         """
+        self.count(t, None)
         r, energies = motion_kernel.residual(self.model, self.data, q, v, qdd)
         power = 0.0
         if self.inputs is not None:
@@ -116,7 +119,10 @@ def run(
     """
     asked = [name for name, value in extras.items() if value is not None and len(value)]
     if asked:
-        raise Rt70Error(f"method '{METHOD}' keeps every step and has no {', '.join(asked)}")
+        raise Rt70Error(
+            f"method '{METHOD}' keeps every step and takes no t_eval, outputs, extra state "
+            f"components (drives, servos) or events: {', '.join(asked)} given; use LSODA or BDF"
+        )
     rtol, atol = tolerances
     if not (np.isfinite(rtol) and MIN_RTOL <= rtol < 1.0):
         raise Rt70Error(f"rtol must lie in [{MIN_RTOL:.3g}, 1), got {rtol!r}")
@@ -166,6 +172,10 @@ def simulate_compiled(
     q0, v0 = check_vector("initial state q0", q0, n), check_vector("initial state qd0", v0, n)
     check_euler_pairs(scene.textbook, scene.textbook.expand(q0))
     t0, t1 = map(float, t_span)
+    # a sample per step (q, q̇, the audit's 2 states and 3 energies), a step at least one
+    # evaluation: the samples memory holds and the budget in force bound the evaluations
+    samples = time_series_samples(2 * n + 5)
+    equations.count = budgeted(lambda t, x: None, t1 - t0, samples, t0)
     shape = "{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]"
     bar = tqdm(total=t1 - t0, disable=not progress, bar_format=shape)
     start = time.perf_counter()

@@ -235,7 +235,7 @@ def integrate(
     cap = np.inf
     while s.t < t1:
         h = min(h, t1 - s.t)
-        if h <= 1e-14 * max(abs(s.t), t1 - t0) or (max_steps and run.n_steps > max_steps):
+        if h < 16 * np.spacing(max(abs(s.t), abs(t1))) or (max_steps and run.n_steps > max_steps):
             why = "the step size underflowed" if h > 0 else "no step"
             if max_steps and run.n_steps > max_steps:
                 why = f"more than {max_steps} steps"
