@@ -80,7 +80,7 @@ def test_equals_bdf_on_a_chain_and_converges(chain, reference_run):
         errors.append(_error(run, reference_run))
         drifts.append(run.relative_drift)
     # the energy audit closes to the method's error: a second-order method's global error
-    # falls as rtol^(2/3) under a local error test (measured: 2.7e-4, then 1.1e-5)
+    # falls as rtol^(2/3) under a local error test (measured: 2.1e-4, then 5.0e-6)
     assert drifts[0] < 100 * 1e-5
     assert drifts[1] < 0.1 * drifts[0]
     assert errors[0] < 1e-2 * scale  # rtol 1e-5: within 1 % of the motion
@@ -103,12 +103,37 @@ def test_inputs_do_work_and_are_audited(chain):
     assert _error(ga, bdf) < 1e-3 * float(np.max(np.abs(bdf.q)))
 
 
-@pytest.mark.parametrize(
-    "extra", [{"t_eval": np.linspace(0, 0.1, 3)}, {"events": [lambda t, q, qd: t - 0.05]}]
-)
+def test_output_times_and_outputs_equal_bdf(chain, reference_run):
+    """At output times the steps' Hermite interpolants; outputs evaluated on them."""
+    from rt70.model.outputs import position_output
+
+    t_eval = np.linspace(0.0, 0.3, 31)
+    tip = [position_output("tip", "body6", (0.0, 0.0, 0.0))]
+    ga = simulate(chain, (0.0, 0.3), method=GA, rtol=1e-7, t_eval=t_eval, outputs=tip)
+    bdf = simulate(chain, (0.0, 0.3), method="BDF", rtol=1e-10, t_eval=t_eval, outputs=tip)
+    assert np.array_equal(ga.t, t_eval) and ga.q.shape == bdf.q.shape
+    scale = float(np.max(np.abs(bdf.q)))
+    assert float(np.max(np.abs(ga.q - bdf.q))) < 1e-3 * scale
+    assert float(np.max(np.abs(ga.qd - bdf.qd))) < 1e-3 * float(np.max(np.abs(bdf.qd)))
+    moved = float(np.ptp(bdf.outputs["tip"][:, 2]))
+    assert moved > 1e-4  # the tip moves, m
+    assert float(np.max(np.abs(ga.outputs["tip"] - bdf.outputs["tip"]))) < 1e-3 * moved
+    # the audit at the output times: the same energies as BDF's at the same states
+    assert ga.kinetic == pytest.approx(bdf.kinetic, rel=1e-2, abs=1e-3 * bdf.balance_scale)
+    assert ga.dissipated[-1] == pytest.approx(bdf.dissipated[-1], rel=1e-3)
+
+
+@pytest.mark.parametrize("extra", [{"components": ["x"]}, {"events": [lambda t, q, qd: t - 0.05]}])
 def test_refuses_what_it_does_not_do(chain, extra):
-    with pytest.raises(Rt70Error, match=f"method '{GA}'"):
+    with pytest.raises(Rt70Error, match=f"method '{GA}' takes no"):
         simulate(chain, (0.0, 0.1), method=GA, **extra)
+
+
+def test_bad_arguments_are_refused_as_for_every_method(chain):
+    with pytest.raises(Rt70Error, match="rtol must lie"):
+        simulate(chain, (0.0, 0.1), method=GA, rtol=2.0)
+    with pytest.raises(Rt70Error, match="t_eval must be increasing"):
+        simulate(chain, (0.0, 0.1), method=GA, t_eval=[0.05, 0.01])
 
 
 def test_refuses_a_model_the_kernels_do_not_cover():

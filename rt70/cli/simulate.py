@@ -197,7 +197,7 @@ def add_parser(
     add_pointing_arguments : callable
         Adds ``--elevation``/``--azimuth`` to a parser (shared with ``rt70 modes``).
     """
-    from rt70.simulation.integrators import METHODS  # not the simulation: --help stays light
+    from rt70.simulation.request import ALL_METHODS  # not the simulation: --help stays light
 
     sim = sub.add_parser(
         "simulate",
@@ -243,7 +243,7 @@ def add_parser(
     )
     sim.add_argument(
         "--method",
-        choices=(*METHODS, "generalized-alpha"),
+        choices=ALL_METHODS,
         help="integrator: a solve_ivp method, CVODE / CVODE_ADAMS (SUNDIALS), or "
         "generalized-alpha on the compiled kernels, in O(nv) memory and work per step "
         "(default BDF; generalized-alpha from 200 coordinates on where the kernels cover "

@@ -87,7 +87,11 @@ from rt70.simulation import simulate as _simulate
 #: lower order and adds nothing to the comparison.
 METHODS = tuple(m for m in _simulate.METHODS if m != "RK23")
 #: Methods that need no cap against stiffness: the implicit ones (scipy's and SUNDIALS').
-STIFF_METHODS = tuple(m for m in METHODS if m in _simulate.IMPLICIT or m.startswith("CVODE"))
+STIFF_METHODS = tuple(
+    m
+    for m in METHODS
+    if m in _simulate.IMPLICIT or m.startswith("CVODE") or m == _simulate.GENERALIZED_ALPHA
+)
 #: The tolerance ladder (relative tolerance; ``atol`` is the default of
 #: :func:`~rt70.simulation.simulate.simulate`).
 RTOLS = tuple(10.0**-k for k in range(3, 10))

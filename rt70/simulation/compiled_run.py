@@ -29,13 +29,13 @@ from rt70.guards.arrays import check_vector
 from rt70.guards.resources import time_series_samples
 from rt70.model.scene import Scene
 from rt70.simulation.generalized_alpha import SPECTRAL_RADIUS, integrate
-from rt70.simulation.integrators import MIN_RTOL, budgeted
+from rt70.simulation.integrators import GENERALIZED_ALPHA, budgeted
 from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
 from rt70.textbook import motion_kernel
 from rt70.textbook.spatial import check_euler_pairs
 
 #: The method's name in :func:`rt70.simulation.simulate.simulate` and ``rt70 simulate``.
-METHOD = "generalized-alpha"
+METHOD = GENERALIZED_ALPHA
 
 
 class CompiledEquations:
@@ -104,35 +104,39 @@ def run(
     tolerances: tuple[float, float | None],
     inputs: Callable | None,
     progress: bool,
-    extras: dict[str, object],
+    t_eval: np.ndarray | None,
+    extras: dict,
 ) -> SimulationResult:
     """:func:`simulate_compiled` for :func:`rt70.simulation.simulate.simulate`'s arguments.
 
     Parameters
     ----------
-    scene, t_span, x0, inputs, progress
-        As :func:`simulate_compiled`.
+    scene, t_span, x0, inputs, progress, t_eval
+        As :func:`simulate_compiled` (checked by
+        :func:`rt70.simulation.request.checked_request`).
     tolerances : (rtol, atol or None)
         ``atol`` defaults to ``1e-3 rtol`` (as the other methods').
     extras : dict
-        ``t_eval``, ``outputs``, ``components``, ``events``: refused unless None or empty.
+        ``components`` and ``events`` (refused unless empty) and ``outputs``:
+        ``(outputs, side)``, the quantities evaluated on the trajectory by ``side``.
     """
-    asked = [name for name, value in extras.items() if value is not None and len(value)]
+    from rt70.model.outputs import evaluate, evaluate_trajectory
+
+    asked = [name for name in ("components", "events") if len(extras[name])]
     if asked:
         raise Rt70Error(
-            f"method '{METHOD}' keeps every step and takes no t_eval, outputs, extra state "
-            f"components (drives, servos) or events: {', '.join(asked)} given; use LSODA or BDF"
+            f"method '{METHOD}' takes no extra state components (drives, servos) or events: "
+            f"{', '.join(asked)} given; use LSODA or BDF"
         )
+    outputs, side = extras["outputs"]
+    if outputs:
+        evaluate(scene, np.zeros(scene.textbook.nv) if x0 is None else x0[0], outputs, side)
     rtol, atol = tolerances
-    if not (np.isfinite(rtol) and MIN_RTOL <= rtol < 1.0):
-        raise Rt70Error(f"rtol must lie in [{MIN_RTOL:.3g}, 1), got {rtol!r}")
-    if atol is not None and not (np.isfinite(atol) and atol > 0.0):
-        raise Rt70Error(f"atol must be a positive finite number, got {atol!r}")
-    t0, t1 = map(float, t_span)
-    if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
-        raise Rt70Error(f"bad time span {t_span!r}")
     atol = 1e-3 * rtol if atol is None else atol
-    return simulate_compiled(scene, (t0, t1), x0, (rtol, atol), inputs, progress)
+    result = simulate_compiled(scene, t_span, x0, (rtol, atol), inputs, progress, t_eval)
+    result.outputs = evaluate_trajectory(scene, result.q, outputs, side)
+    result.output_units = {o.name: o.unit for o in outputs}
+    return result
 
 
 def simulate_compiled(
@@ -142,6 +146,7 @@ def simulate_compiled(
     tolerances: tuple[float, float],
     inputs: Callable | None = None,
     progress: bool = False,
+    t_eval: np.ndarray | None = None,
     rho: float = SPECTRAL_RADIUS,
 ) -> SimulationResult:
     """Integrate ``scene`` by the generalized-α method on the compiled kernels.
@@ -161,6 +166,9 @@ def simulate_compiled(
         matrix).
     progress : bool
         Show a progress bar (tqdm) on stderr.
+    t_eval : numpy.ndarray, optional
+        Output times, s, increasing within ``t_span``: the steps' cubic Hermite
+        interpolants there (:func:`_sampled`); default every step.
     rho : float
         Spectral radius ρ∞ in [0, 1].
     """
@@ -187,22 +195,54 @@ def simulate_compiled(
     finally:
         bar.close()
     wall = time.perf_counter() - start
-    return _result(scene, run, tolerances, wall, rho)
+    t, q, qd, energies = _sampled(equations, run, t_eval)
+    return _result(scene, run, (t, q, qd, energies), tolerances, (wall, rho))
 
 
-def _result(scene: Scene, run, tolerances, wall: float, rho: float) -> SimulationResult:
-    """The run as a :class:`SimulationResult` with its energy audit (module docstring)."""
-    t = np.array(run.t)
-    rec = np.array(run.records)
-    T, U_g, U_c, P_d, P_u = rec.T
+def _hermite(y0, y1, d0, d1, theta, h):
+    """The cubic through (0, y0) and (1, y1) with slopes ``h d0`` and ``h d1`` at θ."""
+    t2, t3 = theta * theta, theta * theta * theta
+    return ((2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + theta) * h * d0
+            + (3 * t2 - 2 * t3) * y1 + (t3 - t2) * h * d1)  # fmt: skip
+
+
+def _sampled(equations: CompiledEquations, run, t_eval: np.ndarray | None) -> tuple:
+    """``(t, q, q̇, [T, U_g, U_c, E_ψ, W_u])`` at every step, or at ``t_eval``.
+
+    E_ψ and W_u by the trapezoidal rule on their power over the steps. At output times:
+    q from the step's q and q̇, q̇ from its q̇ and q̈, E_ψ and W_u from their values and
+    powers, by cubic Hermite interpolation (the method's own order); T, U_g and U_c of
+    the interpolated state.
+    """
+    t, q, v, a = (np.array(x) for x in (run.t, run.q, run.v, run.qdd))
+    T, U_g, U_c, P_d, P_u = np.array(run.records).T
     steps = np.diff(t)
     E_psi = np.r_[0.0, np.cumsum(0.5 * steps * (P_d[1:] + P_d[:-1]))]
     W_u = np.r_[0.0, np.cumsum(0.5 * steps * (P_u[1:] + P_u[:-1]))]
+    if t_eval is None:
+        return t, q, v, np.stack([T, U_g, U_c, E_psi, W_u])
+    i = np.clip(np.searchsorted(t, t_eval, side="right") - 1, 0, t.size - 2)
+    h = steps[i]
+    theta = (t_eval - t[i]) / h
+    qs = _hermite(q[i], q[i + 1], v[i], v[i + 1], theta[:, None], h[:, None])
+    vs = _hermite(v[i], v[i + 1], a[i], a[i + 1], theta[:, None], h[:, None])
+    E_s = _hermite(E_psi[i], E_psi[i + 1], P_d[i], P_d[i + 1], theta, h)
+    W_s = _hermite(W_u[i], W_u[i + 1], P_u[i], P_u[i + 1], theta, h)
+    zero = np.zeros(equations.nv)
+    samples = zip(t_eval, qs, vs, strict=True)
+    state = np.array([equations.residual(te, x, y, zero)[1][:3] for te, x, y in samples])
+    return t_eval, qs, vs, np.stack([*state.T, E_s, W_s])
+
+
+def _result(scene: Scene, run, samples: tuple, tolerances, clock) -> SimulationResult:
+    """The run as a :class:`SimulationResult` with its energy audit (module docstring)."""
+    t, q, qd, (T, U_g, U_c, E_psi, W_u) = samples
+    wall, rho = clock
     total = T + U_g + U_c + E_psi - W_u
     exchanged = max(float(np.max(T + U_c)), float(E_psi[-1]), float(np.max(np.abs(W_u))))
     initial = max(T[0] + U_c[0], 1e-12 * max(abs(U_g[0]), 1.0), 1e-300)
     rtol, atol = tolerances
-    passive = not np.any(P_u)
+    passive = not np.any(run.records and np.array(run.records)[:, 4])
     return SimulationResult(
         scene=scene.name,
         side="compiled",
@@ -210,8 +250,8 @@ def _result(scene: Scene, run, tolerances, wall: float, rho: float) -> Simulatio
         rtol=rtol,
         atol=atol,
         t=t,
-        q=np.array(run.q),
-        qd=np.array(run.v),
+        q=q,
+        qd=qd,
         kinetic=T,
         gravity=U_g,
         elastic=U_c,

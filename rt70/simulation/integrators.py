@@ -35,7 +35,9 @@ SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
 CVODE_METHODS = {"CVODE": "BDF", "CVODE_ADAMS": "Adams"}
 #: Smallest rtol solve_ivp honours (it raises smaller ones to 100 machine epsilons).
 MIN_RTOL = 100 * np.finfo(float).eps
-#: Every method :func:`rt70.simulation.simulate.simulate` takes (scipy's, then SUNDIALS').
+#: The generalized-α method on the compiled kernels (:mod:`rt70.simulation.compiled_run`).
+GENERALIZED_ALPHA = "generalized-alpha"
+#: The methods integrating the first-order form (scipy's, then SUNDIALS').
 METHODS = SCIPY_METHODS + tuple(CVODE_METHODS)
 #: Largest number of CVODE steps between two output times (CVODE's default, 500, is
 #: for a caller that samples often; solve_ivp has no such limit).

@@ -30,26 +30,28 @@ from rt70.guards.arrays import check_vector
 from rt70.guards.resources import check_time_series, time_series_samples
 from rt70.model.outputs import Output, evaluate, evaluate_trajectory
 from rt70.model.scene import Scene
-from rt70.model.sides import check_side, refuses_backend
+from rt70.model.sides import refuses_backend
 from rt70.physics.baumgarte import DEFAULT_STABILIZATION, Baumgarte
 from rt70.simulation import compiled_run
 from rt70.simulation.backends import BACKENDS, Backend
 from rt70.simulation.closed_chains import constrained_start, residual_trajectory
 from rt70.simulation.integrators import (
     CVODE_METHODS,
-    METHODS,
-    MIN_RTOL,
+    GENERALIZED_ALPHA,
     Integration,
     Stopwatch,
     budget_limit,
     integrate,
     load,
 )
+from rt70.simulation.request import ALL_METHODS, checked_request
 from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
 from rt70.simulation.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import check_euler_pairs
 
+#: Every method :func:`simulate` takes: scipy's, SUNDIALS', the compiled generalized-α.
+METHODS = ALL_METHODS
 #: solve_ivp methods that use the Jacobian of the right-hand side (CVODE's all do).
 IMPLICIT = ("Radau", "BDF", "LSODA")
 
@@ -116,10 +118,10 @@ def simulate(
         Zero crossings located, with the optional solve_ivp attributes ``terminal`` and
         ``direction``, for every method; their times in ``result.t_events``.
     """
-    if method == compiled_run.METHOD:  # the compiled kernels (large models)
-        extras = dict(t_eval=t_eval, outputs=outputs, components=components, events=events)
-        return compiled_run.run(scene, t_span, x0, (rtol, atol), inputs, progress, extras)
-    t0, t1, t_eval = _checked_request(side, method, rtol, atol, t_span, t_eval, events)
+    t0, t1, t_eval = checked_request(side, method, rtol, atol, t_span, t_eval, events)
+    if method == GENERALIZED_ALPHA:  # the compiled kernels (large models)
+        extras = dict(components=components, events=events, outputs=(outputs, side))
+        return compiled_run.run(scene, (t0, t1), x0, (rtol, atol), inputs, progress, t_eval, extras)
     backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
     evaluate(scene, q0, outputs, side)  # refuses an unknown link before the run
     energy_scale = _energy_scale(scene, backend, q0, qd0)
@@ -139,37 +141,6 @@ def simulate(
     result.state_units = {n: c.unit(n) for c in layout.components for n in c.names}
     result.coordinate_units = coordinate_units(scene)
     return result
-
-
-def _checked_request(
-    side: str,
-    method: str,
-    rtol: float,
-    atol: float | None,
-    t_span: tuple[float, float],
-    t_eval: np.ndarray | None,
-    events: Sequence[Event],
-) -> tuple[float, float, np.ndarray | None]:
-    """``(t0, t1, t_eval)`` of :func:`simulate`'s arguments, each checked, or an Rt70Error."""
-    check_side(side)
-    if method not in METHODS:
-        raise Rt70Error(f"unknown method '{method}' (choose from {', '.join(METHODS)})")
-    if not all(callable(g) for g in events):
-        raise Rt70Error("events must be callables g(t, q, qd)")
-    if not (np.isfinite(rtol) and MIN_RTOL <= rtol < 1.0):
-        raise Rt70Error(f"rtol must lie in [{MIN_RTOL:.3g}, 1), got {rtol!r}")
-    if atol is not None and not (np.isfinite(atol) and atol > 0.0):
-        raise Rt70Error(f"atol must be a positive finite number, got {atol!r}")
-    t0, t1 = map(float, t_span)
-    if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
-        raise Rt70Error(f"bad time span {t_span!r}")
-    if t_eval is not None:
-        t_eval = np.asarray(t_eval, dtype=float)
-        if t_eval.ndim != 1 or not np.all((t_eval >= t0) & (t_eval <= t1)):
-            raise Rt70Error(f"t_eval must be a vector of times within [{t0:g}, {t1:g}]")
-        if np.any(np.diff(t_eval) <= 0.0):
-            raise Rt70Error("t_eval must be increasing")
-    return t0, t1, t_eval
 
 
 def _initial_state(
