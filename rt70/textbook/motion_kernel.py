@@ -9,24 +9,30 @@ of the equations of motion (1.73), (4.79)
 and, at every step, solutions of ``(A + X) x = r`` with X a pair-local stiffness and
 damping. Forming A costs O(nv²) memory and its factorisation O(nv³); this kernel does
 neither. It works on the mass kernel's placements (:mod:`rt70.textbook.mass_kernel`:
-each pair's ``C_j``, ``p_j`` and the mobility axes ``σ_a`` seen from E0) and on each
-body's inertia in E0, ``Θ⁰_j = L_0^j Θ_j (L_0^j)ᵀ`` (4.77), with spatial vectors in E0
-(``[v; w]`` for motions, ``[f; n]`` about the origin for forces):
+each pair's ``C_j`` and ``p_j``), with spatial vectors in E0's axes (``[v; w]`` for
+motions, ``[f; n]`` for forces) taken about each pair's own origin ``p_j``: the axes
+``σ_a = [C v_a; C w_a]`` and the inertia ``R Θ_j Rᵀ`` ((4.77) about ``p_j``), moved from
+a parent's origin to a child's by ``d = p_j − p_i`` (motions ``v + w × d``, forces
+``n + d × f``). About E0's origin instead (as the mass kernel's ``σ`` and ``Θ⁰``) a
+structure 2 km from it loses 2.7e-10 of its residual to the cancellation of lever-arm
+terms ``m |p|²``; about its own origin each term is the size of the body's own motion.
 
-- **The residual** by the recursive Newton–Euler algorithm in E0 (Featherstone,
-  *Rigid Body Dynamics Algorithms*, 2008, §5.3 in ground coordinates). A pair is a
+- **The residual** by the recursive Newton–Euler algorithm (Featherstone, *Rigid Body
+  Dynamics Algorithms*, 2008, §5.3). A pair is a
   series of elementary motions in the order of its coordinates (euler6: x, y, z in the
   construction frame, then β, θ, α; planar: x, y, then α), so axis a is fixed in the
   frame moved by its pair's earlier coordinates, whose velocity is
   ``W_a = V_parent + Σ_{b<a} σ_b q̇_b``, and ``σ̇_a = W_a ×ₘ σ_a``. Forward:
   ``V_j = V_parent + Σ σ_a q̇_a``, ``Ȧ_j = Ȧ_parent + Σ (σ̇_a q̇_a + σ_a q̈_a)`` from the
-  ground's ``[−g; 0]`` (gravity as a ground acceleration); ``F_j = Θ⁰_j Ȧ_j +
-  V_j ×* Θ⁰_j V_j``. Backward: ``τ_a = σ_aᵀ F_j``, ``F_parent += F_j``. Then
-  ``r = τ − Q_c − Q_d`` with the bushings' ``Q = −Jᵀ (C δ + D J q̇)`` over their paths
-  (as :mod:`rt70.textbook.static_kernel`) and the joint springs' ``−k q − d q̇``.
-- **The iteration matrix** ``A + X`` by the articulated-body algorithm in E0
-  (Featherstone §7.3, zero velocity): from the leaves, ``U = Iᴬ σ``,
-  ``D_j = σᵀ U + X_j``, ``Iᴬ_parent += Iᴬ_j − U D_j⁻¹ Uᵀ``; a solve passes the bias
+  ground's ``[−g; 0]`` (gravity as a ground acceleration), each moved to the child's
+  origin; ``F_j = Θ_j Ȧ_j + V_j ×* Θ_j V_j``. Backward: ``τ_a = σ_aᵀ F_j``,
+  ``F_parent += F_j`` moved to the parent's origin. Then ``r = τ − Q_c − Q_d`` with the
+  bushings' ``Q = −Jᵀ (C δ + D J q̇)`` over their paths (as
+  :mod:`rt70.textbook.static_kernel`) and the joint springs' ``−k q − d q̇``.
+- **The iteration matrix** ``A + X`` by the articulated-body algorithm (Featherstone
+  §7.3, zero velocity): from the leaves, ``U = Iᴬ σ``,
+  ``D_j = σᵀ U + X_j``, ``Iᴬ_parent += Mᵀ (Iᴬ_j − U D_j⁻¹ Uᵀ) M`` (M the move to the
+  parent's origin); a solve passes the bias
   ``pᴬ`` up and the accelerations down. ``X_j`` is pair j's own block, so bushings
   whose path is more than one pair have no place in it (:func:`pair_gains` says so).
 
@@ -68,38 +74,83 @@ def _add_cross_force(m: np.ndarray, f: np.ndarray, out: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def _place(qf, arrays, work, I0) -> None:
-    """Every pair's placement and axes (into ``work``) and its body's ``Θ⁰_j`` into ``I0``."""
+def _place(qf, arrays, work, I0, sl) -> None:
+    """Every pair's placement (into ``work``), its axes and inertia at its own origin.
+
+    ``sl[a] = [C v_a; C w_a]``: axis a at the origin ``p_j`` of its pair, in E0's axes;
+    ``I0[j] = R Θ_j Rᵀ`` with ``R = diag(C_j, C_j)``: (4.77) about ``p_j`` instead of O.
+    """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta = arrays[:8]
     C, p, _, sigma, m6, m3, v3 = work[:7]
+    origin = np.zeros(3)
     for j in range(parent.shape[0]):
         place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma, m6[0], m3, v3)
-        _ground_inertia(C[j], p[j], Theta[j], m6[1], m6[2], I0[j])
+        rows = m6[0]  # the pair's body-frame axes, as place_pair left them
+        for a in range(ndof[j]):
+            for i in range(3):
+                x, y = 0.0, 0.0
+                for m in range(3):
+                    x += C[j, i, m] * rows[a, m]
+                    y += C[j, i, m] * rows[a, 3 + m]
+                sl[q_start[j] + a, i] = x
+                sl[q_start[j] + a, 3 + i] = y
+        _ground_inertia(C[j], origin, Theta[j], m6[1], m6[2], I0[j])
 
 
 @numba.njit(cache=True)
-def _newton_euler(v, acc, gravity, arrays, sigma, I0, V, Ad, F, tmp, out, sums) -> None:
+def _shift_motion(m: np.ndarray, d: np.ndarray, out: np.ndarray) -> None:
+    """``out = [v + w × d; w]``: motion ``m = [v; w]`` from a point to the point ``+ d``."""
+    out[0] = m[0] + m[4] * d[2] - m[5] * d[1]
+    out[1] = m[1] + m[5] * d[0] - m[3] * d[2]
+    out[2] = m[2] + m[3] * d[1] - m[4] * d[0]
+    out[3], out[4], out[5] = m[3], m[4], m[5]
+
+
+@numba.njit(cache=True)
+def _add_shifted_force(f: np.ndarray, d: np.ndarray, out: np.ndarray) -> None:
+    """``out += [f_f; f_n + d × f_f]``: force ``f`` at the point ``+ d`` moved to the point."""
+    out[0] += f[0]
+    out[1] += f[1]
+    out[2] += f[2]
+    out[3] += f[3] + d[1] * f[2] - d[2] * f[1]
+    out[4] += f[4] + d[2] * f[0] - d[0] * f[2]
+    out[5] += f[5] + d[0] * f[1] - d[1] * f[0]
+
+
+@numba.njit(cache=True)
+def _newton_euler(v, acc, gravity, arrays, p, sl, I0, V, Ad, F, tmp, out, sums) -> None:
     """``τ = A q̈ + B q̇ − Q_g`` into ``out`` after :func:`_place` (module docstring).
 
-    ``sums[0]`` = T, ``sums[1] = U_g = −Σ g · m x_cm`` (the first moment ``m x_cm`` is
-    ``Θ⁰``'s lower left block ``m <x_cm>``).
+    Each body's V, Ȧ, F in E0's axes about its own origin ``p_j`` (moved between a
+    parent's origin and a child's by ``d = p_j − p_i``), so that no term carries the
+    lever arm of E0's origin. ``sums[0]`` = T, ``sums[1] = U_g = −Σ g · m x_cm``.
     """
-    parent, q_start, ndof = arrays[0], arrays[2], arrays[3]
+    parent, q_start, ndof, mass = arrays[0], arrays[2], arrays[3], arrays[8]
     T, U = 0.0, 0.0
+    d = np.empty(3)
     for j in range(parent.shape[0]):
-        U -= gravity[0] * I0[j, 5, 1] + gravity[1] * I0[j, 3, 2] + gravity[2] * I0[j, 4, 0]
+        # the first moment about p_j is Θ's lower left block m <C c>
+        U -= gravity[0] * (mass[j] * p[j, 0] + I0[j, 5, 1])
+        U -= gravity[1] * (mass[j] * p[j, 1] + I0[j, 3, 2])
+        U -= gravity[2] * (mass[j] * p[j, 2] + I0[j, 4, 0])
         i = parent[j]
-        for m in range(6):
-            V[j, m] = V[i, m] if i >= 0 else 0.0
-            Ad[j, m] = Ad[i, m] if i >= 0 else (-gravity[m] if m < 3 else 0.0)
+        if i >= 0:
+            for m in range(3):
+                d[m] = p[j, m] - p[i, m]
+            _shift_motion(V[i], d, V[j])
+            _shift_motion(Ad[i], d, Ad[j])
+        else:  # the ground: at rest, accelerating by −g (gravity), at any point
+            for m in range(6):
+                V[j, m] = 0.0
+                Ad[j, m] = -gravity[m] if m < 3 else 0.0
         for a in range(q_start[j], q_start[j] + ndof[j]):
-            s = sigma[a]
+            s = sl[a]
             _cross_motion(V[j], s, tmp[0])  # σ̇_a = W_a ×ₘ σ_a; V[j] holds W_a here
             for m in range(6):
                 Ad[j, m] += tmp[0, m] * v[a] + s[m] * acc[a]
                 V[j, m] += s[m] * v[a]
         h = tmp[1]
-        for m in range(6):  # h = Θ⁰ V (momentum), F = Θ⁰ Ȧ + V ×* h
+        for m in range(6):  # h = Θ V (momentum), F = Θ Ȧ + V ×* h
             x, y = 0.0, 0.0
             for n in range(6):
                 x += I0[j, m, n] * V[j, n]
@@ -113,11 +164,13 @@ def _newton_euler(v, acc, gravity, arrays, sigma, I0, V, Ad, F, tmp, out, sums) 
         for a in range(q_start[j], q_start[j] + ndof[j]):
             x = 0.0
             for m in range(6):
-                x += sigma[a, m] * F[j, m]
+                x += sl[a, m] * F[j, m]
             out[a] = x
-        if parent[j] >= 0:
-            for m in range(6):
-                F[parent[j], m] += F[j, m]
+        i = parent[j]
+        if i >= 0:
+            for m in range(3):
+                d[m] = p[j, m] - p[i, m]
+            _add_shifted_force(F[j], d, F[i])
     sums[0], sums[1] = T, U
 
 
@@ -230,24 +283,29 @@ def _spd_inverse(D: np.ndarray, out: np.ndarray) -> bool:
 
 
 @numba.njit(cache=True)
-def _articulated_factor(parent, q_start, ndof, sigma, I0, X, IA, U, Dinv) -> bool:
-    """``Iᴬ``, ``U = Iᴬ σ`` and ``D_j⁻¹ = (σᵀ U + X_j)⁻¹`` from the leaves; False if singular."""
+def _articulated_factor(parent, q_start, ndof, p, sl, I0, X, IA, U, Dinv) -> bool:
+    """``Iᴬ``, ``U = Iᴬ σ`` and ``D_j⁻¹ = (σᵀ U + X_j)⁻¹`` from the leaves; False if singular.
+
+    About each pair's origin, as :func:`_newton_euler`: a child's ``Iᴬ − U D⁻¹ Uᵀ`` is
+    moved to its parent's origin by ``Mᵀ I M``, ``M = [[1, −<d>], [0, 1]]``.
+    """
     IA[:] = I0
-    Y = np.empty((6, 6))
+    Y, Ia = np.empty((6, 6)), np.empty((6, 6))
+    d = np.empty(3)
     for j in range(parent.shape[0] - 1, -1, -1):
         s0, nd = q_start[j], ndof[j]
         for a in range(s0, s0 + nd):
             for m in range(6):
                 x = 0.0
                 for n in range(6):
-                    x += IA[j, m, n] * sigma[a, n]
+                    x += IA[j, m, n] * sl[a, n]
                 U[a, m] = x
         D = np.empty((nd, nd))
         for a in range(nd):
             for b in range(nd):
                 x = X[j, a, b]
                 for m in range(6):
-                    x += sigma[s0 + a, m] * U[s0 + b, m]
+                    x += sl[s0 + a, m] * U[s0 + b, m]
                 D[a, b] = x
         Di = Dinv[j, :nd, :nd]
         if not _spd_inverse(D, Di):
@@ -255,7 +313,7 @@ def _articulated_factor(parent, q_start, ndof, sigma, I0, X, IA, U, Dinv) -> boo
         i = parent[j]
         if i < 0:
             continue
-        for m in range(6):  # Y = U D⁻¹ (6 × nd), then Iᴬ_parent += Iᴬ_j − Y Uᵀ
+        for m in range(6):  # Y = U D⁻¹ (6 × nd), then Ia = Iᴬ_j − Y Uᵀ
             for b in range(nd):
                 x = 0.0
                 for a in range(nd):
@@ -266,38 +324,62 @@ def _articulated_factor(parent, q_start, ndof, sigma, I0, X, IA, U, Dinv) -> boo
                 x = IA[j, m, n]
                 for b in range(nd):
                     x -= Y[m, b] * U[s0 + b, n]
-                IA[i, m, n] += x
+                Ia[m, n] = x
+        for m in range(3):
+            d[m] = p[j, m] - p[i, m]
+        for m in range(6):  # Ia M: columns 3–5 gain −(row m's first three) × d
+            a0, a1, a2 = Ia[m, 0], Ia[m, 1], Ia[m, 2]
+            Ia[m, 3] -= a1 * d[2] - a2 * d[1]
+            Ia[m, 4] -= a2 * d[0] - a0 * d[2]
+            Ia[m, 5] -= a0 * d[1] - a1 * d[0]
+        for n in range(6):  # Mᵀ (Ia M): rows 3–5 gain d × (column n's first three)
+            b0, b1, b2 = Ia[0, n], Ia[1, n], Ia[2, n]
+            IA[i, 0, n] += b0
+            IA[i, 1, n] += b1
+            IA[i, 2, n] += b2
+            IA[i, 3, n] += Ia[3, n] + d[1] * b2 - d[2] * b1
+            IA[i, 4, n] += Ia[4, n] + d[2] * b0 - d[0] * b2
+            IA[i, 5, n] += Ia[5, n] + d[0] * b1 - d[1] * b0
     return True
 
 
 @numba.njit(cache=True)
-def _articulated_solve(parent, q_start, ndof, sigma, U, Dinv, r, pA, acc6, u, out) -> None:
+def _articulated_solve(parent, q_start, ndof, p, sl, U, Dinv, r, pA, acc6, u, out) -> None:
     """``x = (A + X)⁻¹ r`` after :func:`_articulated_factor` (module docstring)."""
     pA[:] = 0.0
     nb = parent.shape[0]
+    f, d = np.empty(6), np.empty(3)
     for j in range(nb - 1, -1, -1):
         s0, nd = q_start[j], ndof[j]
         for a in range(s0, s0 + nd):
             x = r[a]
             for m in range(6):
-                x -= sigma[a, m] * pA[j, m]
+                x -= sl[a, m] * pA[j, m]
             u[a] = x
         i = parent[j]
         if i < 0:
             continue
-        for a in range(nd):  # pᴬ_parent += pᴬ_j + U D⁻¹ u
+        for m in range(6):
+            f[m] = pA[j, m]
+        for a in range(nd):  # pᴬ_parent += pᴬ_j + U D⁻¹ u, moved to the parent's origin
             x = 0.0
             for b in range(nd):
                 x += Dinv[j, a, b] * u[s0 + b]
             for m in range(6):
-                pA[i, m] += U[s0 + a, m] * x
-        for m in range(6):
-            pA[i, m] += pA[j, m]
+                f[m] += U[s0 + a, m] * x
+        for m in range(3):
+            d[m] = p[j, m] - p[i, m]
+        _add_shifted_force(f, d, pA[i])
     for j in range(nb):
         i = parent[j]
         s0, nd = q_start[j], ndof[j]
-        for m in range(6):
-            acc6[j, m] = acc6[i, m] if i >= 0 else 0.0
+        if i >= 0:
+            for m in range(3):
+                d[m] = p[j, m] - p[i, m]
+            _shift_motion(acc6[i], d, acc6[j])
+        else:
+            for m in range(6):
+                acc6[j, m] = 0.0
         for a in range(nd):  # y = u − Uᵀ a_parent
             x = u[s0 + a]
             for m in range(6):
@@ -307,11 +389,11 @@ def _articulated_solve(parent, q_start, ndof, sigma, U, Dinv, r, pA, acc6, u, ou
             x = 0.0
             for b in range(nd):
                 x += Dinv[j, a, b] * out[s0 + b]
-            pA[j, a] = x  # pᴬ_j is spent: scratch for x
+            f[a] = x
         for a in range(nd):
-            out[s0 + a] = pA[j, a]
+            out[s0 + a] = f[a]
             for m in range(6):
-                acc6[j, m] += sigma[s0 + a, m] * pA[j, a]
+                acc6[j, m] += sl[s0 + a, m] * f[a]
 
 
 class MotionData:
@@ -336,7 +418,7 @@ class MotionData:
         self.I0, self.IA, self.X = (np.zeros((nb, 6, 6)) for _ in range(3))
         self.Dinv = np.zeros((nb, 6, 6))
         self.V, self.Ad, self.F, self.pA, self.acc6 = (np.zeros((nb, 6)) for _ in range(5))
-        self.U, self.u = np.zeros((n, 6)), np.zeros(n)
+        self.U, self.u, self.sl = np.zeros((n, 6)), np.zeros(n), np.zeros((n, 6))
         self.tmp = np.zeros((2, 6))
         ptr = static.paths[0]
         self.local = bool(np.all(np.diff(ptr) == 1))
@@ -353,7 +435,7 @@ def _placed(model: Model, data: MotionData, q: np.ndarray) -> np.ndarray:
     """Place the pairs at ``q`` unless they are placed there already; q as floats."""
     q = np.asarray(q, dtype=float)
     if not np.array_equal(q, data.placed):
-        _place(q, data.static.arrays, data.static.work, data.I0)
+        _place(q, data.static.arrays, data.static.work, data.I0, data.sl)
         data.placed[:] = q
     return q
 
@@ -385,8 +467,8 @@ def residual(
     q = _placed(model, data, q)
     out, energies = np.empty(model.nv), np.empty(4)
     v = np.asarray(v, dtype=float)
-    _newton_euler(v, np.asarray(acc, dtype=float), st.gravity, st.arrays, st.work[3], data.I0,
-                  data.V, data.Ad, data.F, data.tmp, out, energies)  # fmt: skip
+    _newton_euler(v, np.asarray(acc, dtype=float), st.gravity, st.arrays, st.work[1], data.sl,
+                  data.I0, data.V, data.Ad, data.F, data.tmp, out, energies)  # fmt: skip
     bad = _elements(q, v, st.bushes, st.damping, st.paths, st.scoord, st.sk, st.sd, st.work,
                     st.jac, out, energies[2:])  # fmt: skip
     _check(st, bad)
@@ -441,7 +523,7 @@ def articulated_factor(model: Model, data: MotionData, q: np.ndarray, X: np.ndar
     st = data.static
     _placed(model, data, q)
     parent, q_start, ndof = st.arrays[0], st.arrays[2], st.arrays[3]
-    ok = _articulated_factor(parent, q_start, ndof, st.work[3], data.I0,
+    ok = _articulated_factor(parent, q_start, ndof, st.work[1], data.sl, data.I0,
                              np.ascontiguousarray(X, dtype=float), data.IA, data.U,
                              data.Dinv)  # fmt: skip
     if not ok:
@@ -465,7 +547,7 @@ def articulated_solve(model: Model, data: MotionData, r: np.ndarray) -> np.ndarr
     st = data.static
     parent, q_start, ndof = st.arrays[0], st.arrays[2], st.arrays[3]
     out = np.empty(model.nv)
-    _articulated_solve(parent, q_start, ndof, st.work[3], data.U, data.Dinv,
+    _articulated_solve(parent, q_start, ndof, st.work[1], data.sl, data.U, data.Dinv,
                        np.ascontiguousarray(r, dtype=float), data.pA, data.acc6, data.u,
                        out)  # fmt: skip
     return out
