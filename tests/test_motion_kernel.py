@@ -16,7 +16,14 @@ import pytest
 from rt70.model.scene import load_scene, scene_from_text, scene_names
 from rt70.scenes.synthetic import elastic_chain, random_tree
 from rt70.testing import assert_close
-from rt70.textbook import dynamics, forces, mass_kernel, motion_kernel, structured
+from rt70.textbook import (
+    articulated_kernel,
+    dynamics,
+    forces,
+    mass_kernel,
+    motion_kernel,
+    structured,
+)
 
 ALL_TYPES = Path(__file__).parent / "data" / "all_joint_types.urdf"
 
@@ -63,8 +70,8 @@ def _check(scene, seed=2, spread=0.1):
         Kc, Dc = element_gains(m, scene.static_kernels, q)
         g_scale = max(np.abs(Kc).max(), np.abs(Dc).max(), 1e-300)
         assert_close(X, 0.3 * Kc + 0.7 * Dc, rel=1e-13, scale=g_scale, what="pair gains")
-    motion_kernel.articulated_factor(m, data, q, _blocks(m, X))
-    x = motion_kernel.articulated_solve(m, data, r)
+    articulated_kernel.articulated_factor(m, data, q, _blocks(m, X))
+    x = articulated_kernel.articulated_solve(m, data, r)
     S = A + X
     # a solve's residual is ε times ‖S‖ ‖x‖ (backward stability), not ε ‖r‖
     assert_close(S @ x, r, rel=1e-12, scale=np.abs(S).max() * np.abs(x).max(), what="solve")
@@ -116,4 +123,4 @@ def test_a_singular_pair_is_refused():
     X = np.zeros((m.nb, 6, 6))
     X[0] = -1e12 * np.eye(6)  # A + X not positive definite on pair 0
     with pytest.raises(Exception, match="singular"):
-        motion_kernel.articulated_factor(m, data, np.zeros(m.nv), X)
+        articulated_kernel.articulated_factor(m, data, np.zeros(m.nv), X)

@@ -31,7 +31,7 @@ from rt70.model.scene import Scene
 from rt70.simulation.generalized_alpha import SPECTRAL_RADIUS, integrate
 from rt70.simulation.integrators import GENERALIZED_ALPHA, budgeted
 from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
-from rt70.textbook import motion_kernel
+from rt70.textbook import articulated_kernel, motion_kernel
 from rt70.textbook.spatial import check_euler_pairs
 
 #: The method's name in :func:`rt70.simulation.simulate.simulate` and ``rt70 simulate``.
@@ -90,11 +90,11 @@ class CompiledEquations:
             The weights of D (s) and K (s²).
         """
         K, D = motion_kernel.pair_gains(self.model, self.data, q)
-        motion_kernel.articulated_factor(self.model, self.data, q, c_v * D + c_q * K)
+        articulated_kernel.articulated_factor(self.model, self.data, q, c_v * D + c_q * K)
 
     def solve(self, r: np.ndarray) -> np.ndarray:
         """``S⁻¹ r`` with the last factor."""
-        return motion_kernel.articulated_solve(self.model, self.data, r)
+        return articulated_kernel.articulated_solve(self.model, self.data, r)
 
 
 def run(
