@@ -143,12 +143,12 @@ def test_cli_refuses_a_model_too_large(monkeypatch, tmp_path, capsys):
 
 def test_a_refused_simulation_names_what_can_run_it():
     """The compiled kernels where they cover the model, the textbook side otherwise."""
-    from rt70.cli.simulate import _textbook_hint
+    from rt70.cli.simulate import _refusal_hint
 
     chain = scene_from_text(serial_chain(3), "chain.urdf")
-    assert "--method generalized-alpha" in _textbook_hint(chain)
+    assert "--method generalized-alpha" in _refusal_hint(chain)
     closed = load_scene("four_bar")  # a closed loop: not covered
-    assert _textbook_hint(closed).startswith("'--side textbook'")
+    assert _refusal_hint(closed).startswith("'--side textbook'")
 
 
 _MEASURE = r"""

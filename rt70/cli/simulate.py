@@ -60,7 +60,7 @@ def _simulate(args: argparse.Namespace) -> int:
     except ResourceError as exc:  # Pinocchio's Data too large: the textbook side may do
         if args.side != "reference":
             raise
-        raise ResourceError(f"{exc}; {_textbook_hint(scene)}") from None
+        raise ResourceError(f"{exc}; {_refusal_hint(scene)}") from None
     side = "compiled kernels" if result.side == "compiled" else args.side
     print(
         f"{scene.name}: {result.method} ({side}), rtol {args.rtol:g}, "
@@ -114,7 +114,7 @@ def _default_method(scene) -> str:
     return "BDF" if kernels_for(scene) is None else METHOD
 
 
-def _textbook_hint(scene) -> str:
+def _refusal_hint(scene) -> str:
     """What a refused reference-side simulation can do instead."""
     from rt70.textbook.motion_kernel import MotionData
 

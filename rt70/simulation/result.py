@@ -46,7 +46,8 @@ class SimulationResult:
     ``wall_time_s``: "rhs" (s inside the right-hand side, including the calls of a
     difference-quotient Jacobian), "jacobian" (s inside the analytic Jacobian) and
     "integrator" (the rest: the solver's own work, its linear algebra included).
-    ``nlu`` is −1 where the solver does not report it (CVODE), ``n_steps`` −1 when
+    ``nlu`` is −1 where the solver does not report it (CVODE) or factors without LU
+    (generalized-alpha, whose ``njev`` counts its iteration matrices), ``n_steps`` −1 when
     ``t_eval`` was given. ``coordinate_units`` holds each coordinate's unit ("rad" or
     "m"), ``output_units`` and ``state_units`` the outputs' and the extra states' by name;
     ``series`` holds what an analysis measured on the run (a servo scenario's references,
