@@ -87,7 +87,7 @@ def main() -> None:
     text = "\n".join([
         "# The generalized-α method against BDF",
         "",
-        f"`python validation/generalized_alpha.py`, commit {commit}, {date.today()}.",
+        f"> `python validation/generalized_alpha.py` · commit {commit} · {date.today()}",
         "",
         head,
         *rows,

@@ -203,6 +203,23 @@ def _step(problem: Problem, co: Coefficients, s: _State, h: float, tol, run: Tra
     return _State(t, q, v, qdd, a), record, err
 
 
+def _keep(run: Trajectory, s: _State, record: np.ndarray) -> None:
+    """Append an accepted state and its record to the run."""
+    run.t.append(s.t), run.q.append(s.q), run.v.append(s.v), run.qdd.append(s.qdd)
+    run.records.append(record)
+
+
+def _check_progress(t: float, t1: float, h: float, steps: int, max_steps: int | None) -> None:
+    """Stop a run whose step underflows the time's spacing or that takes too many steps."""
+    why = None
+    if h < 16 * np.spacing(max(abs(t), abs(t1))):
+        why = "the step size underflowed"
+    elif max_steps and steps > max_steps:
+        why = f"more than {max_steps} steps"
+    if why:
+        raise SimulationError(f"integration stopped at t = {t:.6g} s: {why}")
+
+
 def integrate(
     problem: Problem,
     t_span: tuple[float, float],
@@ -246,18 +263,13 @@ def integrate(
     qdd0 = -problem.solve(r0)  # A q̈0 = f, exactly: the factor of A alone
     run = Trajectory(evaluations=1, factors=1)
     s = _State(t0, q0, v0, qdd0, qdd0.copy())
-    run.t.append(t0), run.q.append(q0), run.v.append(v0), run.qdd.append(qdd0)
-    run.records.append(record)
+    _keep(run, s, record)
     scale = _rms(qdd0, _weights(*tolerances, q0))
     h = min(t1 - t0, 0.1 / np.sqrt(scale)) if scale > 0 else t1 - t0
     cap, rejected, previous = np.inf, False, 1.0
     while s.t < t1:
         h = t1 - s.t if t1 - s.t - h < 0.01 * h else h  # no sliver of a last step
-        if h < 16 * np.spacing(max(abs(s.t), abs(t1))) or (max_steps and run.n_steps > max_steps):
-            why = "the step size underflowed" if h > 0 else "no step"
-            if max_steps and run.n_steps > max_steps:
-                why = f"more than {max_steps} steps"
-            raise SimulationError(f"integration stopped at t = {s.t:.6g} s: {why}")
+        _check_progress(s.t, t1, h, run.n_steps, max_steps)
         out = _step(problem, co, s, h, tolerances, run)
         run.n_steps += 1
         if out is None:  # the iteration matrix is too far from the Jacobian at this h
@@ -274,8 +286,7 @@ def integrate(
         s = new
         if t1 - s.t <= 16 * np.spacing(abs(t1)):  # the end, but for rounding of t + h
             s.t = t1
-        run.t.append(s.t), run.q.append(s.q), run.v.append(s.v), run.qdd.append(s.qdd)
-        run.records.append(record)
+        _keep(run, s, record)
         if on_step is not None:
             on_step(s.t)
         grow = _growth(err, previous)
