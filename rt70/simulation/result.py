@@ -219,3 +219,33 @@ def coordinate_units(scene) -> list[str]:
     """
     kinds = {j.name: j.type for j in scene.description.joints}
     return ["m" if kinds.get(c) == "prismatic" else "rad" for c in scene.textbook.coordinate_names]
+
+
+def initial_energy_scale(T0: float, U_g0: float, U_c0: float) -> float:
+    """``max(T + U_c, 10⁻¹² max(|U_g|, 1), 10⁻³⁰⁰)`` at the start, J: the audit's floor.
+
+    Parameters
+    ----------
+    T0, U_g0, U_c0 : float
+        Kinetic, gravity and elastic energy at the initial state, J.
+    """
+    return max(T0 + U_c0, 1e-12 * max(abs(U_g0), 1.0), 1e-300)
+
+
+def energy_balance(
+    T: np.ndarray, U_g: np.ndarray, U_c: np.ndarray, E_psi: np.ndarray, W_u: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """``T + U_g + U_c + E_ψ − W_u`` less its initial value, and the energy exchanged.
+
+    The exchanged energy is the largest of the mechanical energy ``T + U_c``, the energy
+    dissipated and the inputs' work over the run (:attr:`SimulationResult.balance_scale`
+    is at least the initial energy scale besides, :func:`initial_energy_scale`).
+
+    Parameters
+    ----------
+    T, U_g, U_c, E_psi, W_u : numpy.ndarray, shape (n_t,)
+        Kinetic, gravity, elastic and dissipated energy and the inputs' work, J.
+    """
+    total = T + U_g + U_c + E_psi - W_u
+    exchanged = max(float(np.max(T + U_c)), float(E_psi[-1]), float(np.max(np.abs(W_u))))
+    return total - total[0], exchanged

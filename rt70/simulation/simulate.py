@@ -45,7 +45,13 @@ from rt70.simulation.integrators import (
     load,
 )
 from rt70.simulation.request import ALL_METHODS, checked_request
-from rt70.simulation.result import DRIFT_FACTOR, SimulationResult, coordinate_units
+from rt70.simulation.result import (
+    DRIFT_FACTOR,
+    SimulationResult,
+    coordinate_units,
+    energy_balance,
+    initial_energy_scale,
+)
 from rt70.simulation.states import EnergyAudit, MechanicsForces, StateComponent, StateLayout
 from rt70.textbook.massless import require_diagonal
 from rt70.textbook.spatial import check_euler_pairs
@@ -184,7 +190,7 @@ def _energy_scale(scene: Scene, backend: Backend, q0: np.ndarray, qd0: np.ndarra
             f"{scene.name}: the energy at the initial state overflows (a stiffness or mass "
             "near the largest floating-point number?)"
         )
-    return max(T0 + Uc0, 1e-12 * max(abs(Ug0), 1.0), 1e-300)
+    return initial_energy_scale(T0, Ug0, Uc0)
 
 
 def _most_samples(
@@ -352,9 +358,7 @@ def _result(
     energies = np.array([backend.energies(a, b) for a, b in zip(q, qd, strict=True)])
     states = rhs.layout.read(sol.y)
     E_psi, W_u = states["dissipated"], states["input_work"]
-    total = energies.sum(axis=1) + E_psi - W_u
-    mech = energies[:, 0] + energies[:, 2]
-    exchanged = max(float(np.max(mech)), float(E_psi[-1]), float(np.max(np.abs(W_u))))
+    balance, exchanged = energy_balance(*energies.T, E_psi, W_u)
     rtol, atol = tolerances
     wall, timing = clock
     return SimulationResult(
@@ -371,7 +375,7 @@ def _result(
         elastic=energies[:, 2],
         dissipated=E_psi,
         input_work=W_u,
-        balance=total - total[0],
+        balance=balance,
         balance_scale=max(exchanged, energy_scale),
         nfev=sol.nfev,
         njev=sol.njev,
