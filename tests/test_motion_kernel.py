@@ -63,26 +63,19 @@ def _check(scene, seed=2, spread=0.1):
     assert_close(U_g_kernel, U_g, rel=1e-12,
                  scale=max(abs(U_g), weight), what="U_g")  # fmt: skip
     K_loc, D_loc = motion_kernel.pair_gains(m, data, q)
-    X = _dense(m, 0.3 * K_loc + 0.7 * D_loc)
+    blocks = 0.3 * K_loc + 0.7 * D_loc
+    X = _dense(m, blocks)
     if data.local:  # every bushing on one pair: the blocks are all of Σ JᵀCJ and Σ JᵀDJ
         from rt70.textbook.static_kernel import element_gains
 
         Kc, Dc = element_gains(m, scene.static_kernels, q)
         g_scale = max(np.abs(Kc).max(), np.abs(Dc).max(), 1e-300)
         assert_close(X, 0.3 * Kc + 0.7 * Dc, rel=1e-13, scale=g_scale, what="pair gains")
-    articulated_kernel.articulated_factor(m, data, q, _blocks(m, X))
+    articulated_kernel.articulated_factor(m, data, q, blocks)
     x = articulated_kernel.articulated_solve(m, data, r)
     S = A + X
     # a solve's residual is ε times ‖S‖ ‖x‖ (backward stability), not ε ‖r‖
     assert_close(S @ x, r, rel=1e-12, scale=np.abs(S).max() * np.abs(x).max(), what="solve")
-
-
-def _blocks(m, X):
-    out = np.zeros((m.nb, 6, 6))
-    for j in range(m.nb):
-        s, d = m.q_start[j], m.ndof[j]
-        out[j, :d, :d] = X[s : s + d, s : s + d]
-    return out
 
 
 @pytest.mark.parametrize("target", [*scene_names(), str(ALL_TYPES)], ids=lambda t: Path(t).stem)
