@@ -43,7 +43,13 @@ import numpy as np
 
 from rt70.textbook.mass_kernel import _ground_inertia, place_pair
 from rt70.textbook.model import Model
-from rt70.textbook.static_kernel import StaticData, _bushing_rows, _check, _twist_rows
+from rt70.textbook.static_kernel import (
+    StaticData,
+    _bushing_rows,
+    _check,
+    _path_gain,
+    _twist_rows,
+)
 
 
 @numba.njit(cache=True)
@@ -211,7 +217,7 @@ def _elements(qf, v, bushes, damping, paths, scoord, sk, sd, work, jac, out, sum
 
 
 @numba.njit(cache=True)
-def _pair_gains(bushes, X, paths, scoord, sk, pair_of, q_start, work, jac, out) -> None:
+def _pair_gains(bushes, X, paths, scoord, sk, pair_of, q_start, work, jac, block, out) -> None:
     """Each pair's own block of ``Σ Jᵀ X J`` (bushings on one pair) and its joint springs' k.
 
     Into ``out`` (nb, 6, 6), after :func:`_place`; a bushing whose path is more than one
@@ -219,27 +225,17 @@ def _pair_gains(bushes, X, paths, scoord, sk, pair_of, q_start, work, jac, out) 
     """
     C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
     body1, body2, r1, c1, r2, c2, _ = bushes
-    ptr, pbody, cptr, ccol, csign = paths
+    ptr, pbody, cptr, ccol = paths[0], paths[1], paths[2], paths[3]
     out[:] = 0.0
     for k in range(body1.shape[0]):
         if ptr[k + 1] - ptr[k] != 1:
             continue
         j = pbody[ptr[k]]
         _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W)  # lock: caught by the residual
-        n = cptr[k + 1] - cptr[k]
-        for u in range(n):
-            _twist_rows(W, sigma[ccol[cptr[k] + u]], csign[cptr[k] + u], jac[u])
-        for u in range(n):
-            for i in range(6):
-                x = 0.0
-                for m in range(6):
-                    x += X[k, i, m] * jac[u, m]
-                rows[0, i] = x
-            for w in range(n):
-                x = 0.0
-                for i in range(6):
-                    x += jac[w, i] * rows[0, i]
-                out[j, ccol[cptr[k] + w] - q_start[j], ccol[cptr[k] + u] - q_start[j]] += x
+        cols = ccol[cptr[k] : cptr[k + 1]]
+        for u in range(_path_gain(k, X, paths, sigma, W, jac, rows, block)):
+            for v in range(cols.shape[0]):
+                out[j, cols[v] - q_start[j], cols[u] - q_start[j]] += block[v, u]
     for i in range(scoord.shape[0]):
         a = scoord[i]
         j = pair_of[a]
@@ -346,6 +342,6 @@ def pair_gains(model: Model, data: MotionData, q: np.ndarray) -> tuple[np.ndarra
     for X, k in ((st.bushes[6], st.sk), (st.damping, st.sd)):
         G = np.empty((model.nb, 6, 6))
         _pair_gains(st.bushes, X, st.paths, st.scoord, k, data.pair_of, st.arrays[2], st.work,
-                    st.jac, G)  # fmt: skip
+                    st.jac, st.block, G)  # fmt: skip
         out.append(G)
     return out[0], out[1]

@@ -260,7 +260,31 @@ def _spring_stiffness(qf, h, arrays, bushes, paths, work, fp, fm, K) -> int:
 
 
 @numba.njit(cache=True)
-def _gains(qf, arrays, bushes, X, paths, scoord, sk, work, jac, out) -> int:
+def _path_gain(k, X, paths, sigma, W, jac, rows, block) -> int:
+    """Bushing k's ``Jᵀ X_k J`` over its path's coordinates, after :func:`_bushing_rows`.
+
+    Into ``block[:n, :n]`` in path order (``block[v, u] = J_vᵀ X_k J_u``); returns n.
+    """
+    cptr, ccol, csign = paths[2], paths[3], paths[4]
+    n = cptr[k + 1] - cptr[k]
+    for u in range(n):
+        _twist_rows(W, sigma[ccol[cptr[k] + u]], csign[cptr[k] + u], jac[u])
+    for u in range(n):
+        for i in range(6):  # rows[0] = X J_u
+            acc = 0.0
+            for m in range(6):
+                acc += X[k, i, m] * jac[u, m]
+            rows[0, i] = acc
+        for v in range(n):
+            acc = 0.0
+            for i in range(6):
+                acc += jac[v, i] * rows[0, i]
+            block[v, u] = acc
+    return n
+
+
+@numba.njit(cache=True)
+def _gains(qf, arrays, bushes, X, paths, scoord, sk, work, jac, block, out) -> int:
     """``Σ Jᵀ X J`` over the bushings (X = C or D per bushing) and ``Σ k`` of the joint springs.
 
     Into ``out`` (n, n); returns −1, or the bushing at gimbal lock.
@@ -268,7 +292,7 @@ def _gains(qf, arrays, bushes, X, paths, scoord, sk, work, jac, out) -> int:
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta, _, _ = arrays
     C, p, theta_c, sigma, m6, m3, v3, W, rows, _ = work
     body1, body2, r1, c1, r2, c2, _ = bushes
-    cptr, ccol, csign = paths[2], paths[3], paths[4]
+    cptr, ccol = paths[2], paths[3]
     forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
                  sigma, m6, m3, v3, False)  # fmt: skip
     out[:] = 0.0
@@ -276,19 +300,9 @@ def _gains(qf, arrays, bushes, X, paths, scoord, sk, work, jac, out) -> int:
         if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
             return k
         cols = ccol[cptr[k] : cptr[k + 1]]
-        for u in range(cols.shape[0]):
-            _twist_rows(W, sigma[cols[u]], csign[cptr[k] + u], jac[u])
-        for u in range(cols.shape[0]):
-            for i in range(6):  # rows[0] = X J_u
-                acc = 0.0
-                for n in range(6):
-                    acc += X[k, i, n] * jac[u, n]
-                rows[0, i] = acc
+        for u in range(_path_gain(k, X, paths, sigma, W, jac, rows, block)):
             for v in range(cols.shape[0]):
-                acc = 0.0
-                for i in range(6):
-                    acc += jac[v, i] * rows[0, i]
-                out[cols[v], cols[u]] += acc
+                out[cols[v], cols[u]] += block[v, u]
     for i in range(scoord.shape[0]):
         out[scoord[i], scoord[i]] += sk[i]
     return -1
@@ -328,6 +342,7 @@ class StaticData:
         #: Coordinates on the longest bushing path (the size of the path buffers).
         self.widest = int(np.max(np.diff(cptr), initial=0))
         self.jac = np.empty((self.widest, 6))
+        self.block = np.empty((self.widest, self.widest))
         self.names = [b.name for b in bs]
 
     @classmethod
@@ -453,6 +468,6 @@ def element_gains(model: Model, data: StaticData, q: np.ndarray) -> tuple[np.nda
     for X, k in ((data.bushes[6], data.sk), (data.damping, data.sd)):
         G = np.empty((model.nv, model.nv))
         _check(data, _gains(qf, data.arrays, data.bushes, X, data.paths, data.scoord, k,
-                            data.work, data.jac, G))  # fmt: skip
+                            data.work, data.jac, data.block, G))  # fmt: skip
         out.append(G)
     return out[0], out[1]
