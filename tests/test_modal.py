@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 
 from rt70.errors import Rt70Error
 from rt70.linear import modal, responses
+from rt70.linear.damped import damped_modes
 from rt70.linear.state_space import StateSpace
 from rt70.plotting import modal as plots
 from rt70.testing import MIN_REL, assert_close
@@ -446,13 +447,13 @@ def test_damped_modes_proportional_pairs_and_overdamped_reals():
     M = np.diag([1.0, 2.0])
     K = np.array([[3.0, -1.0], [-1.0, 2.0]])
     und = modal.modes(M, K, 0.1 * K)
-    d = modal.damped_modes(M, K, 0.1 * K)
+    d = damped_modes(M, K, 0.1 * K)
     assert_close(d.frequencies_hz, und.freq_hz, rel=1e-12)
     assert_close(d.zeta, und.zeta, rel=1e-12)
     assert d.real.size == 0 and d.eigenvalues.size == 4
     # one mass, ζ = 2: λ = ω(−ζ ± √(ζ² − 1)), both real
     omega, zeta = 3.0, 2.0
-    d1 = modal.damped_modes(np.eye(1), np.eye(1) * omega**2, np.eye(1) * 2 * zeta * omega)
+    d1 = damped_modes(np.eye(1), np.eye(1) * omega**2, np.eye(1) * 2 * zeta * omega)
     expected = np.sort(omega * (-zeta + np.array([-1.0, 1.0]) * np.sqrt(zeta**2 - 1)))
     assert d1.oscillatory.size == 0
     assert_close(d1.real, expected, rel=1e-12)

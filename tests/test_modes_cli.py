@@ -5,6 +5,7 @@ import re
 
 from rt70.cli.main import main
 from rt70.model.scene import URDF_DIR
+from rt70.testing import assert_close
 
 PRINTED_ELEVATION_HZ = ["0.0000", "3.2700", "4.2424", "6.3041", "7.2579", "19.6420"]
 
@@ -72,10 +73,18 @@ def test_a_large_chain_goes_the_compiled_way(capsys, tmp_path):
     assert 6 * 90 > max(DENSE_MAX, compiled.LARGE_NV)
     assert main(["modes", str(path)]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("chain90: 540 modes at static equilibrium")
+    assert out.startswith(f"chain90: the {LOWEST} lowest of 540 modes (--count N|all")
     assert f"among its {2 * LOWEST} eigenvalues nearest zero (of 1080)" in out
     assert main(["modes", str(path), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
+    assert data["lowest_of"] == {"modes": 540, "unstable": 0} and len(data["modes"]) == LOWEST
+    assert main(["modes", str(path), "--json", "--count", "all"]) == 0
+    every = json.loads(capsys.readouterr().out)["modes"]
+    assert len(every) == 540
+    low, dense = data["modes"], every[:LOWEST]
+    assert [m["kind"] for m in low] == [m["kind"] for m in dense]
+    freq = [m["freq_hz"] for m in dense]
+    assert_close([m["freq_hz"] for m in low], freq, rel=1e-8, scale=freq)
     damped = data["damped"]
     assert (damped["eigenvalues_found"], damped["eigenvalues_total"]) == (2 * LOWEST, 1080)
     assert len(damped["oscillatory"]) == LOWEST

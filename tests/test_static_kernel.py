@@ -16,6 +16,7 @@ from rt70.crosscheck.robots import load_robot
 from rt70.errors import SingularConfigurationError
 from rt70.linear import compiled, modal
 from rt70.linear import linearize as lin
+from rt70.linear.damped import damped_modes
 from rt70.linear.damped_lowest import lowest_damped_modes
 from rt70.model.scene import load_scene, scene_from_text, scene_names
 from rt70.scenes.synthetic import elastic_chain, random_tree
@@ -129,7 +130,7 @@ def test_lowest_damped_modes_equal_the_dense_ones(chain20):
     """ARPACK's shift-invert eigenvalues are the dense eig's nearest zero, to rounding."""
     scene = chain20
     lm = lin.linearize(scene, lin.equilibrium(scene))
-    dense = modal.damped_modes(lm.M, lm.K, lm.D)
+    dense = damped_modes(lm.M, lm.K, lm.D)
     undamped = modal.modes(lm.M, lm.K)
     some = lowest_damped_modes(lm.M, lm.K, lm.D, 10, float(undamped.omega[0]))
     assert some.eigenvalues.size == 20

@@ -15,8 +15,15 @@ from rt70.cli import options
 from rt70.errors import SceneError, SingularConfigurationError
 
 
+def _count(text: str) -> int | str:
+    """``--count``: a positive integer, or ``all``."""
+    return text if text == "all" else options.positive_int(text)
+
+
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add ``rt70 modes`` to the command line's subparsers ``sub``; return its parser."""
+    from rt70.linear.lowest_modes import DENSE_MAX, LOWEST
+
     mod = sub.add_parser(
         "modes",
         help="eigenfrequencies and mode shapes at static equilibrium",
@@ -32,6 +39,13 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--lock-axes",
         action="store_true",
         help="remove the azimuth and elevation coordinates (drives infinitely stiff)",
+    )
+    mod.add_argument(
+        "--count",
+        type=_count,
+        metavar="N|all",
+        help="the N modes nearest zero (the lowest), found by shift-invert Lanczos; default "
+        f"all up to {DENSE_MAX} coordinates, the lowest {LOWEST} above",
     )
     mod.add_argument("--json", action="store_true", help="print JSON")
     mod.add_argument(
@@ -58,10 +72,13 @@ def run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     has_axes, elevation, azimuth, held = options.asked_pointing(args, scene, "modes")
-    result, shapes, model, damped, constraints = _spectrum(args, scene, held)
+    result, shapes, model, damped, constraints, partial = _spectrum(args, scene, held)
     drives = bool(scene.description.drives) and not args.lock_axes
     rows = mode_table.mode_rows(result, shapes, model.M, model.coordinates, args.json)
-    damped_summary = mode_table.damped_summary(result, damped)
+    if isinstance(args.count, int):
+        rows = rows[: args.count]
+    n = result.n if partial is None else partial["modes"]
+    damped_summary = mode_table.damped_summary(result, damped, n)
     options.check_finite({"modes": rows, "damped": damped_summary}, f"{scene.name}: modes")
     if args.plot is not None:
         _plot(args, scene, model, result, shapes)
@@ -71,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
             "held": held,
             "locked_rotor": drives,
             **({"constraints": constraints} if constraints is not None else {}),
+            **({"lowest_of": partial} if partial is not None else {}),
             "modes": rows,
             "damped": damped_summary,
             "units": {
@@ -85,11 +103,18 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(out, indent=2))
         return 0
     where = f", elevation {elevation:g}°, azimuth {azimuth:g}°" if has_axes else ""
-    what = f"{len(rows)} modes at static equilibrium{where}{_manifold(constraints)}"
+    what = f"{_how_many(rows, partial)} at static equilibrium{where}{_manifold(constraints)}"
     print(f"{scene.name}: {what}{_axes(args, scene, held, drives)}")
-    _print_table(rows, result, damped)
-    _print_unheld(rows, held, args.lock_axes)
+    _print_table(rows, result, damped, n)
+    _print_unheld(rows, held, args.lock_axes, partial)
     return 0
+
+
+def _how_many(rows: list[dict], partial: dict | None) -> str:
+    """The title's count: every mode, or the lowest found of how many."""
+    if partial is None:
+        return f"{len(rows)} modes"
+    return f"the {len(rows)} lowest of {partial['modes']} modes (--count N|all for others)"
 
 
 #: Frames of one cycle in an animated mode plot.
@@ -144,9 +169,10 @@ def _spectrum(args: argparse.Namespace, scene, held: dict) -> tuple:
     from rt70.linear import linearize as lin
     from rt70.linear import modal
     from rt70.linear.damped_lowest import damped_spectrum
+    from rt70.linear.lowest_modes import lowest_modes
     from rt70.textbook.massless import require_diagonal
 
-    constraints = None
+    constraints = partial = None
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
             if scene.description.loops:  # on the manifold Φ(q) = 0 (docs/constrained-modes.md)
@@ -160,10 +186,33 @@ def _spectrum(args: argparse.Namespace, scene, held: dict) -> tuple:
         raise SingularConfigurationError(f"{scene.name}: {exc}") from None
     if constraints is None:
         require_diagonal(model.M, model.coordinates, f"{scene.name}: ")
-        result = modal.modes(model.M, model.K, model.D)
+        n = model.M.shape[0]
+        count = _wanted(args.count, n)
+        if count is None:
+            result = modal.modes(model.M, model.K, model.D)
+        else:
+            result, unstable = lowest_modes(model.M, model.K, model.D, count)
+            partial = {"modes": n, "unstable": unstable}
         shapes = result.shapes
         damped = damped_spectrum(model.M, model.K, model.D, result)
-    return result, shapes, model, damped, constraints
+    if partial is None and isinstance(args.count, int) and args.count < result.n:
+        partial = {"modes": result.n, "unstable": int(result.negative.sum())}
+    return result, shapes, model, damped, constraints, partial
+
+
+def _wanted(count: int | str | None, n: int) -> int | None:
+    """How many modes the Lanczos solver finds; None: every mode, by the dense ``eigh``.
+
+    Every mode when asked (``all``), by default up to
+    :data:`rt70.linear.lowest_modes.DENSE_MAX` coordinates, and
+    when ARPACK cannot find that many (more than n − 2); the table then shows ``--count``.
+    """
+    from rt70.linear.lowest_modes import DENSE_MAX, LOWEST
+
+    if count == "all" or (count is None and n <= DENSE_MAX):
+        return None
+    count = LOWEST if count is None else int(count)
+    return None if count > n - 2 else count
 
 
 def _loop_modes(args: argparse.Namespace, scene, held: dict) -> tuple:
@@ -214,8 +263,11 @@ def _axes(args: argparse.Namespace, scene, held: dict, drives: bool) -> str:
     return " (axes locked)" if args.lock_axes and held else ""
 
 
-def _print_table(rows: list[dict], result, damped) -> None:
-    """The modes' table and the line on the damping and the damped system's eigenvalues."""
+def _print_table(rows: list[dict], result, damped, n: int) -> None:
+    """The modes' table and the line on the damping and the damped system's eigenvalues.
+
+    ``n`` is the number of modes of the model (more than the rows when some were found).
+    """
     print(f"{'mode':>4} {'f, Hz':>10} {'ξ':>8}  {'kind':<8} dominant coordinate (energy)")
     for r in rows:
         zeta = "" if r["zeta"] is None else f"{r['zeta']:.4f}"
@@ -226,7 +278,7 @@ def _print_table(rows: list[dict], result, damped) -> None:
         + ("" if result.proportional else " (approximate: the damping is not proportional)")
         + f"; the damped system has {len(damped.oscillatory)} oscillatory pairs and "
         f"{len(damped.real)} real eigenvalues (creeping motions: overdamped, rigid, unstable)"
-        + _found(damped, len(result.freq_hz))
+        + _found(damped, n)
     )
 
 
@@ -236,9 +288,20 @@ def _found(damped, n: int) -> str:
     return "" if found == 2 * n else f" among its {found} eigenvalues nearest zero (of {2 * n})"
 
 
-def _print_unheld(rows: list[dict], held: dict, lock_axes: bool) -> None:
-    """One line per unstable or rigid mode: what it is and what would hold it."""
+def _print_unheld(rows: list[dict], held: dict, lock_axes: bool, partial: dict | None) -> None:
+    """One line per unstable or rigid mode: what it is and what would hold it.
+
+    With modes found in part, also the unstable modes beyond them (counted by inertia).
+    """
     hint = "; --lock-axes lets the drives hold it" if held and not lock_axes else ""
+    beyond = (
+        0 if partial is None else partial["unstable"] - sum(r["kind"] == "unstable" for r in rows)
+    )
+    if beyond > 0:
+        print(
+            f"{beyond} more unstable mode(s) lie beyond the modes shown (counted by the "
+            f"inertia of K − σM; --count all lists every mode){hint}"
+        )
     for r in rows:
         if r["kind"] == "unstable":
             print(

@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             q0 = lin.equilibrium(scene, held)
-            ss = pl.plant(scene, q0, inputs, outputs)
+            ss = pl.plant_matrices(scene, q0, inputs, outputs)
     except SingularConfigurationError as exc:
         raise SingularConfigurationError(f"{scene.name}: {exc}") from None
     # from K v = ω² M v, not from eig(A): a rigid mode's double pole at 0 splits by
@@ -124,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
         "units": UNITS,
     }
     if args.reduce is not None:  # modal or balanced truncation, and what it costs
-        ss = _reduce(args, scene, method, ss, info)
+        ss = _reduce(args, scene, method, ss.state_space(), info)
     _write(args, scene, ss, info)
     if args.json:
         print(json.dumps(info, indent=2))

@@ -51,6 +51,8 @@ def _square(name: str, X: np.ndarray, n: int | None = None) -> np.ndarray:
 def _symmetric(name: str, X: np.ndarray, n: int | None = None) -> np.ndarray:
     """Square, finite and symmetric up to rounding; returns the symmetric part."""
     X = _square(name, X, n)
+    if scipy.linalg.issymmetric(X):  # exactly: a copy (the check below is 10× slower)
+        return np.array(X, dtype=float)
     scale = np.max(np.abs(X))
     asym = np.max(np.abs(X - X.T))
     if asym > SYMMETRY_RTOL * scale:

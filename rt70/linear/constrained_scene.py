@@ -35,6 +35,7 @@ from rt70.errors import Rt70Error
 from rt70.linear import constrained as cm
 from rt70.linear import constrained_equilibrium, manifold, modal, mode_table
 from rt70.linear import linearize as lin
+from rt70.linear.damped import damped_modes
 from rt70.model.scene import Scene
 from rt70.model.sides import side_of
 
@@ -304,7 +305,7 @@ def spectrum(model: SceneConstrainedModel) -> tuple[modal.Modes, np.ndarray, Any
         "rank": red.rank,
         "multipliers": model.equilibrium.lam[: model.loop_rows].tolist(),
     }
-    return result.modes, result.shapes, modal.damped_modes(red.M_r, red.K_r, red.D_r), constraints
+    return result.modes, result.shapes, damped_modes(red.M_r, red.K_r, red.D_r), constraints
 
 
 def constrained_modes(model: SceneConstrainedModel) -> dict:

@@ -28,6 +28,7 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.linear.checks import _mass, _matrix, _square, _symmetric
+from rt70.linear.sparsity import sparse_if_sparse
 
 #: Default rigid-mode tolerance, relative to the largest ``|ω²|``.
 RIGID_RTOL = 1e-10
@@ -44,6 +45,10 @@ PROPORTIONAL_RTOL = 1e-8
 @dataclass(frozen=True)
 class Modes:
     """Eigenfrequencies and mode shapes of ``K v = ω² M v`` (formalism §2).
+
+    All n modes of n coordinates from :func:`modes`; the k nearest zero from
+    :func:`rt70.linear.lowest_modes.lowest_modes` (the arrays below then have k entries
+    where they say n, and ``shapes`` is n × k).
 
     Attributes
     ----------
@@ -91,7 +96,7 @@ class Modes:
 
     @property
     def n(self) -> int:
-        """Number of modes (= number of coordinates)."""
+        """Number of modes (the number of coordinates when every mode was found)."""
         return self.omega2.size
 
     @property
@@ -164,8 +169,37 @@ def modes(
     reported as non-proportional, as it physically is.
     """
     omega2, V, D = _eigh(M, K, D)
-    scale = float(np.max(np.abs(omega2)))
-    rigid, negative, rigid_tol = _classify(omega2, rigid_tol)
+    return finished_modes(omega2, V, D, float(np.max(np.abs(omega2))), rigid_tol)
+
+
+def finished_modes(
+    omega2: np.ndarray,
+    V: np.ndarray,
+    D: np.ndarray | None,
+    scale: float,
+    rigid_tol: float | None = None,
+) -> Modes:
+    """:class:`Modes` from eigenpairs: classified, clusters rotated, signs fixed, ξ.
+
+    The steps of :func:`modes` after the eigensolver (its Notes), shared with the modes
+    found in part (:mod:`rt70.linear.lowest_modes`).
+
+    Parameters
+    ----------
+    omega2 : ndarray, shape (k,)
+        Eigenvalues, ascending.
+    V : ndarray, shape (n, k)
+        Their M-orthonormal eigenvectors (rotated in place within clusters).
+    D : ndarray, shape (n, n), or None
+        Symmetric damping matrix (checked).
+    scale : float
+        The largest ``|ω²|`` of the whole spectrum: the rigid and cluster tolerances are
+        relative to it.
+    rigid_tol : float, optional
+        As :func:`modes` takes it (default ``RIGID_RTOL · scale``).
+    """
+    rigid_tol = _rigid_tolerance(rigid_tol, scale)
+    rigid, negative = np.abs(omega2) <= rigid_tol, omega2 < -rigid_tol
     Z = None
     if D is not None:
         Z = _diagonalise_clusters(V, D, np.where(rigid, 0.0, omega2), CLUSTER_RTOL * scale)
@@ -248,7 +282,7 @@ def _diagonalise_clusters(
     ``omega2`` has the rigid modes' eigenvalues set to 0 (they form one cluster); the
     rotations are orthogonal, so ``VᵀMV = 1`` is kept (:func:`modes`, Notes).
     """
-    Z = V.T @ D @ V
+    Z = V.T @ (sparse_if_sparse(D) @ V)
     for idx in _clusters(omega2, tol):
         _, R = np.linalg.eigh(Z[np.ix_(idx, idx)])
         V[:, idx] = V[:, idx] @ R
@@ -315,7 +349,7 @@ def residuals(M: np.ndarray, K: np.ndarray, modes: Modes) -> dict[str, float]:
     M = _square("M", M)
     n = M.shape[0]
     K = _square("K", K, n)
-    V = _matrix("modes.shapes", modes.shapes, (n, n))
+    V = _matrix("modes.shapes", modes.shapes, (n, modes.n))
     w2 = modes.omega2
     R = K @ V - (M @ V) * w2
     nK, nM = np.linalg.norm(K, 2), np.linalg.norm(M, 2)
@@ -325,7 +359,7 @@ def residuals(M: np.ndarray, K: np.ndarray, modes: Modes) -> dict[str, float]:
     return {
         "eigen": float(np.max(nR / (max(nK, np.finfo(float).tiny) * nv))),
         "eigen_backward": float(np.max(nR / ((nK + np.abs(w2) * nM) * nv))),
-        "orthonormality": float(np.max(np.abs(V.T @ M @ V - np.eye(n)))),
+        "orthonormality": float(np.max(np.abs(V.T @ M @ V - np.eye(modes.n)))),
         "stiffness_diagonal": float(np.max(np.abs(V.T @ K @ V - np.diag(w2))) / scale),
     }
 
@@ -413,74 +447,3 @@ def principal_coordinates(
     V = modes.shapes
     Z = np.zeros((n, n)) if D is None else V.T @ _square("D", D, n) @ V
     return np.diag(modes.omega2), Z
-
-
-@dataclass(frozen=True)
-class DampedModes:
-    """Eigenvalues of the damped system ``M q̈ + D q̇ + K q = 0`` (its state matrix).
-
-    The undamped modes' ξ = (VᵀDV)_ii / 2ω_i is exact only for proportional damping; the
-    damped system's own eigenvalues λ say without approximation which motions oscillate
-    (a complex pair ``−ξω ± iω√(1−ξ²)``) and which creep (real λ: overdamped, or rigid
-    at λ = 0, or unstable at λ > 0).
-
-    Attributes
-    ----------
-    eigenvalues : ndarray, shape (2n,)
-        λ of ``[[0, 1], [−M⁻¹K, −M⁻¹D]]``, complex, sorted by ``|λ|``.
-    oscillatory : ndarray of complex
-        One λ of each complex pair (positive imaginary part), by frequency.
-    real : ndarray of float
-        The real eigenvalues (1/s), ascending.
-    """
-
-    eigenvalues: np.ndarray
-    oscillatory: np.ndarray
-    real: np.ndarray
-
-    @property
-    def frequencies_hz(self) -> np.ndarray:
-        """Natural frequencies ``|λ|/2π`` of the oscillatory pairs, Hz.
-
-        For a mode under proportional damping it is the undamped ω/2π; ``Im λ`` is the
-        damped frequency.
-        """
-        return np.abs(self.oscillatory) / (2.0 * np.pi)
-
-    @property
-    def zeta(self) -> np.ndarray:
-        """Damping ratios ``−Re λ / |λ|`` of the oscillatory pairs."""
-        return -self.oscillatory.real / np.abs(self.oscillatory)
-
-
-def damped_modes(
-    M: np.ndarray, K: np.ndarray, D: np.ndarray, real_rtol: float = 1e-9
-) -> DampedModes:
-    """Eigenvalues of the damped system, split into oscillatory pairs and real ones.
-
-    Parameters
-    ----------
-    M, K, D : ndarray, shape (n, n)
-        Mass (symmetric positive definite), stiffness and damping matrices.
-    real_rtol : float
-        An eigenvalue with ``|Im λ| ≤ real_rtol · |λ|`` (or ``|λ|`` at rounding level)
-        is real.
-    """
-    M, _ = _mass(M)  # symmetric positive definite, or a clear error
-    n = M.shape[0]
-    K = _square("K", K, n)
-    D = _square("D", D, n)
-    A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = np.eye(n)
-    A[n:, :n] = -scipy.linalg.solve(M, K, assume_a="pos")
-    A[n:, n:] = -scipy.linalg.solve(M, D, assume_a="pos")
-    return split_damped(scipy.linalg.eigvals(A), real_rtol)
-
-
-def split_damped(lam: np.ndarray, real_rtol: float = 1e-9) -> DampedModes:
-    """Eigenvalues ``lam`` of a damped system sorted by ``|λ|`` and split (:func:`damped_modes`)."""
-    lam = lam[np.argsort(np.abs(lam), kind="stable")]
-    scale = max(float(np.max(np.abs(lam))), 1.0)
-    is_real = np.abs(lam.imag) <= real_rtol * np.maximum(np.abs(lam), 1e-12 * scale)
-    pairs = lam[~is_real & (lam.imag > 0)]
-    return DampedModes(lam, pairs[np.argsort(np.abs(pairs))], np.sort(lam[is_real].real))

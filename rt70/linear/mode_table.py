@@ -11,7 +11,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rt70.linear.modal import DampedModes, Modes
+from rt70.linear.damped import DampedModes
+from rt70.linear.modal import Modes
 
 
 def mode_rows(
@@ -74,8 +75,18 @@ def mode_rows(
     return rows
 
 
-def damped_summary(result: Modes, damped: DampedModes) -> dict:
-    """The damped system's oscillatory pairs and real eigenvalues, as ``rt70 modes`` lists them."""
+def damped_summary(result: Modes, damped: DampedModes, n: int | None = None) -> dict:
+    """The damped system's oscillatory pairs and real eigenvalues, as ``rt70 modes`` lists them.
+
+    Parameters
+    ----------
+    result : Modes
+        The undamped modes (their damping's proportionality).
+    damped : DampedModes
+        The damped system's eigenvalues (all, or those found nearest zero).
+    n : int, optional
+        The number of coordinates (default: the modes of ``result``, all of them).
+    """
     return {
         "oscillatory": [
             {"freq_hz": float(f), "zeta": float(z)}
@@ -85,5 +96,5 @@ def damped_summary(result: Modes, damped: DampedModes) -> dict:
         "proportional": bool(result.proportional),
         # how many of the state matrix's 2n eigenvalues these are (rt70.linear.damped_lowest)
         "eigenvalues_found": len(damped.eigenvalues),
-        "eigenvalues_total": 2 * len(result.freq_hz),
+        "eigenvalues_total": 2 * (len(result.freq_hz) if n is None else n),
     }

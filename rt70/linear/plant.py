@@ -17,7 +17,8 @@ One call, :func:`plant`, linearises a scene about a static equilibrium
 
 The result is a python-control ``StateSpace`` (:class:`rt70.linear.state_space.StateSpace`,
 which also keeps the second-order model) with its state, input and output names, for
-Bode plots, margins and loop design there. Do not
+Bode plots, margins and loop design there; :func:`plant_matrices` gives the same matrices
+and names without importing python-control (what ``rt70 plant --out`` writes). Do not
 convert a high-order, lightly damped plant to a transfer function (``ss2tf``): the
 polynomial coefficients lose the resonances (``scipy.signal.bode`` via ``ss2tf`` is off
 by 24 dB at 1 Hz on the RT-70); evaluate the state space
@@ -36,7 +37,8 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
-from rt70.linear.responses import state_space
+from rt70.linear.responses import system_matrices
+from rt70.linear.system_matrices import SystemMatrices
 from rt70.model.outputs import Output, column_labels, output_matrix
 from rt70.model.scene import Scene
 from rt70.physics.loads import Wrench
@@ -131,7 +133,31 @@ def plant(
     outputs: Sequence[PlantOutput],
     locked: Sequence[str] = (),
 ) -> StateSpace:
-    """The linear plant about the equilibrium ``q0`` with named inputs and outputs.
+    """The linear plant about the equilibrium ``q0``: :func:`plant_matrices` in python-control.
+
+    Parameters
+    ----------
+    scene, q0, inputs, outputs, locked
+        As :func:`plant_matrices` takes them.
+
+    Returns
+    -------
+    StateSpace
+        A python-control ``StateSpace`` with its second-order model; states ``q…`` and
+        ``q…_dot`` named by coordinate; frequency responses by
+        :func:`rt70.linear.responses.frequency_response`.
+    """
+    return plant_matrices(scene, q0, inputs, outputs, locked).state_space()
+
+
+def plant_matrices(
+    scene: Scene,
+    q0: np.ndarray,
+    inputs: Sequence[PlantInput],
+    outputs: Sequence[PlantOutput],
+    locked: Sequence[str] = (),
+) -> SystemMatrices:
+    """The linear plant's matrices about the equilibrium ``q0``, inputs and outputs named.
 
     Parameters
     ----------
@@ -149,10 +175,10 @@ def plant(
 
     Returns
     -------
-    StateSpace
-        A python-control ``StateSpace`` with its second-order model; states ``q…`` and
-        ``q…_dot`` named by coordinate; frequency responses by
-        :func:`rt70.linear.responses.frequency_response`.
+    SystemMatrices
+        A, B, C, D with the signals' names and the second-order model
+        (:meth:`~rt70.linear.system_matrices.SystemMatrices.state_space`: the python-control
+        system).
 
     Raises
     ------
@@ -172,7 +198,7 @@ def plant(
         repeated = sorted(n for n, count in Counter(names).items() if count > 1)
         if repeated:
             raise Rt70Error(f"{scene.name}: {kind} names used twice: {', '.join(repeated)}")
-    return state_space(
+    return system_matrices(
         lm.M,
         lm.K,
         lm.D,

@@ -30,6 +30,7 @@ from rt70.errors import Rt70Error
 from rt70.linear.checks import _columns, _mass, _matrix, _names, _rows, _square
 from rt70.linear.modal import Modes
 from rt70.linear.second_order import SecondOrder
+from rt70.linear.system_matrices import SystemMatrices
 
 if TYPE_CHECKING:
     import control
@@ -52,25 +53,24 @@ def _assemble(
     input_names: tuple[str, ...],
     output_names: tuple[str, ...],
     rate_suffix: str,
-) -> StateSpace:
-    from rt70.linear.state_space import StateSpace
-
+) -> SystemMatrices:
     n, m = B_in.shape
-    MinvK = scipy.linalg.cho_solve(chol, K)
-    MinvD = scipy.linalg.cho_solve(chol, D)
-    MinvB = scipy.linalg.cho_solve(chol, B_in)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-MinvK, -MinvD]])
-    B = np.vstack([np.zeros((n, m)), MinvB])
-    C = np.hstack([C_out, C_vel])
+    solved = scipy.linalg.cho_solve(chol, np.hstack([K, D, B_in]), check_finite=False)
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -solved[:, :n]
+    A[n:, n:] = -solved[:, n : 2 * n]
+    B = np.zeros((2 * n, m))
+    B[n:] = solved[:, 2 * n :]
     states = coord_names + tuple(f"{s}{rate_suffix}" for s in coord_names)
-    return StateSpace(
+    return SystemMatrices(
         A,
         B,
-        C,
+        np.hstack([C_out, C_vel]),
         D_ff,
-        states=states,
-        inputs=input_names,
-        outputs=output_names,
+        state_labels=states,
+        input_labels=tuple(input_names),
+        output_labels=tuple(output_names),
         second_order=SecondOrder(M, K, D, B_in, C_out, C_vel, D_ff),
     )
 
@@ -92,7 +92,7 @@ def _io(
     return B_in, C_out, C_vel, D_ff
 
 
-def state_space(
+def system_matrices(
     M: np.ndarray,
     K: np.ndarray,
     D: np.ndarray | None,
@@ -104,8 +104,8 @@ def state_space(
     coord_names: Sequence[str] | None = None,
     input_names: Sequence[str] | None = None,
     output_names: Sequence[str] | None = None,
-) -> StateSpace:
-    """State space of ``M q̈ + D q̇ + K q = B_in u``, ``y = C_out q + C_vel q̇ + D_ff u``.
+) -> SystemMatrices:
+    """The state-space matrices of ``M q̈ + D q̇ + K q = B_in u``, ``y = C_out q + C_vel q̇ + D_ff u``.
 
     With ``x = [q; q̇]``::
 
@@ -135,8 +135,9 @@ def state_space(
 
     Returns
     -------
-    StateSpace
-        Also remembers the second-order matrices for :func:`frequency_response`.
+    SystemMatrices
+        With the second-order matrices; :meth:`~SystemMatrices.state_space` gives the
+        python-control system (:func:`state_space`).
     """
     M, chol = _mass(M)
     n = M.shape[0]
@@ -157,6 +158,47 @@ def state_space(
         _names(output_names, "y", C_out.shape[0], "output"),
         "_dot",
     )
+
+
+def state_space(
+    M: np.ndarray,
+    K: np.ndarray,
+    D: np.ndarray | None,
+    B_in: np.ndarray,
+    C_out: np.ndarray,
+    C_vel: np.ndarray | None = None,
+    D_ff: np.ndarray | None = None,
+    *,
+    coord_names: Sequence[str] | None = None,
+    input_names: Sequence[str] | None = None,
+    output_names: Sequence[str] | None = None,
+) -> StateSpace:
+    """The python-control system of :func:`system_matrices` (its formulas and checks).
+
+    Parameters
+    ----------
+    M, K, D, B_in, C_out, C_vel, D_ff : numpy.ndarray
+        As :func:`system_matrices` takes them.
+    coord_names, input_names, output_names : sequence of str, optional
+        Labels, as :func:`system_matrices`.
+
+    Returns
+    -------
+    StateSpace
+        Also remembers the second-order matrices for :func:`frequency_response`.
+    """
+    return system_matrices(
+        M,
+        K,
+        D,
+        B_in,
+        C_out,
+        C_vel,
+        D_ff,
+        coord_names=coord_names,
+        input_names=input_names,
+        output_names=output_names,
+    ).state_space()
 
 
 def modal_state_space(
@@ -225,7 +267,7 @@ def modal_state_space(
         _names(input_names, "u", B_in.shape[1], "input"),
         _names(output_names, "y", C_out.shape[0], "output"),
         "_dot",
-    )
+    ).state_space()
 
 
 # ----------------------------------------------------------------------------- responses

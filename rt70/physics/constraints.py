@@ -75,6 +75,8 @@ class HolonomicMap:
     def reduce_matrix(self, M_full: np.ndarray) -> np.ndarray:
         """``Tᵀ M T``: a mass, stiffness or damping matrix on the independent coordinates."""
         if self.columns is not None:
+            if self.columns.size == len(self.full_names):  # nothing locked: T = 1
+                return np.array(M_full, dtype=float)
             return np.asarray(M_full)[np.ix_(self.columns, self.columns)]
         return self.T.T @ M_full @ self.T
 

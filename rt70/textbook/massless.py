@@ -46,9 +46,12 @@ def probe_configuration(model: Model) -> np.ndarray:
     return np.random.default_rng(PROBE_SEED).uniform(-0.5, 0.5, model.nv)
 
 
-def _term_scale(model: Model, q: np.ndarray) -> np.ndarray:
-    """``B_i``: the size of the terms summed into each diagonal entry ``A_ii``."""
-    bdata = structured.BatchData(model, 1)
+def _term_scale(model: Model, q: np.ndarray, bdata: structured.BatchData) -> np.ndarray:
+    """``B_i``: the size of the terms summed into each diagonal entry ``A_ii``.
+
+    ``bdata`` is a :class:`~rt70.textbook.structured.BatchData` of ``model`` for one
+    configuration (its topology is reused).
+    """
     topo, work = bdata.topology, bdata.work(1)
     structured.forward_kinematics_batch(model, work, model.expand(q)[None, :])
     theta0 = structured.ground_inertias(model, work)[0]
@@ -82,10 +85,11 @@ def singular_coordinates(model: Model) -> tuple[list[str], list[str]]:
     if model.nv == 0:
         return [], []
     q = probe_configuration(model)
-    A = structured.mass_matrix(model, structured.BatchData(model, 1), q)
+    bdata = structured.BatchData(model, 1)
+    A = structured.mass_matrix(model, bdata, q)
     diag = np.diag(A).copy()
     names = model.coordinate_names
-    massless = diag <= MASSLESS_RTOL * _term_scale(model, q)
+    massless = diag <= MASSLESS_RTOL * _term_scale(model, q, bdata)
     if np.any(massless):
         return [n for n, m in zip(names, massless, strict=True) if m], []
     scale = 1.0 / np.sqrt(diag)

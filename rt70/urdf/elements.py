@@ -8,6 +8,7 @@ file, the element and the attribute (docs/urdf-reader.md).
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -77,29 +78,39 @@ class ElementReader:
             MagnitudeError beyond :data:`MAX_MAGNITUDE`.
         """
         raw = elem.get(attr)
+        if raw is not None:
+            try:
+                values = [float(tok) for tok in raw.split()]
+            except ValueError:
+                values = []
+            if len(values) == count and all(abs(v) <= MAX_MAGNITUDE for v in values):
+                return np.array(values, dtype=float)  # NaN fails the comparison too
+        elif default is not None:
+            return np.array(default, dtype=float)
+        raise self._bad_numbers(elem, attr, count, owner)
+
+    def _bad_numbers(self, elem: ET.Element, attr: str, count: int, owner: str) -> UrdfError:
+        """The error of an attribute that :meth:`numbers` refused (to be raised)."""
+        raw = elem.get(attr)
         tag = f"{owner} <{tag_of(elem)}" if owner else f"<{tag_of(elem)}"
         bad = ExtensionError if tag_of(elem).startswith("rt70:") else UrdfError
         if raw is None:
-            if default is None:
-                raise self.fail(bad, f"{tag}> lacks attribute '{attr}'")
-            return np.array(default, dtype=float)
+            return self.fail(bad, f"{tag}> lacks attribute '{attr}'")
         try:
-            values = np.array([float(tok) for tok in raw.split()], dtype=float)
+            values = [float(tok) for tok in raw.split()]
         except ValueError:
-            raise self.fail(bad, f'{tag} {attr}="{raw}">: not a list of numbers') from None
-        if values.size != count:
-            raise self.fail(
-                bad, f'{tag} {attr}="{raw}">: expected {count} numbers, got {values.size}'
+            return self.fail(bad, f'{tag} {attr}="{raw}">: not a list of numbers')
+        if len(values) != count:
+            return self.fail(
+                bad, f'{tag} {attr}="{raw}">: expected {count} numbers, got {len(values)}'
             )
-        if not np.all(np.isfinite(values)):
-            raise self.fail(NonFiniteError, f'{tag} {attr}="{raw}">: NaN or infinite value')
-        if np.any(np.abs(values) > MAX_MAGNITUDE):
-            raise self.fail(
-                MagnitudeError,
-                f'{tag} {attr}="{raw}">: magnitude above {MAX_MAGNITUDE:g}, the largest number '
-                "rt70 reads (docs/urdf-reader.md)",
-            )
-        return values
+        if not all(math.isfinite(v) for v in values):
+            return self.fail(NonFiniteError, f'{tag} {attr}="{raw}">: NaN or infinite value')
+        return self.fail(
+            MagnitudeError,
+            f'{tag} {attr}="{raw}">: magnitude above {MAX_MAGNITUDE:g}, the largest number '
+            "rt70 reads (docs/urdf-reader.md)",
+        )
 
     def number(
         self, elem: ET.Element, attr: str, default: float | None = None, owner: str = ""
