@@ -42,6 +42,13 @@ this form reaches 1e-15).
    :func:`~rt70.linear.modal.finished_modes` classifies them, rotates clusters and
    computes ``VᵀDV`` (k × k) as for the full spectrum.
 
+:func:`rt70.fe.modes.lowest_modes` does the same for a finite-element model's sparse M
+and K (SuperLU in nested-dissection order). A model in the book's joint coordinates is
+dense instead — the tree couples each coordinate to its ancestors' — so this module
+factors by LAPACK, works in the standard form above, and returns the
+:class:`~rt70.linear.modal.Modes` of :func:`~rt70.linear.modal.modes` (rigid and unstable
+flags, clusters, damping) that ``rt70 modes`` prints.
+
 The modes are exact to the eigensolver's tolerance, not those of a reduced model; the
 tests hold them equal to the dense solution's lowest k.
 """

@@ -6,7 +6,8 @@ A hanging chain of 334 bodies on the book's 6-DOF elastic pairs
 as subprocesses, each timed (wall) with its peak resident memory (``os.wait4``'s
 ``ru_maxrss``):
 
-- ``rt70 modes FILE``: ≤ :data:`MODES_TARGET_S`;
+- ``rt70 modes FILE`` (its default above 500 coordinates: the 20 lowest modes, by
+  shift-invert Lanczos, :mod:`rt70.linear.lowest_modes`): ≤ :data:`MODES_TARGET_S`;
 - ``rt70 plant FILE --out FILE.npz``: ≤ :data:`PLANT_TARGET_S`;
 - ``rt70 simulate FILE --t-end 1``: ≤ :data:`SIMULATE_TARGET_S`;
 
