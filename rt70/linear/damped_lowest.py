@@ -6,7 +6,8 @@ development machine, where the undamped ``eigh`` takes 1.8 s. An engineer asks o
 model what its lowest modes do; this module finds exactly those eigenvalues by ARPACK's
 implicitly restarted Arnoldi on the shifted inverse ``(A − σ1)⁻¹``, whose largest
 eigenvalues ``μ = 1/(λ − σ)`` are the λ nearest the shift. One product with the inverse
-is two triangular solves with a single LU of the n × n ``P = K + σD + σ²M``:
+is two triangular solves with a single factor of the n × n ``P = K + σD + σ²M``
+(Cholesky when it is positive definite, else an LU):
 
 ``y₁ = −P⁻¹ (M x₂ + (D + σM) x₁)``, ``y₂ = x₁ + σ y₁``.
 
@@ -22,8 +23,10 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse.linalg
 
+from rt70.linear.checks import _symmetric
 from rt70.linear.damped import DampedModes, damped_modes, split_damped
 from rt70.linear.lowest_modes import DENSE_MAX, LOWEST
+from rt70.linear.solvers import positive_definite_solver
 from rt70.linear.sparsity import sparse_if_sparse
 
 
@@ -56,15 +59,20 @@ def lowest_damped_modes(
         Of the eigenvalues found only, sorted by ``|λ|``.
     """
     n = M.shape[0]
+    M, K = _symmetric("M", M, n), _symmetric("K", K, n)
     sigma = -0.01 * omega_low if omega_low > 0 else -1e-3
-    lu = scipy.linalg.lu_factor(K + sigma * D + sigma**2 * M)
+    shifted = K + sigma * D + sigma**2 * M
+    solve = positive_definite_solver(shifted)
+    if solve is None:  # not symmetric (D) or not positive definite: an LU
+        lu = scipy.linalg.lu_factor(shifted)
+        solve = lambda r: scipy.linalg.lu_solve(lu, r, check_finite=False)  # noqa: E731
     damping = sparse_if_sparse(D)
 
     def apply(x: np.ndarray) -> np.ndarray:
         x = np.asarray(x).ravel()
         x1, x2 = x[:n], x[n:]
         rhs = M @ (x2 + sigma * x1) + damping @ x1  # M x₂ + (D + σM) x₁
-        y1 = -scipy.linalg.lu_solve(lu, rhs, check_finite=False)
+        y1 = -solve(rhs)
         return np.concatenate([y1, x1 + sigma * y1])
 
     op = scipy.sparse.linalg.LinearOperator((2 * n, 2 * n), matvec=apply, dtype=float)
