@@ -16,6 +16,7 @@ The names a user starts with are exported here and imported on first use::
     run = rt70.simulate(scene, (0.0, 1.0))  # with the energy audit
 """
 
+from rt70._version import __version__
 from rt70.errors import (
     DtdError,
     ExtensionError,
@@ -53,21 +54,13 @@ _EXPORTS = {
 
 
 def __getattr__(name: str):
-    """The exported names of :data:`_EXPORTS`, imported on first use, and ``__version__``.
-
-    ``rt70.__version__`` is the installed distribution's version (pyproject.toml's), read
-    from the package metadata.
-    """
+    """The exported names of :data:`_EXPORTS`, imported on first use."""
     if name in _EXPORTS:
         from importlib import import_module
 
         value = getattr(import_module(_EXPORTS[name]), name)
         globals()[name] = value  # later look-ups skip this function
         return value
-    if name == "__version__":
-        from importlib.metadata import version
-
-        return version("rt70")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

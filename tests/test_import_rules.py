@@ -86,7 +86,7 @@ RULES = {
 #: role). A module may import its own folder and any folder on a lower floor; folders on
 #: one floor are independent of each other (the two sides of the cross-check above all).
 FLOORS = (
-    ("rt70.errors", "rt70.testing", "rt70.units"),
+    ("rt70._version", "rt70.errors", "rt70.testing", "rt70.units"),
     ("rt70.guards", "rt70.bondgraph"),
     ("rt70.physics", "rt70.fe", "rt70.surface"),
     ("rt70.urdf",),

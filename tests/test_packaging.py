@@ -11,6 +11,7 @@ index.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -48,12 +49,20 @@ def _run(cmd: list[str], cwd: Path, timeout: float = HANG_GUARD_S) -> subprocess
     return proc
 
 
+#: What the wheel is not built from (the copy of the tree leaves them out).
+NOT_SOURCE = (".git", ".venv", "build", "*.egg-info", "__pycache__", ".*_cache")
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory) -> Path:
     """``bin/`` of a fresh venv with the wheel of this tree installed."""
     tmp = tmp_path_factory.mktemp("wheel")
     pip = [sys.executable, "-m", "pip"]
-    _run([*pip, "wheel", "-q", "--no-deps", "-w", str(tmp / "dist"), str(ROOT)], tmp)
+    # a copy: pip builds in the source tree (its build/), and two test workers at once
+    # would collide there ("File exists: build/bdist…")
+    source = tmp / "source"
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(*NOT_SOURCE))
+    _run([*pip, "wheel", "-q", "--no-deps", "-w", str(tmp / "dist"), str(source)], tmp)
     wheels = list((tmp / "dist").glob("rt70-*.whl"))
     assert len(wheels) == 1
     _run([sys.executable, "-m", "venv", str(tmp / "venv")], tmp)
@@ -94,15 +103,19 @@ def test_installed_package_ships_the_wind_tables(installed, tmp_path):
 
 
 def test_installed_package_is_typed_and_knows_its_version(installed, tmp_path):
-    """The PEP 561 marker ships in the wheel; --version reads the wheel's metadata."""
+    """The PEP 561 marker ships in the wheel; --version and the wheel's metadata agree."""
     code = "from importlib.resources import files; print(files('rt70').joinpath('py.typed'))"
     proc = _run([str(installed / "python"), "-c", code], tmp_path)
     marker = Path(proc.stdout.strip())
     assert marker.is_file() and marker.stat().st_size == 0
     assert not str(marker).startswith(str(ROOT))
     proc = _run([str(installed / "rt70"), "--version"], tmp_path)
-    version = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
-    assert proc.stdout == f"rt70 {version['project']['version']}\n"
+    from rt70._version import __version__
+
+    assert proc.stdout == f"rt70 {__version__}\n"
+    proc = _run([str(installed / "python"), "-c", "import importlib.metadata as m; "
+                 "print(m.version('rt70'))"], tmp_path)  # fmt: skip
+    assert proc.stdout == f"{__version__}\n"
 
 
 def test_core_install_without_robots_says_which_extra(installed, tmp_path):

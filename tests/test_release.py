@@ -1,8 +1,8 @@
 """The release's metadata agrees with itself (issue 22, part 5).
 
-The version has one source, ``[project] version`` in pyproject.toml: ``rt70 --version``
-and ``rt70.__version__`` read it from the installed package's metadata; CHANGELOG.md's
-latest release and CITATION.cff name the same version and date. The wheel's contents
+The version has one source, ``rt70/_version.py``: pyproject.toml reads it into the
+package's metadata (``dynamic``), ``rt70 --version`` and ``rt70.__version__`` import it;
+CHANGELOG.md's latest release and CITATION.cff name the same version and date. The wheel's contents
 (the ``py.typed`` marker) are checked in tests/test_packaging.py.
 """
 
@@ -21,7 +21,18 @@ from rt70.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
-VERSION = PYPROJECT["project"]["version"]
+VERSION = re.search(
+    r'^__version__ = "(\d+\.\d+\.\d+)"$',
+    (ROOT / "rt70" / "_version.py").read_text(encoding="utf-8"),
+    re.M,
+).group(1)
+
+
+def test_pyproject_reads_the_one_version():
+    assert "version" not in PYPROJECT["project"]
+    assert PYPROJECT["project"]["dynamic"] == ["version"]
+    dynamic = PYPROJECT["tool"]["setuptools"]["dynamic"]["version"]
+    assert dynamic == {"attr": "rt70._version.__version__"}
 
 
 def test_version_option_prints_the_installed_version(capsys):

@@ -61,17 +61,16 @@ class Parser(argparse.ArgumentParser):
 
 
 def version_line() -> str:
-    """What ``rt70 --version`` prints: ``rt70 X.Y.Z``, the installed version (pyproject's)."""
-    import rt70
+    """What ``rt70 --version`` prints: ``rt70 X.Y.Z`` (:mod:`rt70._version`)."""
+    from rt70._version import __version__
 
-    return f"rt70 {rt70.__version__}"
+    return f"rt70 {__version__}"
 
 
 class PrintVersion(argparse.Action):
     """``--version``: print :func:`version_line` and exit 0.
 
-    The version is read from the package metadata only when the option is given, so
-    other commands do not pay for the lookup.
+    The version is :mod:`rt70._version`'s, the one the package metadata is built from.
     """
 
     def __init__(

@@ -73,7 +73,11 @@ class HolonomicMap:
         return self.T.T @ Q_full
 
     def reduce_matrix(self, M_full: np.ndarray) -> np.ndarray:
-        """``Tᵀ M T``: a mass, stiffness or damping matrix on the independent coordinates."""
+        """``Tᵀ M T``: a mass, stiffness or damping matrix on the independent coordinates.
+
+        When nothing is locked (T = 1) that is a copy of ``M_full`` (it may be a work
+        buffer, e.g. the textbook's ``data.A``).
+        """
         if self.columns is not None:
             if self.columns.size == len(self.full_names):  # nothing locked: T = 1
                 return np.array(M_full, dtype=float)
