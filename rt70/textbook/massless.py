@@ -93,7 +93,9 @@ def singular_coordinates(model: Model) -> tuple[list[str], list[str]]:
     if np.any(massless):
         return [n for n, m in zip(names, massless, strict=True) if m], []
     scale = 1.0 / np.sqrt(diag)
-    scaled = scale[:, None] * A * scale[None, :]
+    scaled = A  # the work buffer, scaled in place (no n × n temporaries)
+    scaled *= scale[:, None]
+    scaled *= scale[None, :]
     try:
         factor = scipy.linalg.cholesky(scaled, lower=True)
         if np.min(np.diag(factor)) ** 2 > MASSLESS_RTOL:
