@@ -3,6 +3,8 @@
 import json
 import re
 
+import pytest
+
 from rt70.cli.main import main
 from rt70.model.scene import URDF_DIR
 from rt70.testing import assert_close
@@ -89,3 +91,22 @@ def test_a_large_chain_goes_the_compiled_way(capsys, tmp_path):
     assert (damped["eigenvalues_found"], damped["eigenvalues_total"]) == (2 * LOWEST, 1080)
     assert len(damped["oscillatory"]) == LOWEST
     assert all(0.0 < o["zeta"] < 1.0 for o in damped["oscillatory"])  # 1 % bushing damping
+
+
+def test_a_bad_count_is_one_line_naming_the_option(capsys):
+    for bad in ("0", "al", "-3"):
+        with pytest.raises(SystemExit) as exc:
+            main(["modes", "rt70_elevation", "--count", bad])
+        assert exc.value.code == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "--count" in err and "'all'" in err
+
+
+def test_count_picks_the_lowest_modes_of_a_small_model(capsys):
+    """Lanczos on the book's 6-coordinate elevation model: its rigid mode and the lowest
+    elastic ones, as the dense solution has them (the book's 3.2700 and 4.2424 Hz)."""
+    assert main(["modes", "rt70_elevation", "--count", "3", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["lowest_of"] == {"modes": 6, "unstable": 0}
+    assert [m["kind"] for m in data["modes"]] == ["rigid", "elastic", "elastic"]
+    assert_close([m["freq_hz"] for m in data["modes"][1:]], [3.2700, 4.2424], rel=2e-5)

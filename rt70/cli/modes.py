@@ -17,7 +17,14 @@ from rt70.errors import SceneError, SingularConfigurationError
 
 def _count(text: str) -> int | str:
     """``--count``: a positive integer, or ``all``."""
-    return text if text == "all" else options.positive_int(text)
+    if text == "all":
+        return text
+    try:
+        return options.positive_int(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(
+            f"expected a number of modes (1 or more) or 'all', got {text!r}"
+        ) from None
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
