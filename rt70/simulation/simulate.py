@@ -35,6 +35,7 @@ from rt70.physics.baumgarte import DEFAULT_STABILIZATION, Baumgarte
 from rt70.simulation import compiled_run
 from rt70.simulation.backends import BACKENDS, Backend
 from rt70.simulation.closed_chains import constrained_start, residual_trajectory
+from rt70.simulation.coupling import Coupling
 from rt70.simulation.integrators import (
     CVODE_METHODS,
     GENERALIZED_ALPHA,
@@ -232,6 +233,7 @@ class _RightHandSide:
         self.t0, self.t1 = t_span
         self.reached = self.t0
         self.pushed = False
+        self.coupling: Coupling | None = None
         self.bar = None
 
     def input_force(self, t: float, x: np.ndarray) -> np.ndarray | None:
@@ -265,11 +267,19 @@ class _RightHandSide:
         return out
 
     def jacobian(self, t: float, x: np.ndarray) -> np.ndarray:
-        """``∂ẋ/∂x`` from the backend's analytic Jacobian; zero in the extra states' rows."""
+        """``∂ẋ/∂x``: the backend's analytic Jacobian, the components' couplings by differences.
+
+        :mod:`rt70.simulation.coupling` (found at the first call); the rows of the
+        components that push no force (the energy audit) are zero.
+        """
         n, size = self.n, self.layout.size
         q, qd = x[:n], x[n : 2 * n]
-        J = np.zeros((2 * n + size, 2 * n + size))  # zero for extra states
+        J = np.zeros((2 * n + size, 2 * n + size))
         J[: 2 * n, : 2 * n] = self.backend.jacobian(q, qd, self.input_force(t, x))
+        if self.coupling is None:
+            self.coupling = Coupling(self, t, x)
+        if not self.coupling.empty:
+            self.coupling.complete(J, self, t, x)
         if not np.isfinite(J).all():
             raise SimulationError("the Jacobian of the right-hand side is not finite")
         return J

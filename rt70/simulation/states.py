@@ -14,9 +14,11 @@ and velocities of the mechanics, then the states ``s_i`` of every
   (:meth:`StateComponent.force`: what a drive does with its motor current). That force
   is added to the input force ``Q_u``: the energy audit counts it as input work.
 
-The rows and columns of the extra states in the analytic Jacobian of the implicit
-methods are zero, and it holds no derivative of a component's force: the solver's
-Newton iteration treats them explicitly (it converges, more slowly if they are stiff).
+The analytic Jacobian of the implicit methods gets the couplings of the components that
+push a force — their rows, their states' columns, and the coordinates that reach them —
+by differences over those columns (:mod:`rt70.simulation.coupling`); the rows of the
+components that only watch (the energy audit) are zero: the solver's Newton iteration
+treats them explicitly.
 
 The first component is the energy audit (:class:`EnergyAudit`, (1.73)), which every
 simulation carries; drives with motor states come next. The simulation's result holds
