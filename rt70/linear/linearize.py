@@ -40,7 +40,6 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.linear import compiled
-from rt70.linear.solvers import positive_definite_solver
 from rt70.model.scene import Scene
 from rt70.model.sides import Side, check_side, side_of
 from rt70.physics.constraints import HolonomicMap, locking
@@ -288,9 +287,6 @@ def _factor(scene: Scene, K: np.ndarray, names: tuple[str, ...]):
             f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
             "largest floating-point number?)"
         )
-    solve = positive_definite_solver(K)
-    if solve is not None:  # a stable equilibrium's stiffness: half an LU's work
-        return solve
     with warnings.catch_warnings():
         warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
         try:
