@@ -7,13 +7,22 @@ coordinates it reads, and its states' derivatives depend on the mechanics: witho
 those terms the implicit methods' Newton iteration treats the drives explicitly, and
 LSODA took a new Jacobian every 2.5 evaluations holding ``rt70_servo``.
 
-:class:`Coupling` finds once, at the start, which columns of ``x = [q, q̇, s]`` reach
-``Q_u`` or a pushing component's derivative (a drive reads its axis and motor
-coordinates, not the structure's hundreds), and at every Jacobian replaces those
-columns' ``q̈`` rows and the pushing components' rows by forward differences of the
-right-hand side, one evaluation per column, step ``√ε · max(|x_j|, 1)``. The columns
-of the other states and the rows of components that only watch (the energy audit: a
-quadrature that feeds nothing back) stay as they are.
+:class:`Coupling` finds once, at the first Jacobian, which columns of ``x = [q, q̇, s]``
+reach ``Q_u`` or a pushing component's derivative, and which entries of those each
+column moves (a drive reads its axis and motor coordinates, not the structure's
+hundreds). It probes at a slightly moved state, so that a dependence that happens to
+vanish at the start (a current of zero) is not missed. At every Jacobian it then
+differences those entries forward, step ``√ε · max(|x_j|, 1)``:
+
+- Columns that move disjoint entries share one evaluation (Curtis, Powell & Reid 1974).
+  The azimuth drive's columns pair with the elevation drive's, for example.
+- An evaluation is of the components alone: ``Q_u`` and the pushing derivatives, not
+  the mechanics.
+- The ``q̈`` rows gain ``M⁻¹ ΔQ_u / h``, one Cholesky solve for all columns. q̈ is
+  linear in ``Q_u``, and the backend's block holds ``Q_u`` fixed.
+
+The columns of the other states, and the rows of components that only watch, stay as
+they are. The energy audit is such a component: a quadrature that feeds nothing back.
 """
 
 from __future__ import annotations
@@ -26,15 +35,18 @@ from rt70.simulation.states import MechanicsForces, StateLayout
 #: Relative forward-difference step (the square root of the machine epsilon).
 FD_RSTEP = float(np.sqrt(np.finfo(float).eps))
 
+#: Seed of the slightly moved state the couplings are probed at.
+PROBE_SEED = 20261127
+
 
 class Coupling:
-    """The columns and rows the components couple, found at ``(t, x)`` (module docstring).
+    """The entries the components couple, found at ``(t, x)`` (module docstring).
 
     Parameters
     ----------
-    rhs : callable
-        The right-hand side ``f(t, x)`` (with ``input_force(t, x)``, ``backend`` and
-        ``layout`` attributes: rt70.simulation.simulate's).
+    rhs : object
+        The right-hand side (rt70.simulation.simulate's: ``input_force(t, x)``,
+        ``backend``, ``layout``).
     t : float
         Time of the start, s.
     x : numpy.ndarray
@@ -44,16 +56,19 @@ class Coupling:
     def __init__(self, rhs, t: float, x: np.ndarray) -> None:
         layout: StateLayout = rhs.layout
         n = self.nv = layout.nv
-        pushing = [(c, where) for c, where in layout.pushing]
+        pushing = list(layout.pushing)
         #: Rows of the pushing components' states.
         self.rows = np.concatenate(
             [np.arange(w.start, w.stop) for _, w in pushing] or [np.zeros(0, dtype=int)]
-        )
-        states = self.rows  # their own columns always couple
-        reach = _reaching(rhs, pushing, t, x, n)
-        #: Columns replaced by differences: the coordinates and rates that reach the
-        #: components, then the pushing components' states.
-        self.columns = np.concatenate([np.flatnonzero(reach), states]).astype(int)
+        ).astype(int)
+        #: Per coupled column of x, the entries of ``[Q_u; ṡ_pushing]`` it moves.
+        self.patterns: dict[int, np.ndarray] = {}
+        if pushing:
+            self.patterns = _patterns(rhs, pushing, t, _probe_state(x, n), self.rows)
+        #: The coupled columns, ascending.
+        self.columns = np.array(sorted(self.patterns), dtype=int)
+        #: Groups of columns that move disjoint entries: one evaluation each.
+        self.groups = _groups(self.patterns, n + self.rows.size)
 
     @property
     def empty(self) -> bool:
@@ -63,19 +78,15 @@ class Coupling:
     def complete(self, J: np.ndarray, rhs, t: float, x: np.ndarray) -> np.ndarray:
         """Add the components' couplings to ``J`` (in place; module docstring).
 
-        For each coupled column j, with ``x' = x + h e_j``: the ``q̈`` rows gain
-        ``M⁻¹ (Q_u(x') − Q_u(x)) / h`` (q̈ is linear in ``Q_u``: the backend's block holds
-        ``Q_u`` fixed), and the pushing components' rows are their derivatives' forward
-        differences. The mechanics' damper force passed to the components is the one at
-        x (none of rt70's drives reads it).
+        The mechanics' damper force passed to the components is the one at x (none of
+        rt70's drives reads it).
 
         Parameters
         ----------
         J : numpy.ndarray, shape (N, N)
             The Jacobian with the backend's mechanics block.
         rhs : object
-            The right-hand side (rt70.simulation.simulate's: ``input_force``,
-            ``backend``, ``layout``).
+            The right-hand side, as for the constructor.
         t : float
             Time, s.
         x : numpy.ndarray, shape (N,)
@@ -85,44 +96,67 @@ class Coupling:
         q, qd = x[:n], x[n : 2 * n]
         Q0 = rhs.input_force(t, x)
         _, Qd = rhs.backend.accelerations(q, qd, Q0)
-        mass = scipy.linalg.cho_factor(rhs.backend.mass_matrix(q))
-        ds0 = _pushing_derivatives(pushing, t, x, n, MechanicsForces(Qd, Q0))
-        for j in self.columns:
-            h = FD_RSTEP * max(abs(float(x[j])), 1.0)
+        base = _components(rhs, pushing, t, x, n, Qd)
+        dQ = np.zeros((n, self.columns.size))
+        where = {j: k for k, j in enumerate(self.columns)}
+        for group in self.groups:
+            steps = {j: FD_RSTEP * max(abs(float(x[j])), 1.0) for j in group}
             shifted = x.copy()
-            shifted[j] += h
-            Q = rhs.input_force(t, shifted)
-            if Q is not None and Q0 is not None:
-                J[n : 2 * n, j] += scipy.linalg.cho_solve(mass, (Q - Q0) / h)
-            ds = _pushing_derivatives(pushing, t, shifted, n, MechanicsForces(Qd, Q))
-            J[self.rows, j] = (ds - ds0) / h
+            for j, h in steps.items():
+                shifted[j] += h
+            change = _components(rhs, pushing, t, shifted, n, Qd) - base
+            for j, h in steps.items():
+                entries = self.patterns[j]
+                forces, states = entries[entries < n], entries[entries >= n]
+                dQ[forces, where[j]] = change[forces] / h
+                J[self.rows[states - n], j] = change[states] / h
+        if self.columns.size:
+            mass = scipy.linalg.cho_factor(rhs.backend.mass_matrix(q))
+            J[n : 2 * n, self.columns] += scipy.linalg.cho_solve(mass, dQ)
         return J
 
 
-def _pushing_derivatives(pushing: list, t: float, x: np.ndarray, n: int, forces) -> np.ndarray:
-    """The pushing components' state derivatives at ``x``, concatenated in row order."""
+def _components(rhs, pushing: list, t: float, x: np.ndarray, n: int, Qd: np.ndarray) -> np.ndarray:
+    """``[Q_u; ṡ_pushing]`` at ``x`` (``Q_u`` zero when there is none)."""
+    Q = rhs.input_force(t, x)
+    forces = MechanicsForces(Qd, Q)
     q, qd = x[:n], x[n : 2 * n]
-    return np.concatenate(
-        [np.asarray(c.derivative(t, q, qd, x[w], forces), dtype=float) for c, w in pushing]
-    )
+    ds = [np.asarray(c.derivative(t, q, qd, x[w], forces), dtype=float) for c, w in pushing]
+    return np.concatenate([np.zeros(n) if Q is None else Q, *ds])
 
 
-def _reaching(rhs, pushing: list, t: float, x: np.ndarray, n: int) -> np.ndarray:
-    """Which of the 2n coordinate and rate columns change ``Q_u`` or a pushing derivative."""
-    reach = np.zeros(2 * n, dtype=bool)
-    if not pushing:
-        return reach
-    base_Q = rhs.input_force(t, x)
-    forces = MechanicsForces(np.zeros(n), base_Q)
-    base_ds = [c.derivative(t, x[:n], x[n : 2 * n], x[w], forces) for c, w in pushing]
-    for j in range(2 * n):
+def _probe_state(x: np.ndarray, n: int) -> np.ndarray:
+    """``x`` moved by a fixed pseudo-random 1e-6 of each entry's size (at least 1e-6)."""
+    rng = np.random.default_rng(PROBE_SEED)
+    return x + 1e-6 * np.maximum(np.abs(x), 1.0) * rng.uniform(-1.0, 1.0, x.size)
+
+
+def _patterns(rhs, pushing: list, t: float, x: np.ndarray, rows: np.ndarray) -> dict:
+    """For each column of x that moves ``[Q_u; ṡ_pushing]``, the entries it moves."""
+    n = rhs.layout.nv
+    Qd = np.zeros(n)
+    base = _components(rhs, pushing, t, x, n, Qd)
+    patterns = {}
+    for j in [*range(2 * n), *rows]:
         shifted = x.copy()
         shifted[j] += FD_RSTEP * max(abs(float(x[j])), 1.0)
-        Q = rhs.input_force(t, shifted)
-        if Q is not None and base_Q is not None and np.any(Q != base_Q):
-            reach[j] = True
-            continue
-        q, qd = shifted[:n], shifted[n : 2 * n]
-        ds = [c.derivative(t, q, qd, shifted[w], forces) for c, w in pushing]
-        reach[j] = any(np.any(a != b) for a, b in zip(ds, base_ds, strict=True))
-    return reach
+        moved = np.flatnonzero(_components(rhs, pushing, t, shifted, n, Qd) != base)
+        if moved.size:
+            patterns[int(j)] = moved
+    return patterns
+
+
+def _groups(patterns: dict, size: int) -> list[list[int]]:
+    """Greedy groups of columns whose entries are disjoint (Curtis, Powell & Reid)."""
+    groups: list[tuple[list[int], np.ndarray]] = []
+    for j, entries in patterns.items():
+        for columns, used in groups:
+            if not used[entries].any():
+                columns.append(j)
+                used[entries] = True
+                break
+        else:
+            used = np.zeros(size, dtype=bool)
+            used[entries] = True
+            groups.append(([j], used))
+    return [columns for columns, _ in groups]
