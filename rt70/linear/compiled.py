@@ -64,7 +64,6 @@ class Kernels:
         model = self.scene.textbook
         M = mass_kernel.mass_matrix(model, mass_kernel.KernelData(model), q)
         D = element_gains(model, self.scene.static_kernels, q)[1]
-        D = 0.5 * (D + D.T)  # ΣJᵀDJ is symmetric; its products round unevenly
         K, K_gravity = self._stiffness(q)
         return M, K, D, K_gravity
 

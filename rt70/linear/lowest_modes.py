@@ -62,7 +62,7 @@ from scipy.linalg import blas
 
 from rt70.errors import Rt70Error
 from rt70.linear.checks import _mass, _symmetric
-from rt70.linear.modal import RIGID_RTOL, Modes, finished_modes
+from rt70.linear.modal import Modes, _classify, _rigid_tolerance, finished_modes
 from rt70.linear.solvers import symmetric_solver
 
 #: Up to this many coordinates every mode is found by default, undamped and damped (dense
@@ -115,12 +115,12 @@ def lowest_modes(
         raise Rt70Error(f"lowest modes: count must be between 1 and {n - 2}, got {count}")
     L = np.asfortranarray(chol[0])  # lower; BLAS and LAPACK read that triangle only
     scale = largest_eigenvalue(L, K)
-    tol = RIGID_RTOL * scale if rigid_tol is None else rigid_tol
+    tol = _rigid_tolerance(rigid_tol, scale)
     if not tol > 0:
         raise Rt70Error(f"lowest modes: rigid_tol must be positive, got {rigid_tol}")
     solve, unstable = symmetric_solver(K + tol * M)
     omega2, V = _lanczos(L, K, M, solve, count)
-    rigid = np.abs(omega2) <= tol
+    rigid, _, _ = _classify(omega2, tol, scale)
     if rigid.any() and not rigid.all():  # again, the shift halfway to the nearest non-rigid
         solve, _ = symmetric_solver(K + 0.5 * float(np.min(np.abs(omega2[~rigid]))) * M)
         omega2, V = _lanczos(L, K, M, solve, count)

@@ -198,8 +198,7 @@ def finished_modes(
     rigid_tol : float, optional
         As :func:`modes` takes it (default ``RIGID_RTOL · scale``).
     """
-    rigid_tol = _rigid_tolerance(rigid_tol, scale)
-    rigid, negative = np.abs(omega2) <= rigid_tol, omega2 < -rigid_tol
+    rigid, negative, rigid_tol = _classify(omega2, rigid_tol, scale)
     Z = None
     if D is not None:
         Z = _diagonalise_clusters(V, D, np.where(rigid, 0.0, omega2), CLUSTER_RTOL * scale)
@@ -236,16 +235,19 @@ def unheld_counts(M: np.ndarray, K: np.ndarray) -> tuple[int, int]:
     """
     M, _ = _mass(M)
     omega2 = scipy.linalg.eigh(_symmetric("K", K, M.shape[0]), M, eigvals_only=True)
-    rigid, negative, _ = _classify(omega2, None)
+    rigid, negative, _ = _classify(omega2, None, float(np.max(np.abs(omega2))))
     return int(negative.sum()), int(rigid.sum())
 
 
-def _classify(omega2: np.ndarray, rigid_tol: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+def _classify(
+    omega2: np.ndarray, rigid_tol: float | None, scale: float
+) -> tuple[np.ndarray, np.ndarray, float]:
     """``(rigid, negative, rigid_tol)``: ``|ω²| ≤ rigid_tol`` and ``ω² < −rigid_tol``.
 
-    ``rigid_tol`` as :func:`modes` takes it (default ``RIGID_RTOL · max|ω²|``).
+    ``rigid_tol`` as :func:`modes` takes it (default ``RIGID_RTOL · scale``, ``scale`` the
+    largest ``|ω²|`` of the whole spectrum).
     """
-    tol = _rigid_tolerance(rigid_tol, float(np.max(np.abs(omega2))))
+    tol = _rigid_tolerance(rigid_tol, scale)
     return np.abs(omega2) <= tol, omega2 < -tol, tol
 
 

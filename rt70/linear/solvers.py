@@ -1,6 +1,6 @@
-"""Factor once, solve many times: the dense symmetric solves of the eigensolvers and Newton.
+"""Factor once, solve many times: the dense symmetric solves of the eigensolvers.
 
-Lanczos, Arnoldi and Newton apply the inverse of one matrix to a vector at a time. For a
+Lanczos and Arnoldi apply the inverse of one matrix to a vector at a time. For a
 matrix of thousands of rows these solves are bound by memory (a 2004-row factor is
 32 MB, read twice per solve), and the way they are called matters:
 
@@ -27,23 +27,18 @@ from rt70.errors import Rt70Error
 Solve = Callable[[np.ndarray], np.ndarray]
 
 
-def cholesky_solver(factor: np.ndarray, lower: bool) -> Solve:
-    """``x ↦ A⁻¹x`` from A's Cholesky factor, by two triangular solves (module docstring).
+def cholesky_solver(L: np.ndarray) -> Solve:
+    """``x ↦ A⁻¹x`` from A's lower Cholesky factor, by two triangular solves (module docstring).
 
     Parameters
     ----------
-    factor : ndarray, shape (n, n)
-        The triangular factor (L with ``A = LLᵀ`` when ``lower``, else U with ``A = UᵀU``);
-        the other triangle is not read.
-    lower : bool
-        Which triangle ``factor`` holds.
+    L : ndarray, shape (n, n)
+        The factor, ``A = LLᵀ``; its upper triangle is not read.
     """
-    first, second = ("N", "T") if lower else ("T", "N")
 
     def solve(x: np.ndarray) -> np.ndarray:
-        y = scipy.linalg.solve_triangular(factor, x, lower=lower, trans=first, check_finite=False)
-        return scipy.linalg.solve_triangular(factor, y, lower=lower, trans=second,
-                                             check_finite=False)  # fmt: skip
+        y = scipy.linalg.solve_triangular(L, x, lower=True, check_finite=False)
+        return scipy.linalg.solve_triangular(L, y, lower=True, trans="T", check_finite=False)
 
     return solve
 
@@ -69,7 +64,7 @@ def positive_definite_solver(A: np.ndarray) -> Solve | None:
     rcond, info = lapack.dpocon(L, np.linalg.norm(A, 1), uplo="L")
     if info != 0 or rcond < np.finfo(float).eps:
         return None
-    return cholesky_solver(L, True)
+    return cholesky_solver(L)
 
 
 def symmetric_solver(A: np.ndarray) -> tuple[Solve, int]:
@@ -91,7 +86,7 @@ def symmetric_solver(A: np.ndarray) -> tuple[Solve, int]:
     """
     try:
         L = scipy.linalg.cholesky(A, lower=True, check_finite=False)
-        return cholesky_solver(L, True), 0
+        return cholesky_solver(L), 0
     except np.linalg.LinAlgError:
         pass
     lwork, _ = lapack.dsytrf_lwork(A.shape[0], lower=1)

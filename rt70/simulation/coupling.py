@@ -64,7 +64,7 @@ class Coupling:
         #: Per coupled column of x, the entries of ``[Q_u; ṡ_pushing]`` it moves.
         self.patterns: dict[int, np.ndarray] = {}
         if pushing:
-            self.patterns = _patterns(rhs, pushing, t, _probe_state(x, n), self.rows)
+            self.patterns = _patterns(rhs, pushing, t, _probe_state(x), self.rows)
         #: The coupled columns, ascending.
         self.columns = np.array(sorted(self.patterns), dtype=int)
         #: Groups of columns that move disjoint entries: one evaluation each.
@@ -75,7 +75,9 @@ class Coupling:
         """True when no component pushes a force (nothing to complete)."""
         return self.rows.size == 0
 
-    def complete(self, J: np.ndarray, rhs, t: float, x: np.ndarray) -> np.ndarray:
+    def complete(
+        self, J: np.ndarray, rhs, t: float, x: np.ndarray, Q_u: np.ndarray | None
+    ) -> np.ndarray:
         """Add the components' couplings to ``J`` (in place; module docstring).
 
         The mechanics' damper force passed to the components is the one at x (none of
@@ -91,16 +93,17 @@ class Coupling:
             Time, s.
         x : numpy.ndarray, shape (N,)
             The state.
+        Q_u : numpy.ndarray or None
+            ``rhs.input_force(t, x)``, which the caller has computed.
         """
         n, pushing = self.nv, rhs.layout.pushing
         q, qd = x[:n], x[n : 2 * n]
-        Q0 = rhs.input_force(t, x)
-        _, Qd = rhs.backend.accelerations(q, qd, Q0)
-        base = _components(rhs, pushing, t, x, n, Qd)
+        _, Qd = rhs.backend.accelerations(q, qd, Q_u)
+        base = _components(rhs, pushing, t, x, n, Qd, Q_u)
         dQ = np.zeros((n, self.columns.size))
         where = {j: k for k, j in enumerate(self.columns)}
         for group in self.groups:
-            steps = {j: FD_RSTEP * max(abs(float(x[j])), 1.0) for j in group}
+            steps = {j: _step(x, j) for j in group}
             shifted = x.copy()
             for j, h in steps.items():
                 shifted[j] += h
@@ -116,16 +119,23 @@ class Coupling:
         return J
 
 
-def _components(rhs, pushing: list, t: float, x: np.ndarray, n: int, Qd: np.ndarray) -> np.ndarray:
-    """``[Q_u; ṡ_pushing]`` at ``x`` (``Q_u`` zero when there is none)."""
-    Q = rhs.input_force(t, x)
+def _step(x: np.ndarray, j: int) -> float:
+    """The forward-difference step of column j: ``√ε · max(|x_j|, 1)``."""
+    return FD_RSTEP * max(abs(float(x[j])), 1.0)
+
+
+def _components(rhs, pushing: list, t: float, x: np.ndarray, n: int, Qd: np.ndarray,
+                Q: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """``[Q_u; ṡ_pushing]`` at ``x``; ``Q_u`` is ``Q`` when given, zero when there is none."""
+    if Q is None:
+        Q = rhs.input_force(t, x)
     forces = MechanicsForces(Qd, Q)
     q, qd = x[:n], x[n : 2 * n]
     ds = [np.asarray(c.derivative(t, q, qd, x[w], forces), dtype=float) for c, w in pushing]
     return np.concatenate([np.zeros(n) if Q is None else Q, *ds])
 
 
-def _probe_state(x: np.ndarray, n: int) -> np.ndarray:
+def _probe_state(x: np.ndarray) -> np.ndarray:
     """``x`` moved by a fixed pseudo-random 1e-6 of each entry's size (at least 1e-6)."""
     rng = np.random.default_rng(PROBE_SEED)
     return x + 1e-6 * np.maximum(np.abs(x), 1.0) * rng.uniform(-1.0, 1.0, x.size)
@@ -139,7 +149,7 @@ def _patterns(rhs, pushing: list, t: float, x: np.ndarray, rows: np.ndarray) -> 
     patterns = {}
     for j in [*range(2 * n), *rows]:
         shifted = x.copy()
-        shifted[j] += FD_RSTEP * max(abs(float(x[j])), 1.0)
+        shifted[j] += _step(x, j)
         moved = np.flatnonzero(_components(rhs, pushing, t, shifted, n, Qd) != base)
         if moved.size:
             patterns[int(j)] = moved

@@ -275,11 +275,12 @@ class _RightHandSide:
         n, size = self.n, self.layout.size
         q, qd = x[:n], x[n : 2 * n]
         J = np.zeros((2 * n + size, 2 * n + size))
-        J[: 2 * n, : 2 * n] = self.backend.jacobian(q, qd, self.input_force(t, x))
+        Q_u = self.input_force(t, x)
+        J[: 2 * n, : 2 * n] = self.backend.jacobian(q, qd, Q_u)
         if self.coupling is None:
             self.coupling = Coupling(self, t, x)
         if not self.coupling.empty:
-            self.coupling.complete(J, self, t, x)
+            self.coupling.complete(J, self, t, x, Q_u)
         if not np.isfinite(J).all():
             raise SimulationError("the Jacobian of the right-hand side is not finite")
         return J

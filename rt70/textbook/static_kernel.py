@@ -454,6 +454,8 @@ def stiffness_matrices(
 def element_gains(model: Model, data: StaticData, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(Σ Jᵀ C J, Σ Jᵀ D J)`` of the bushings and joint springs at ``q``, exact.
 
+    Both symmetric: each is symmetrised, since its products round unevenly.
+
     Parameters
     ----------
     model : Model
@@ -469,5 +471,5 @@ def element_gains(model: Model, data: StaticData, q: np.ndarray) -> tuple[np.nda
         G = np.empty((model.nv, model.nv))
         _check(data, _gains(qf, data.arrays, data.bushes, X, data.paths, data.scoord, k,
                             data.work, data.jac, data.block, G))  # fmt: skip
-        out.append(G)
+        out.append(0.5 * (G + G.T))
     return out[0], out[1]
