@@ -34,7 +34,7 @@ from rt70.cli import options
 from rt70.cli.main import main
 from rt70.errors import Rt70Error, SimulationError
 from rt70.model.scene import URDF_DIR
-from rt70.physics.aerodynamics import MAX_COEFFICIENT, MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from rt70.physics.coefficient_tables import MAX_COEFFICIENT, MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from rt70.testing import assert_close
 from rt70.urdf import elements
 

@@ -37,7 +37,8 @@ PACKAGE = ROOT / "rt70"
 
 #: Modules below both sides that any layer may import (``rt70.physics.loads``: the plain
 #: Wrench value both sides turn into a generalised force; ``rt70.physics.aerodynamics``:
-#: the wind's Wrench on a body at a pose each side computes; ``rt70.surface.pressure``:
+#: the wind's Wrench on a body at a pose each side computes, from the coefficient tables
+#: of ``rt70.physics.coefficient_tables``; ``rt70.surface.pressure``:
 #: that Wrench spread over surface nodes each side places).
 SHARED = (
     "rt70.errors",
@@ -46,6 +47,7 @@ SHARED = (
     "rt70.physics.loads",
     "rt70.physics.constraints",
     "rt70.physics.aerodynamics",
+    "rt70.physics.coefficient_tables",
     "rt70.physics.kkt",
     "rt70.physics.baumgarte",
     "rt70.surface.pressure",
@@ -63,6 +65,7 @@ RULES = {
         "rt70.guards.resources",
         *SHARED[:4],
         "rt70.physics.aerodynamics",
+        "rt70.physics.coefficient_tables",
         "rt70.physics.baumgarte",
         "rt70.surface.pressure",
     ),
@@ -74,7 +77,12 @@ RULES = {
     # a second formulation of the drives, independent of both rigid-body sides
     "rt70.bondgraph": ("rt70.bondgraph", *SHARED),
     "rt70.physics.loads": ("rt70.guards.arrays", "rt70.errors"),
-    "rt70.physics.aerodynamics": ("rt70.errors", "rt70.physics.loads"),
+    "rt70.physics.aerodynamics": (
+        "rt70.errors",
+        "rt70.physics.loads",
+        "rt70.physics.coefficient_tables",
+    ),
+    "rt70.physics.coefficient_tables": ("rt70.errors",),
     "rt70.physics.kkt": ("rt70.errors",),
     "rt70.physics.baumgarte": ("rt70.errors",),
     "rt70.surface.pressure": ("rt70.errors",),
@@ -283,6 +291,7 @@ GENERIC = (
     "rt70.model.optics",
     "rt70.physics.loads",
     "rt70.physics.aerodynamics",
+    "rt70.physics.coefficient_tables",
     "rt70.wind.load",
     "rt70.physics.constraints",
     "rt70.physics.kkt",

@@ -95,7 +95,7 @@ def test_installed_package_is_not_the_source_tree(installed, tmp_path):
 def test_installed_package_ships_the_wind_tables(installed, tmp_path):
     """The built-in coefficient tables are package data (rt70/wind_tables/*.csv)."""
     code = (
-        "from rt70.physics.aerodynamics import builtin_table as b\n"
+        "from rt70.physics.coefficient_tables import builtin_table as b\n"
         "print(b('dish').axial[0], b('cylinder').normal[18], b('dish').source)\n"
     )
     proc = _run([str(installed / "python"), "-c", code], tmp_path)

@@ -21,14 +21,12 @@ from rt70.errors import ExtensionError, UrdfError
 from rt70.model.scene import load_scene, scene_from_text
 from rt70.physics.aerodynamics import (
     DEFAULT_AIR_DENSITY,
-    CoefficientTable,
     WindCondition,
-    WindError,
     body_load,
-    builtin_table,
     horizontal_direction,
     wind_frame,
 )
+from rt70.physics.coefficient_tables import CoefficientTable, WindError, builtin_table
 from rt70.reference import points as ref_points
 from rt70.reference import wind as ref_wind
 from rt70.scenes import rt70_data

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rt70.physics.aerodynamics import WindCondition, wind_wrench
+from rt70.physics.aerodynamics import WindCondition, wind_load, wind_wrench
 from rt70.physics.loads import Wrench
 from rt70.reference.drives import link_pose
 from rt70.reference.model import ReferenceData, ReferenceModel
@@ -120,9 +120,10 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
     Each exposed body's pose and the Jacobian of its load point come from the compiled
     joint walk from the ground to the link (:class:`rt70.reference.element_kernels.
     RelativePoints`, frame 1 the ground) instead of Pinocchio's placements and point
-    Jacobians per body and evaluation; :func:`rt70.physics.aerodynamics.wind_wrench` gives the same
-    Wrench from the same pose, and ``Q = J_vᵀ F + J_ωᵀ M`` (tested equal to
-    :func:`wind_force`). Mapped coordinates, a wind spread over a surface or an
+    Jacobians per body and evaluation; :func:`rt70.physics.aerodynamics.wind_load` gives the
+    force and moment of :func:`~rt70.physics.aerodynamics.wind_wrench` from the link's
+    rotation (a uniform flow does not read its origin), and ``Q = J_vᵀ F + J_ωᵀ M``
+    (tested equal to :func:`wind_force`). Mapped coordinates, a wind spread over a surface or an
     unsupported path keep :func:`wind_force`.
     """
     slow = lambda q, condition: wind_force(model, data, q, condition)  # noqa: E731
@@ -139,14 +140,14 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
     frames = RelativePoints.of(model, ground, points)
     if frames is None:
         return slow
-    xyz = [np.asarray(w.xyz, dtype=float) for w in model.winds]
 
     def force(q: np.ndarray, condition: WindCondition) -> np.ndarray:
-        C, r, J = frames.frames(q)
+        C, _, J = frames.frames(q)
         Q = np.zeros(model.nv)
-        for i, w in enumerate(model.winds):  # the link's pose: the point minus R·xyz
-            wrench = wind_wrench(w, (C[i], r[i] - C[i] @ xyz[i]), condition, model.air_density)
-            Q += J[i, :3].T @ np.asarray(wrench.force) + J[i, 3:].T @ np.asarray(wrench.torque)
+        for i, w in enumerate(model.winds):  # a uniform flow reads the link's rotation only
+            load = wind_load(w, C[i], condition, model.air_density)
+            if load is not None:
+                Q += J[i, :3].T @ load[0] + J[i, 3:].T @ load[1]
         return Q
 
     return force

@@ -45,7 +45,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY, builtin_table
+from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY
+from rt70.physics.coefficient_tables import builtin_table
 from rt70.scenes import urdf_writer as uw
 from rt70.scenes.urdf_writer import check_name, fmt, fmt_vec
 

@@ -8,21 +8,29 @@ those terms the implicit methods' Newton iteration treats the drives explicitly,
 LSODA took a new Jacobian every 2.5 evaluations holding ``rt70_servo``.
 
 :class:`Coupling` finds once, at the first Jacobian, which columns of ``x = [q, q̇, s]``
-reach ``Q_u`` or a pushing component's derivative, and which entries of those each
-column moves (a drive reads its axis and motor coordinates, not the structure's
-hundreds). It probes at a slightly moved state, so that a dependence that happens to
+reach the force ``Q_s`` of the components with states or their derivatives, and which
+entries of those each column moves (a drive reads its axis and motor coordinates, not
+the structure's hundreds). It probes at a slightly moved state, so that a dependence that happens to
 vanish at the start (a current of zero) is not missed. At every Jacobian it then
 differences those entries forward, step ``√ε · max(|x_j|, 1)``:
 
 - Columns that move disjoint entries share one evaluation (Curtis, Powell & Reid 1974).
   The azimuth drive's columns pair with the elevation drive's, for example.
-- An evaluation is of the components alone: ``Q_u`` and the pushing derivatives, not
-  the mechanics.
-- The ``q̈`` rows gain ``M⁻¹ ΔQ_u / h``, one Cholesky solve for all columns. q̈ is
+- An evaluation is of those components alone: ``Q_s`` and their derivatives, not the
+  mechanics.
+- The ``q̈`` rows gain ``M⁻¹ ΔQ_s / h``, one Cholesky solve for all columns. q̈ is
   linear in ``Q_u``, and the backend's block holds ``Q_u`` fixed.
 
 The columns of the other states, and the rows of components that only watch, stay as
 they are. The energy audit is such a component: a quadrature that feeds nothing back.
+
+A component without states that pushes a force — a load, such as the wind's
+(:class:`rt70.wind.load.WindLoad`) — is held fixed, as the ``inputs`` callable is: it
+has no state to couple, its stiffness (the aerodynamic one) is small beside the
+structure's, and it reads every coordinate of the bodies it loads, so that differencing
+it cost one load evaluation per coordinate at every Jacobian (on the RT-70's gust runs,
+three quarters of the run time). A stiff load belongs in a component's states or in
+the model's elements.
 """
 
 from __future__ import annotations
@@ -56,15 +64,16 @@ class Coupling:
     def __init__(self, rhs, t: float, x: np.ndarray) -> None:
         layout: StateLayout = rhs.layout
         n = self.nv = layout.nv
-        pushing = list(layout.pushing)
-        #: Rows of the pushing components' states.
+        #: The pushing components with states, and their slices of x: those coupled.
+        self.coupled = [(c, w) for c, w in layout.pushing if w.stop > w.start]
+        #: Rows of the coupled components' states.
         self.rows = np.concatenate(
-            [np.arange(w.start, w.stop) for _, w in pushing] or [np.zeros(0, dtype=int)]
+            [np.arange(w.start, w.stop) for _, w in self.coupled] or [np.zeros(0, dtype=int)]
         ).astype(int)
-        #: Per coupled column of x, the entries of ``[Q_u; ṡ_pushing]`` it moves.
+        #: Per coupled column of x, the entries of ``[Q_s; ṡ_coupled]`` it moves.
         self.patterns: dict[int, np.ndarray] = {}
-        if pushing:
-            self.patterns = _patterns(rhs, pushing, t, _probe_state(x), self.rows)
+        if self.coupled:
+            self.patterns = _patterns(rhs, self.coupled, t, _probe_state(x), self.rows)
         #: The coupled columns, ascending.
         self.columns = np.array(sorted(self.patterns), dtype=int)
         #: Groups of columns that move disjoint entries: one evaluation each.
@@ -72,7 +81,7 @@ class Coupling:
 
     @property
     def empty(self) -> bool:
-        """True when no component pushes a force (nothing to complete)."""
+        """True when no component with states pushes a force (nothing to complete)."""
         return self.rows.size == 0
 
     def complete(
@@ -96,10 +105,11 @@ class Coupling:
         Q_u : numpy.ndarray or None
             ``rhs.input_force(t, x)``, which the caller has computed.
         """
-        n, pushing = self.nv, rhs.layout.pushing
+        n, coupled = self.nv, self.coupled
         q, qd = x[:n], x[n : 2 * n]
         _, Qd = rhs.backend.accelerations(q, qd, Q_u)
-        base = _components(rhs, pushing, t, x, n, Qd, Q_u)
+        base = _components(coupled, t, x, n, Qd, None)
+        rest = None if Q_u is None else Q_u - base[:n]  # the inputs' and the loads' force
         dQ = np.zeros((n, self.columns.size))
         where = {j: k for k, j in enumerate(self.columns)}
         for group in self.groups:
@@ -107,7 +117,7 @@ class Coupling:
             shifted = x.copy()
             for j, h in steps.items():
                 shifted[j] += h
-            change = _components(rhs, pushing, t, shifted, n, Qd) - base
+            change = _components(coupled, t, shifted, n, Qd, rest) - base
             for j, h in steps.items():
                 entries = self.patterns[j]
                 forces, states = entries[entries < n], entries[entries >= n]
@@ -124,15 +134,22 @@ def _step(x: np.ndarray, j: int) -> float:
     return FD_RSTEP * max(abs(float(x[j])), 1.0)
 
 
-def _components(rhs, pushing: list, t: float, x: np.ndarray, n: int, Qd: np.ndarray,
-                Q: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
-    """``[Q_u; ṡ_pushing]`` at ``x``; ``Q_u`` is ``Q`` when given, zero when there is none."""
-    if Q is None:
-        Q = rhs.input_force(t, x)
-    forces = MechanicsForces(Qd, Q)
+def _components(coupled: list, t: float, x: np.ndarray, n: int, Qd: np.ndarray,
+                rest: np.ndarray | None) -> np.ndarray:  # fmt: skip
+    """``[Q_s; ṡ_coupled]`` at ``x``: the coupled components' force and derivatives.
+
+    Their derivatives see ``Q_u = Q_s + rest`` (``rest``: the inputs' and the loads'
+    force, held fixed; None for none).
+    """
     q, qd = x[:n], x[n : 2 * n]
-    ds = [np.asarray(c.derivative(t, q, qd, x[w], forces), dtype=float) for c, w in pushing]
-    return np.concatenate([np.zeros(n) if Q is None else Q, *ds])
+    Q_s = np.zeros(n)
+    for c, w in coupled:
+        Q = c.force(t, q, qd, x[w])
+        if Q is not None:
+            Q_s += Q
+    forces = MechanicsForces(Qd, Q_s if rest is None else Q_s + rest)
+    ds = [np.asarray(c.derivative(t, q, qd, x[w], forces), dtype=float) for c, w in coupled]
+    return np.concatenate([Q_s, *ds])
 
 
 def _probe_state(x: np.ndarray) -> np.ndarray:
@@ -141,16 +158,16 @@ def _probe_state(x: np.ndarray) -> np.ndarray:
     return x + 1e-6 * np.maximum(np.abs(x), 1.0) * rng.uniform(-1.0, 1.0, x.size)
 
 
-def _patterns(rhs, pushing: list, t: float, x: np.ndarray, rows: np.ndarray) -> dict:
-    """For each column of x that moves ``[Q_u; ṡ_pushing]``, the entries it moves."""
+def _patterns(rhs, coupled: list, t: float, x: np.ndarray, rows: np.ndarray) -> dict:
+    """For each column of x that moves ``[Q_s; ṡ_coupled]``, the entries it moves."""
     n = rhs.layout.nv
     Qd = np.zeros(n)
-    base = _components(rhs, pushing, t, x, n, Qd)
+    base = _components(coupled, t, x, n, Qd, None)
     patterns = {}
     for j in [*range(2 * n), *rows]:
         shifted = x.copy()
         shifted[j] += _step(x, j)
-        moved = np.flatnonzero(_components(rhs, pushing, t, shifted, n, Qd) != base)
+        moved = np.flatnonzero(_components(coupled, t, shifted, n, Qd, None) != base)
         if moved.size:
             patterns[int(j)] = moved
     return patterns

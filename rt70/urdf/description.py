@@ -6,7 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY, CoefficientTable
+from rt70.physics.aerodynamics import DEFAULT_AIR_DENSITY
+from rt70.physics.coefficient_tables import CoefficientTable
 from rt70.urdf.beam_record import Beam
 from rt70.urdf.modal_record import ModalBody
 from rt70.urdf.mount_record import Mount, Optics
@@ -277,7 +278,7 @@ class Wind:
     shape : str
         The built-in table's name (``dish``, ``cylinder``) or the ``coefficients`` file
         as written in the URDF.
-    table : rt70.physics.aerodynamics.CoefficientTable
+    table : rt70.physics.coefficient_tables.CoefficientTable
         The coefficients C_A, C_N, C_M against θ (:mod:`rt70.physics.aerodynamics`).
     surface : str or None
         A modal body with a reflecting surface over whose nodes the wrench is spread as

@@ -4,8 +4,9 @@ One job: turn the XML of an exposed body — its link, reference point, symmetry
 reference area and length, and coefficient table — into a
 :class:`~rt70.urdf.description.Wind`, or the scene's air density, or refuse it with an
 :class:`~rt70.errors.ExtensionError` naming the file and the element. The coefficient
-table is read and checked here (:class:`rt70.physics.aerodynamics.CoefficientTable`): a built-in
-``shape`` or a ``coefficients`` CSV file, relative to the URDF file's directory.
+table is read and checked here
+(:class:`rt70.physics.coefficient_tables.CoefficientTable`): a built-in ``shape`` or a
+``coefficients`` CSV file, relative to the URDF file's directory.
 Called by :mod:`rt70.urdf.extensions`.
 """
 
@@ -17,7 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from rt70.errors import ExtensionError
-from rt70.physics.aerodynamics import BUILTIN_TABLES, CoefficientTable, WindError, builtin_table
+from rt70.physics.coefficient_tables import (
+    BUILTIN_TABLES,
+    CoefficientTable,
+    WindError,
+    builtin_table,
+)
 from rt70.urdf.description import RobotDescription, Wind
 from rt70.urdf.elements import ElementReader
 
@@ -45,7 +51,8 @@ def read_wind(
         If the name is missing or repeated, the link does not exist, the axis is zero,
         the area or length is not positive, not exactly one of ``shape`` and
         ``coefficients`` is given, the shape is not built in, or the coefficient file
-        is missing or malformed (:meth:`rt70.physics.aerodynamics.CoefficientTable.from_text`).
+        is missing or malformed
+        (:meth:`rt70.physics.coefficient_tables.CoefficientTable.from_text`).
     NonFiniteError, MagnitudeError
         If a number is NaN, infinite or too large (as anywhere in the file).
     """
