@@ -134,3 +134,11 @@ def test_startup_target_times_the_version_command():
     assert check.met in (True, False)  # the verdict is the machine's; the test is not
     assert "best of 1" in check.measured and "rt70 --version" in check.target
     assert st.version_target(quick=True).met is None
+
+
+def test_gust_target_runs_a_record_and_judges_its_pace():
+    """A short record stands in for the 600 s one; the verdict is a bool either way."""
+    assert st.gust_target(None).met is None
+    check = st.gust_target(2.0)
+    assert isinstance(check.met, bool)
+    assert "for 2 s" in check.measured and "× real time (CVODE" in check.measured

@@ -221,19 +221,19 @@ def wind_wrench(
         axes (zero in still air).
     """
     R = np.asarray(pose[0], dtype=float)
-    load = wind_load(surface, R, condition, density)
+    load = wind_load(surface, R, condition.velocity(), condition.air_density(density))
     if load is None:
         return Wrench(surface.link, tuple(surface.xyz))
     return Wrench(surface.link, tuple(surface.xyz), tuple(load[0]), tuple(load[1]))
 
 
 def wind_load(
-    surface: WindSurface, R: np.ndarray, condition: WindCondition, density: float
+    surface: WindSurface, R: np.ndarray, velocity: np.ndarray, density: float
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """The force F (N) and moment M (N·m) of :func:`wind_wrench`, ground axes; None in still air.
 
-    The arrays without the :class:`~rt70.physics.loads.Wrench` around them: what a
-    simulation's wind force sums at every evaluation
+    The arrays without the :class:`~rt70.physics.loads.Wrench` around them, from the
+    flow's velocity and density: what a simulation's wind force sums at every evaluation
     (:func:`rt70.reference.wind.wind_force_function`).
 
     Parameters
@@ -242,17 +242,16 @@ def wind_load(
         The exposed body, as for :func:`wind_wrench`.
     R : numpy.ndarray, shape (3, 3)
         The link's rotation in ground axes.
-    condition : WindCondition
-        The steady wind.
+    velocity : numpy.ndarray, shape (3,)
+        The flow velocity v0 in ground axes, m/s (:meth:`WindCondition.velocity`).
     density : float
-        The scene's air density ρ, kg/m³, used when ``condition`` gives none.
+        The air density ρ, kg/m³.
     """
-    v = R.T @ condition.velocity()
+    v = R.T @ velocity
     speed = math.sqrt(float(v @ v))
     if speed == 0.0:
         return None
-    rho = condition.air_density(density)
-    force_scale = 0.5 * rho * speed * speed * surface.area
+    force_scale = 0.5 * density * speed * speed * surface.area
     force, torque = body_load(
         surface.table, np.asarray(surface.axis, dtype=float), v / speed, force_scale, surface.length
     )

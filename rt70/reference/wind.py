@@ -144,8 +144,9 @@ def wind_force_function(model: ReferenceModel, data: ReferenceData):
     def force(q: np.ndarray, condition: WindCondition) -> np.ndarray:
         C, _, J = frames.frames(q)
         Q = np.zeros(model.nv)
+        velocity, density = condition.velocity(), condition.air_density(model.air_density)
         for i, w in enumerate(model.winds):  # a uniform flow reads the link's rotation only
-            load = wind_load(w, C[i], condition, model.air_density)
+            load = wind_load(w, C[i], velocity, density)
             if load is not None:
                 Q += J[i, :3].T @ load[0] + J[i, 3:].T @ load[1]
         return Q

@@ -30,11 +30,14 @@ its output has the one-sided spectrum ``2|H(j2πn)|² ≈ S_u(n)``.
 :func:`realise` samples the continuous process exactly (Van Loan's discretisation, the
 initial state drawn from the stationary covariance) with a reproducible seed; the
 :class:`GustSeries` it returns interpolates linearly between samples, as
-``scipy.signal.lsim`` and python-control's ``forced_response`` do.
+``scipy.signal.lsim`` and python-control's ``forced_response`` do; its
+:meth:`~GustSeries.smooth` form (:class:`SmoothGust`) is the C² cubic spline through
+the same samples, which a nonlinear simulation integrates without a kink per sample.
 """
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -293,6 +296,50 @@ class GustSeries(NamedTuple):
         if self.v.ndim == 1:
             return np.interp(time, self.t, self.v)
         return np.stack([np.interp(time, self.t, col) for col in self.v.T], axis=-1)
+
+    def smooth(self) -> SmoothGust:
+        """The C² cubic spline through the samples (:class:`SmoothGust`)."""
+        return SmoothGust(self)
+
+
+class SmoothGust:
+    """A gust record read through the C² cubic spline of its samples (not-a-knot ends).
+
+    What a nonlinear simulation's wind force reads (:mod:`rt70.telescope.gust_run`): the
+    linear interpolant of :class:`GustSeries` kinks at every sample, and an implicit
+    integrator steps through each kink with a short step and a low order, while the
+    spline's third derivative alone jumps there. Both pass through the exact samples;
+    they differ between them by what the samples do not determine (the process above
+    their Nyquist frequency). ``gust(t)`` of a scalar evaluates the interval's cubic in
+    plain floats (the integrator calls it at every evaluation); times outside the record
+    raise :class:`~rt70.errors.Rt70Error`, as :class:`GustSeries`.
+
+    Parameters
+    ----------
+    series : GustSeries
+        The record (at least two samples, times increasing).
+    """
+
+    def __init__(self, series: GustSeries) -> None:
+        from scipy.interpolate import CubicSpline
+
+        self.series = series
+        self.spline = CubicSpline(series.t, series.v, axis=0)
+        self._knots = series.t.tolist()
+        self._pieces = np.moveaxis(self.spline.c, 0, -1).tolist()  # per interval, c0…c3
+
+    def __call__(self, time: float | np.ndarray) -> float | np.ndarray:
+        """The gust at ``time`` (scalar or array), m/s, from the spline."""
+        knots = self._knots
+        if isinstance(time, float | int) and knots[0] <= time <= knots[-1]:
+            i = min(bisect_right(knots, time) - 1, len(knots) - 2)
+            dx = time - knots[i]
+            if self.series.v.ndim == 1:
+                c = self._pieces[i]
+                return ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
+            return np.array([((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3] for c in self._pieces[i]])
+        self.series(time)  # its range check
+        return self.spline(np.asarray(time, dtype=float))
 
 
 def _factor(S: np.ndarray) -> np.ndarray:
