@@ -87,3 +87,44 @@ def test_a_run_with_the_motor_keeps_its_accuracy():
     assert stiff.success and ref.success
     assert_close(stiff.q, ref.q, rel=1e-5, scale=np.max(np.abs(ref.q)))
     assert_close(stiff.states["current"], ref.states["current"], rel=1e-5)
+
+
+class Load(StateComponent):
+    """A stateless load ``−k sin(q₁)`` on joint 1; ``held`` sets IN_JACOBIAN False."""
+
+    names = ()
+
+    def __init__(self, n: int, k: float = 30.0, held: bool = False) -> None:
+        self.n, self.k = n, k
+        self.initial, self.atol = np.zeros(0), np.zeros(0)
+        self.IN_JACOBIAN = not held
+
+    def derivative(self, t, q, qd, s, forces):
+        return np.zeros(0)
+
+    def force(self, t, q, qd, s):
+        Q = np.zeros(self.n)
+        Q[1] = -self.k * np.sin(q[1])
+        return Q
+
+
+def test_a_load_is_coupled_unless_it_asks_to_be_held():
+    """A stateless load is differenced like a drive; IN_JACOBIAN = False holds it fixed
+    (as the wind's load does), so its stiffness is missing from the q̈ rows."""
+    scene = load_scene("double_pendulum")
+    n = scene.textbook.nv
+    x = np.r_[0.4, -0.2, 0.3, 0.7, 0.0, 0.0, 0.8]
+    coupled = _rhs(scene, [Motor(n), Load(n)])
+    J = coupled.jacobian(0.0, x)
+    reference = _central_jacobian(coupled, 0.0, x)
+    rows = np.r_[n : 2 * n, 2 * n + 2]
+    assert_close(J[rows], reference[rows], rel=1e-6, scale=np.max(np.abs(reference[rows])))
+    assert 1 in coupled.coupling.columns
+    held = _rhs(scene, [Motor(n), Load(n, held=True)])
+    J_held = held.jacobian(0.0, x)
+    assert 1 not in held.coupling.columns and np.array_equal(held.coupling.columns, [0, 2, 6])
+    # the held load's stiffness M⁻¹ (−k cos q₁) e₁ is what the two Jacobians differ by
+    M = held.backend.mass_matrix(x[:n])
+    missing = np.linalg.solve(M, np.r_[0.0, -30.0 * np.cos(x[1])])
+    assert_close(J[n : 2 * n, 1] - J_held[n : 2 * n, 1], missing, rel=1e-6,
+                 scale=np.max(np.abs(missing)))  # fmt: skip

@@ -8,7 +8,7 @@ those terms the implicit methods' Newton iteration treats the drives explicitly,
 LSODA took a new Jacobian every 2.5 evaluations holding ``rt70_servo``.
 
 :class:`Coupling` finds once, at the first Jacobian, which columns of ``x = [q, q̇, s]``
-reach the force ``Q_s`` of the components with states or their derivatives, and which
+reach the force ``Q_s`` of the coupled components or their derivatives, and which
 entries of those each column moves (a drive reads its axis and motor coordinates, not
 the structure's hundreds). It probes at a slightly moved state, so that a dependence that happens to
 vanish at the start (a current of zero) is not missed. At every Jacobian it then
@@ -24,13 +24,13 @@ differences those entries forward, step ``√ε · max(|x_j|, 1)``:
 The columns of the other states, and the rows of components that only watch, stay as
 they are. The energy audit is such a component: a quadrature that feeds nothing back.
 
-A component without states that pushes a force — a load, such as the wind's
-(:class:`rt70.wind.load.WindLoad`) — is held fixed, as the ``inputs`` callable is: it
-has no state to couple, its stiffness (the aerodynamic one) is small beside the
-structure's, and it reads every coordinate of the bodies it loads, so that differencing
-it cost one load evaluation per coordinate at every Jacobian (on the RT-70's gust runs,
-three quarters of the run time). A stiff load belongs in a component's states or in
-the model's elements.
+A component that sets :attr:`~rt70.simulation.states.StateComponent.IN_JACOBIAN` False
+is held fixed, as the ``inputs`` callable is. The wind's load
+(:class:`rt70.wind.load.WindLoad`) does: its stiffness (the aerodynamic one) is small
+beside the structure's, and it reads every coordinate of the bodies it loads, so that
+differencing it cost one load evaluation per coordinate at every Jacobian (three
+quarters of a gust run's time with LSODA). Friction, whose slope at rest is the
+stiffest term of a drive, stays in.
 """
 
 from __future__ import annotations
@@ -64,8 +64,8 @@ class Coupling:
     def __init__(self, rhs, t: float, x: np.ndarray) -> None:
         layout: StateLayout = rhs.layout
         n = self.nv = layout.nv
-        #: The pushing components with states, and their slices of x: those coupled.
-        self.coupled = [(c, w) for c, w in layout.pushing if w.stop > w.start]
+        #: The pushing components in the Jacobian, and their slices of x.
+        self.coupled = [(c, w) for c, w in layout.pushing if c.IN_JACOBIAN]
         #: Rows of the coupled components' states.
         self.rows = np.concatenate(
             [np.arange(w.start, w.stop) for _, w in self.coupled] or [np.zeros(0, dtype=int)]
@@ -81,7 +81,7 @@ class Coupling:
 
     @property
     def empty(self) -> bool:
-        """True when no component with states pushes a force (nothing to complete)."""
+        """True when no coupled component pushes a force (nothing to complete)."""
         return self.rows.size == 0
 
     def complete(

@@ -73,6 +73,12 @@ class StateComponent(ABC):
     #: ``azimuth:current``); a state not listed is written with the unit "unknown".
     STATE_UNITS: ClassVar[dict[str, str]] = {}
 
+    #: Whether the implicit methods' Jacobian gets this component's couplings, by
+    #: differences (:mod:`rt70.simulation.coupling`). A load whose stiffness is small
+    #: beside the structure's and which reads many coordinates (the wind's) sets False:
+    #: its force is then held fixed there, as the ``inputs`` callable's is.
+    IN_JACOBIAN: ClassVar[bool] = True
+
     def unit(self, name: str) -> str:
         """The unit of the state ``name`` (one of :attr:`names`), from :attr:`STATE_UNITS`."""
         return self.STATE_UNITS.get(name.rsplit(":", 1)[-1], "unknown")

@@ -46,6 +46,8 @@ class WindLoad(StateComponent):
     """
 
     names: tuple[str, ...] = ()
+    #: Held fixed in the implicit methods' Jacobian (:mod:`rt70.simulation.coupling`).
+    IN_JACOBIAN = False
 
     def __init__(
         self,
