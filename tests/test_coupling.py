@@ -128,3 +128,33 @@ def test_a_load_is_coupled_unless_it_asks_to_be_held():
     missing = np.linalg.solve(M, np.r_[0.0, -30.0 * np.cos(x[1])])
     assert_close(J[n : 2 * n, 1] - J_held[n : 2 * n, 1], missing, rel=1e-6,
                  scale=np.max(np.abs(missing)))  # fmt: skip
+
+
+class ClampedMotor(Motor):
+    """The motor's PD law clamped to ±limit: saturated, it ignores the joint's angle and rate."""
+
+    def __init__(self, n: int, limit: float = 1.0) -> None:
+        super().__init__(n)
+        self.limit = limit
+
+    def derivative(self, t, q, qd, s, forces):
+        law = min(max(-self.kp * q[0] - self.kd * qd[0], -self.limit), self.limit)
+        return np.array([(law - s[0]) / self.tau])
+
+
+def test_a_dependence_hidden_by_a_clamp_at_the_start_is_kept():
+    """The couplings are found at a saturated start, where the motor's law ignores q₀ and
+    q̇₀; once the clamp lets go, the Jacobian must still hold them (a servo's rate loop
+    at the start of a large step: its pattern left them out, and LSODA and CVODE stalled
+    on rt70_servo's 1° azimuth step)."""
+    scene = load_scene("double_pendulum")
+    n = scene.textbook.nv
+    rhs = _rhs(scene, [ClampedMotor(n)])
+    saturated = np.r_[0.4, -0.2, 0.3, 0.7, 0.0, 0.0, 0.8]  # −kp q₀ − kd q̇₀ = −17.8
+    rhs.jacobian(0.0, saturated)
+    free = np.r_[0.01, -0.2, 0.02, 0.7, 0.0, 0.0, 0.1]  # −0.52: inside the clamp
+    J = rhs.jacobian(0.0, free)
+    reference = _central_jacobian(rhs, 0.0, free)
+    rows = np.r_[n : 2 * n, 2 * n + 2]
+    assert_close(J[rows], reference[rows], rel=1e-6, scale=np.max(np.abs(reference[rows])))
+    assert abs(J[2 * n + 2, 0]) > 1.0  # −kp/τ: the angle reaches the current once free

@@ -3,12 +3,11 @@
 Measured in one process, BLAS/OpenMP pinned to one thread, rounds alternating between
 the methods (best wall time of the rounds):
 
-- ``rt70_servo``'s hold, track and step-elevation scenarios, 10 s at 45°
+- ``rt70_servo``'s hold, track, step-elevation and step-azimuth scenarios, 10 s at 45°
   (:func:`rt70.telescope.scenarios.run_scenario` with the scene's drives, what ``rt70
   simulate rt70_servo --scenario S --t-end 10`` runs) with LSODA and with CVODE at rtol
-  1e-6: wall time of
-  the integration, evaluations, Jacobians, and the largest difference of the pointing
-  error between the two methods (arc seconds);
+  1e-6: wall time of the integration, evaluations, Jacobians, and the largest
+  difference of the pointing error between the two methods (arc seconds);
 - the wind's generalised force on ``rt70_servo`` (four exposed bodies) at a moved
   configuration: the compiled path the simulation uses
   (:func:`rt70.reference.wind.wind_force_function`) against Pinocchio's placements and
@@ -35,7 +34,7 @@ from rt70.telescope import scenarios as S
 from rt70.telescope.scene_servo import choose_drives
 
 OUT = Path(__file__).resolve().parent / "results" / "servo_speed.md"
-SCENARIOS = ("hold", "track", "step-elevation")
+SCENARIOS = ("hold", "track", "step-elevation", "step-azimuth")
 METHODS = ("LSODA", "CVODE")
 T_END = 10.0
 

@@ -247,7 +247,7 @@ def add_parser(
         help="integrator: a solve_ivp method, CVODE / CVODE_ADAMS (SUNDIALS), or "
         "generalized-alpha on the compiled kernels, in O(nv) memory and work per step "
         "(default BDF; generalized-alpha from 200 coordinates on where the kernels cover "
-        "the model; LSODA for the servo scenarios)",
+        "the model; CVODE for the servo scenarios)",
     )
     options.add_side_argument(sim, what="q̈ and its Jacobian")
     sim.add_argument(

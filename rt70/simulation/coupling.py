@@ -7,12 +7,18 @@ coordinates it reads, and its states' derivatives depend on the mechanics: witho
 those terms the implicit methods' Newton iteration treats the drives explicitly, and
 LSODA took a new Jacobian every 2.5 evaluations holding ``rt70_servo``.
 
-:class:`Coupling` finds once, at the first Jacobian, which columns of ``x = [q, q̇, s]``
-reach the force ``Q_s`` of the coupled components or their derivatives, and which
-entries of those each column moves (a drive reads its axis and motor coordinates, not
-the structure's hundreds). It probes at a slightly moved state, so that a dependence that happens to
-vanish at the start (a current of zero) is not missed. At every Jacobian it then
-differences those entries forward, step ``√ε · max(|x_j|, 1)``:
+:class:`Coupling` finds at the first Jacobian which columns of ``x = [q, q̇, s]`` reach
+each coupled component: its force ``Q_s`` or its derivatives (a drive reads its axis
+and motor coordinates, not the structure's hundreds). It probes at a slightly moved
+state, so that a dependence that happens to vanish at the start (a current of zero) is
+not missed. A column that reaches a component counts for all of its entries (its
+force's rows and its states), and every later Jacobian moves all the other columns at
+once in one more evaluation: if that moves a component, the search runs again and the
+pattern grows. A dependence hidden where the pattern was found is then kept: a servo's
+rate loop, saturated at the start of a large step, ignores the axis it reads. Without
+this the 1° azimuth step of ``rt70_servo`` stalled once its loops let go (LSODA and
+CVODE alike). At every Jacobian the columns are differenced forward, step
+``√ε · max(|x_j|, 1)``:
 
 - Columns that move disjoint entries share one evaluation (Curtis, Powell & Reid 1974).
   The azimuth drive's columns pair with the elevation drive's, for example.
@@ -46,6 +52,10 @@ FD_RSTEP = float(np.sqrt(np.finfo(float).eps))
 #: Seed of the slightly moved state the couplings are probed at.
 PROBE_SEED = 20261127
 
+#: A change of an entry beyond this many of its block's size is not rounding
+#: (:meth:`Coupling._reached_outside`).
+ROUNDING = 1e3 * float(np.finfo(float).eps)
+
 
 class Coupling:
     """The entries the components couple, found at ``(t, x)`` (module docstring).
@@ -63,21 +73,60 @@ class Coupling:
 
     def __init__(self, rhs, t: float, x: np.ndarray) -> None:
         layout: StateLayout = rhs.layout
-        n = self.nv = layout.nv
+        self.nv = layout.nv
         #: The pushing components in the Jacobian, and their slices of x.
         self.coupled = [(c, w) for c, w in layout.pushing if c.IN_JACOBIAN]
         #: Rows of the coupled components' states.
         self.rows = np.concatenate(
             [np.arange(w.start, w.stop) for _, w in self.coupled] or [np.zeros(0, dtype=int)]
         ).astype(int)
-        #: Per coupled column of x, the entries of ``[Q_s; ṡ_coupled]`` it moves.
-        self.patterns: dict[int, np.ndarray] = {}
+        patterns = {}
         if self.coupled:
-            self.patterns = _patterns(rhs, self.coupled, t, _probe_state(x), self.rows)
+            patterns = _patterns(rhs, self.coupled, t, _probe_state(x), self.rows)
+        self._use(patterns)
+
+    def _use(self, patterns: dict[int, np.ndarray]) -> None:
+        """Take ``patterns``: the columns, their groups, and the columns outside them."""
+        n = self.nv
+        #: Per coupled column of x, the entries of ``[Q_s; ṡ_coupled]`` it may move.
+        self.patterns = patterns
         #: The coupled columns, ascending.
-        self.columns = np.array(sorted(self.patterns), dtype=int)
+        self.columns = np.array(sorted(patterns), dtype=int)
         #: Groups of columns that move disjoint entries: one evaluation each.
-        self.groups = _groups(self.patterns, n + self.rows.size)
+        self.groups = _groups(patterns, n + self.rows.size)
+        #: The other columns, and the signs of the one probe over all of them
+        #: (:meth:`_reached_outside`).
+        candidates = [*range(2 * n), *self.rows.tolist()] if self.coupled else []
+        self.outside = np.array([j for j in candidates if j not in patterns], dtype=int)
+        self._signs = np.random.default_rng(PROBE_SEED).choice([-1.0, 1.0], self.outside.size)
+
+    def _reached_outside(self, t: float, x: np.ndarray, Qd: np.ndarray, base: np.ndarray) -> bool:
+        """Whether the columns outside the pattern, all moved at once, move a component.
+
+        One evaluation of the components per Jacobian. A column that reached no
+        component where the pattern was found (a dependence a clamp hid there, as a
+        saturated loop hides its error) is found once it does.
+        """
+        if not self.outside.size:
+            return False
+        shifted = x.copy()
+        steps = FD_RSTEP * np.maximum(np.abs(x[self.outside]), 1.0)
+        shifted[self.outside] += self._signs * steps
+        change = _components(self.coupled, t, shifted, self.nv, Qd, None) - base
+        return bool(np.any(np.abs(change) > ROUNDING * self._scales(base)))
+
+    def _scales(self, base: np.ndarray) -> np.ndarray:
+        """Per entry of ``[Q_s; ṡ_coupled]``, the largest entry of its block.
+
+        The blocks are ``Q_s`` and each component's states; rounding moves an entry by a
+        few ε of its block's largest.
+        """
+        scales = np.empty_like(base)
+        start = 0
+        for stop in [self.nv, *(self.nv + np.cumsum([w.stop - w.start for _, w in self.coupled]))]:
+            scales[start:stop] = np.max(np.abs(base[start:stop]), initial=0.0)
+            start = stop
+        return scales
 
     @property
     def empty(self) -> bool:
@@ -109,6 +158,14 @@ class Coupling:
         q, qd = x[:n], x[n : 2 * n]
         _, Qd = rhs.backend.accelerations(q, qd, Q_u)
         base = _components(coupled, t, x, n, Qd, None)
+        if self._reached_outside(t, x, Qd, base):  # the pattern grows, never shrinks
+            found = _patterns(rhs, coupled, t, x, self.rows)
+            for j, entries in self.patterns.items():
+                found[j] = np.union1d(found.get(j, entries), entries)
+            grown = set(found) != set(self.patterns)
+            self._use(dict(sorted(found.items())))
+            if not grown:  # moved only by the columns together: not searched again
+                self.outside = self.outside[:0]
         rest = None if Q_u is None else Q_u - base[:n]  # the inputs' and the loads' force
         dQ = np.zeros((n, self.columns.size))
         where = {j: k for k, j in enumerate(self.columns)}
@@ -159,18 +216,35 @@ def _probe_state(x: np.ndarray) -> np.ndarray:
 
 
 def _patterns(rhs, coupled: list, t: float, x: np.ndarray, rows: np.ndarray) -> dict:
-    """For each column of x that moves ``[Q_s; ṡ_coupled]``, the entries it moves."""
+    """For each column of x that reaches a coupled component, the entries it may move.
+
+    A component's entries are the rows of ``Q_s`` its force moves and its own states'
+    rows. A column reaches the component when it moves any of them at x (its own
+    states' columns always do), and then counts for all of them: a dependence that a
+    clamp hides at x (a saturated loop ignores its error, as a servo's rate loop does
+    at the start of a large step) appears once the clamp lets go, and a pattern of only
+    the entries moved at x would leave it out of every later Jacobian.
+    """
     n = rhs.layout.nv
     Qd = np.zeros(n)
-    base = _components(coupled, t, x, n, Qd, None)
-    patterns = {}
-    for j in [*range(2 * n), *rows]:
-        shifted = x.copy()
-        shifted[j] += _step(x, j)
-        moved = np.flatnonzero(_components(coupled, t, shifted, n, Qd, None) != base)
-        if moved.size:
-            patterns[int(j)] = moved
-    return patterns
+    patterns: dict[int, set[int]] = {}
+    offset = n
+    for c, w in coupled:
+        one = [(c, w)]
+        base = _components(one, t, x, n, Qd, None)
+        reached, force_rows = [], set()
+        for j in [*range(2 * n), *rows]:
+            shifted = x.copy()
+            shifted[j] += _step(x, j)
+            moved = _components(one, t, shifted, n, Qd, None) != base
+            if moved.any() or w.start <= j < w.stop:
+                reached.append(int(j))
+                force_rows.update(np.flatnonzero(moved[:n]).tolist())
+        entries = [*force_rows, *range(offset, offset + w.stop - w.start)]
+        for j in reached:
+            patterns.setdefault(j, set()).update(entries)
+        offset += w.stop - w.start
+    return {j: np.array(sorted(patterns[j]), dtype=int) for j in sorted(patterns)}
 
 
 def _groups(patterns: dict, size: int) -> list[list[int]]:

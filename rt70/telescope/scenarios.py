@@ -115,12 +115,14 @@ __all__ = [
     "tuning_text",
 ]
 
-#: Integration method of the scenarios. scipy's BDF and Radau stop at random on a hold
-#: ("Required step size is less than spacing between numbers": measured at 30° and 90°,
-#: 60 s): at rest every Newton correction is rounding noise, their ratio reaches 1 and
-#: the iteration is declared diverging at any step size; LSODA's own test does not (60 s
-#: hold at 30°: 3.9e-7″, 17 s wall).
-METHOD = "LSODA"
+#: Integration method of the scenarios: SUNDIALS' BDF. scipy's BDF and Radau stop at
+#: random on a hold ("Required step size is less than spacing between numbers": measured
+#: at 30° and 90°, 60 s): at rest every Newton correction is rounding noise, their ratio
+#: reaches 1 and the iteration is declared diverging at any step size. CVODE first asks
+#: whether the correction is within the tolerance, as LSODA does, and keeps its Jacobian
+#: while the iteration converges: it takes a fraction of LSODA's evaluations and
+#: Jacobians on every scenario (docs/servo-scenarios.md, validation/servo_speed.py).
+METHOD = "CVODE"
 
 
 @refuses_backend
@@ -156,7 +158,7 @@ def run_scenario(
     side : {"reference", "textbook"}
         Which side evaluates the mechanics (:mod:`rt70.model.sides`).
     method : str, optional
-        The integration method; default :data:`METHOD` (LSODA, and why).
+        The integration method; default :data:`METHOD` (CVODE, and why).
     progress : bool
         Show a progress bar on stderr.
     """
