@@ -123,6 +123,13 @@ def test_a_load_is_coupled_unless_it_asks_to_be_held():
     held = _rhs(scene, [Motor(n), Load(n, held=True)])
     J_held = held.jacobian(0.0, x)
     assert 1 not in held.coupling.columns and np.array_equal(held.coupling.columns, [0, 2, 6])
+    alone = _rhs(scene, [Load(n)])  # a stateless load by itself is differenced too
+    x_alone = np.r_[x[: 2 * n], 0.0, 0.0]
+    J_alone = alone.jacobian(0.0, x_alone)
+    reference = _central_jacobian(alone, 0.0, x_alone)
+    assert not alone.coupling.empty and np.array_equal(alone.coupling.columns, [1])
+    assert_close(J_alone[n : 2 * n], reference[n : 2 * n], rel=1e-6,
+                 scale=np.max(np.abs(reference[n : 2 * n])))  # fmt: skip
     # the held load's stiffness M⁻¹ (−k cos q₁) e₁ is what the two Jacobians differ by
     M = held.backend.mass_matrix(x[:n])
     missing = np.linalg.solve(M, np.r_[0.0, -30.0 * np.cos(x[1])])

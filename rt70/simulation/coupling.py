@@ -131,7 +131,7 @@ class Coupling:
     @property
     def empty(self) -> bool:
         """True when no coupled component pushes a force (nothing to complete)."""
-        return self.rows.size == 0
+        return not self.coupled
 
     def complete(
         self, J: np.ndarray, rhs, t: float, x: np.ndarray, Q_u: np.ndarray | None
