@@ -7,14 +7,13 @@ C_M/sin θ are smooth through θ = 0 and 180° (there: the spline's derivative).
 built-in tables ``dish`` and ``cylinder`` (:data:`BUILTIN_TABLES`) are engineering
 estimates derived in their files' headers and in docs/wind.md, not wind-tunnel data.
 The law that uses them is :mod:`rt70.physics.aerodynamics`. Imports nothing of rt70 but
-the errors (tests/test_import_rules.py, ``SHARED``).
+the errors and :mod:`rt70.physics.cubic_pieces` (tests/test_import_rules.py, ``SHARED``).
 """
 
 from __future__ import annotations
 
 import math
 import stat
-from bisect import bisect_right
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.physics.cubic_pieces import CubicPieces, horner
 
 if TYPE_CHECKING:
     from scipy.interpolate import CubicSpline
@@ -78,8 +78,7 @@ class CoefficientTable:
     normal: np.ndarray
     moment: np.ndarray
     _splines: tuple = field(init=False, repr=False)
-    _knots: list = field(init=False, repr=False)
-    _pieces: list = field(init=False, repr=False)
+    _pieces: CubicPieces = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         from scipy.interpolate import CubicSpline  # only when a scene has wind elements
@@ -97,10 +96,9 @@ class CoefficientTable:
             extended(self.moment, -1.0),
         )
         object.__setattr__(self, "_splines", splines)
-        # the same polynomials as plain floats, per interval (c0, c1, c2, c3) of each spline
-        object.__setattr__(self, "_knots", full.tolist())
-        pieces = np.stack([sp.c for sp in splines], axis=0).transpose(2, 0, 1)  # (m, 3, 4)
-        object.__setattr__(self, "_pieces", pieces.tolist())
+        # the same polynomials in plain floats: per interval, (C_A, C_N, C_M)'s four each
+        pieces = CubicPieces(full, np.stack([sp.c for sp in splines], axis=-1))
+        object.__setattr__(self, "_pieces", pieces)
 
     @classmethod
     def from_rows(cls, source: str, rows: np.ndarray) -> CoefficientTable:
@@ -232,20 +230,20 @@ class CoefficientTable:
         theta = math.atan2(sin_theta, cos_theta)
         c_a, c_n, c_m = self._values(theta)
         m = len(self.theta_deg) - 1  # the interval [π, …] of the full circle
+        pieces, knots = self._pieces.pieces, self._pieces.knots
         if sin_theta < SMALL_SINE:
             if cos_theta > 0.0:
-                _, normal, moment = self._pieces[0]
+                _, normal, moment = pieces[0]
                 return c_a, normal[2], moment[2]
-            _, normal, moment = self._pieces[m]
+            _, normal, moment = pieces[m]
             return c_a, -normal[2], -moment[2]
         if cos_theta < 0.0:
             x = math.atan2(sin_theta, -cos_theta)
-            if x <= self._knots[m + 1] - self._knots[m]:
-                _, normal, moment = self._pieces[m]
-                c_n = -(((normal[0] * x + normal[1]) * x + normal[2]) * x + normal[3])
-                c_m = -(((moment[0] * x + moment[1]) * x + moment[2]) * x + moment[3])
+            if x <= knots[m + 1] - knots[m]:
+                _, normal, moment = pieces[m]
+                c_n, c_m = -horner(normal, x), -horner(moment, x)
             else:
-                _, c_n, c_m = self._values(self._knots[m] + x)
+                _, c_n, c_m = self._values(knots[m] + x)
                 c_n, c_m = -c_n, -c_m
         return c_a, c_n / sin_theta, c_m / sin_theta
 
@@ -255,10 +253,8 @@ class CoefficientTable:
         The interval is scipy's (``x_i ≤ θ < x_{i+1}``, the last one closed); the
         polynomial is evaluated by Horner's rule, in plain floats (no array per call).
         """
-        knots = self._knots
-        i = min(max(bisect_right(knots, theta) - 1, 0), len(knots) - 2)
-        dx = theta - knots[i]
-        return tuple(((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3] for c in self._pieces[i])
+        i, dx = self._pieces.locate(theta)
+        return tuple(horner(c, dx) for c in self._pieces.pieces[i])
 
 
 def builtin_table(name: str) -> CoefficientTable:

@@ -37,7 +37,6 @@ the same samples, which a nonlinear simulation integrates without a kink per sam
 
 from __future__ import annotations
 
-from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -48,6 +47,7 @@ import scipy.signal
 
 from rt70.errors import Rt70Error
 from rt70.linear.covariance import _no_feedthrough, _system, state_covariance
+from rt70.physics.cubic_pieces import CubicPieces, horner
 
 #: Davenport's surface drag coefficient κ for open country (referred to U).
 DAVENPORT_KAPPA = 0.005
@@ -325,19 +325,17 @@ class SmoothGust:
 
         self.series = series
         self.spline = CubicSpline(series.t, series.v, axis=0)
-        self._knots = series.t.tolist()
-        self._pieces = np.moveaxis(self.spline.c, 0, -1).tolist()  # per interval, c0…c3
+        self._pieces = CubicPieces(series.t, self.spline.c)
 
     def __call__(self, time: float | np.ndarray) -> float | np.ndarray:
         """The gust at ``time`` (scalar or array), m/s, from the spline."""
-        knots = self._knots
+        knots = self._pieces.knots
         if isinstance(time, float | int) and knots[0] <= time <= knots[-1]:
-            i = min(bisect_right(knots, time) - 1, len(knots) - 2)
-            dx = time - knots[i]
+            i, dx = self._pieces.locate(time)
+            c = self._pieces.pieces[i]
             if self.series.v.ndim == 1:
-                c = self._pieces[i]
-                return ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
-            return np.array([((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3] for c in self._pieces[i]])
+                return horner(c, dx)
+            return np.array([horner(column, dx) for column in c])
         self.series(time)  # its range check
         return self.spline(np.asarray(time, dtype=float))
 
