@@ -8,6 +8,7 @@ import pytest
 from rt70.control.friction import (
     AxisFriction,
     creep_speed,
+    friction_slope,
     friction_torque,
     relay_torque,
     switched_rigid_axis,
@@ -15,7 +16,9 @@ from rt70.control.friction import (
 from rt70.errors import Rt70Error
 from rt70.model.scene import scene_from_text
 from rt70.scenes.rt70_drives import FRICTION, KGF_M
-from rt70.simulation.simulate import simulate
+from rt70.simulation.backends import BACKENDS
+from rt70.simulation.simulate import _RightHandSide, simulate
+from rt70.simulation.states import EnergyAudit, StateLayout
 from rt70.testing import assert_close
 
 TOP = FRICTION.top_speed
@@ -84,12 +87,14 @@ def test_switched_reference_against_closed_forms():
     assert not still.angle.any() and still.switches == 0
 
 
-def _rotor(inertia):
+def _rotor(inertia, joint="continuous"):
+    limit = '<limit lower="-7" upper="7" effort="1e12" velocity="1"/>'
+    limit = limit if joint == "revolute" else ""
     return scene_from_text(
         f"""<robot name="r"><link name="g"/><link name="b"><inertial><mass value="1"/>
         <inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/>
-        </inertial></link><joint name="azimuth" type="continuous"><parent link="g"/>
-        <child link="b"/><axis xyz="0 0 1"/></joint></robot>""",
+        </inertial></link><joint name="azimuth" type="{joint}"><parent link="g"/>
+        <child link="b"/><axis xyz="0 0 1"/>{limit}</joint></robot>""",
         "rotor",
     )
 
@@ -137,3 +142,46 @@ def test_friction_dissipation_closes_the_energy_balance():
     # it stops within the time the relay law gives: t ≤ J ω₀ / F_s (slope helps)
     stop = run.t[np.flatnonzero(np.abs(run.qd[:, 0]) > 1e-3 * w0)[-1]]
     assert stop < J * w0 / FRICTION.static_torque
+
+
+@pytest.mark.parametrize("kind", ["linear", "tanh"])
+def test_slope_is_the_laws_derivative(kind):
+    """Central differences of the law, with a step of 10⁻⁶ of the zone: in the zone, on
+    its edge's either side, and far out on the sliding branch."""
+    width = 1e-6 * TOP
+    h = 1e-6 * width
+    for speed in (0.0, 0.3 * width, -0.7 * width, 1.5 * width, -40.0 * width, 0.5 * TOP):
+        diff = (
+            friction_torque(FRICTION, speed + h, width, kind)
+            - friction_torque(FRICTION, speed - h, width, kind)
+        ) / (2 * h)
+        slope = friction_slope(FRICTION, speed, width, kind)
+        scale = FRICTION.static_torque / width
+        assert_close(slope, diff, rel=1e-6, scale=scale, what=f"{kind} at {speed / width:g} ω_ε")
+    assert friction_slope(FRICTION, 2 * width, width, "linear") == -FRICTION.slope
+    assert friction_slope(FRICTION, width, width, "linear") < -0.9 * FRICTION.static_torque / width
+
+
+def test_the_implicit_methods_get_the_zones_slope_not_a_differenced_one():
+    """A zone narrower than the difference step (√ε ≈ 1.5·10⁻⁸ rad/s): the Jacobian's q̈
+    and heat entries on the axis's speed are the law's own, as central differences with a
+    step inside the zone give them; the friction is not differenced (a revolute axis:
+    Pinocchio's analytic Jacobian covers it)."""
+    scene = _rotor(J, "revolute")
+    width = 1e-9
+    f = AxisFriction("f", scene.coordinate_names, "azimuth", FRICTION, width, "linear")
+    rhs = _RightHandSide(
+        BACKENDS["reference"](scene), StateLayout([EnergyAudit(1e-9), f], 1), None,
+        (0.0, 1.0), False,
+    )  # fmt: skip
+    x = np.r_[0.2, 0.4 * width, 0.0, 0.0, 0.0]  # q, q̇, audit (2), heat
+    Jac = rhs.jacobian(0.0, x)
+    assert rhs.coupling.analytic and not rhs.coupling.coupled
+    h = 1e-4 * width
+    e = np.zeros(x.size)
+    e[1] = h
+    column = (rhs(0.0, x + e) - rhs(0.0, x - e)) / (2 * h)
+    zone = FRICTION.static_torque / width
+    assert_close(Jac[1, 1], column[1], rel=1e-6, scale=zone / J)
+    assert_close(Jac[4, 1], column[4], rel=1e-6, scale=abs(column[4]))
+    assert Jac[1, 1] < -0.9 * zone / J  # the zone's slope, not the sliding branch's

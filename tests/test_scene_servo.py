@@ -117,6 +117,22 @@ def test_hold_from_the_start_does_not_move(servo_scene, started):
     assert_close(total, np.zeros_like(total), rel=2e-6, scale=sag, what="pointing")
 
 
+def test_hold_with_dry_friction_runs_and_holds(servo_scene):
+    """The book's dry friction on both axes (zone 3·10⁻⁹ rad/s): a 10 s hold integrates
+    and holds as the frictionless one does (it stopped 0.4 s in while the zone was
+    differenced, rt70/simulation/coupling.py); the axes at rest dissipate no heat."""
+    run = S.run_scenario(
+        servo_scene, S.scenario("hold", 45.0, 0.0, 10.0), SceneServoFactory(friction=True)
+    )
+    sag = 45.0  # ″, the sector's deflection (the test above)
+    for axis in ("azimuth", "elevation"):
+        error = run.axis_error[axis]
+        assert_close(error, np.zeros_like(error), rel=2e-6, scale=sag, what=axis)
+        heat = run.result.states[f"{axis}_friction:dissipated"]
+        assert np.all(np.isfinite(heat)) and heat.size == run.result.t.size
+        assert_close(heat, np.zeros_like(heat), rel=1e-9, scale=1.0, what=f"{axis} heat, J")
+
+
 def test_elevation_step_moves_toward_the_reference(servo_scene):
     """A 1° elevation step: 3 s of the rate-limited slew (0.18 °/s), the other axis still."""
     sc = S.scenario("step-elevation", 45.0, 0.0, 3.0)

@@ -142,3 +142,32 @@ def test_gust_target_runs_a_record_and_judges_its_pace():
     check = st.gust_target(2.0)
     assert isinstance(check.met, bool)
     assert "for 2 s" in check.measured and "× real time (CVODE" in check.measured
+
+
+def test_servo_commands_are_judged_on_their_real_time_factor(monkeypatch):
+    """Given wall times: a hold of 60 s in 1.2 s is 50× (met), in 1.3 s not; the hold
+    with friction is judged at 10×; a failing command is a failed row, not the end."""
+    from rt70.reports import servo_commands as sc
+
+    assert sc.command_args("hold", True)[-1] == "--friction"
+    quick = sc.servo_command_targets(quick=True)
+    assert len(quick) == len(sc.CASES) and all(c.met is None for c in quick)
+    walls = {"hold": 1.2, "track": 0.9, "step-elevation": 1.0, "step-azimuth": 0.7}
+
+    def fake(args, repeats):
+        if "--friction" in args:
+            return [6.1, 5.9]
+        if args[3] == "step-azimuth":
+            raise Rt70Error("rt70 simulate: exit 2: rt70: error: stopped")
+        return [walls[args[3]] + 0.1, walls[args[3]]]
+
+    monkeypatch.setattr(sc, "wall_times", fake)
+    hold, track, step_el, step_az, friction = sc.servo_command_targets()
+    assert hold.met is True and "50.0× real time" in hold.measured
+    assert track.met is False and "44.4×" in track.measured  # 40 s in 0.9 s
+    assert step_el.met is False  # 25 s in 1.0 s
+    assert step_az.met is False and step_az.measured.startswith("failed:")
+    assert friction.met is True and "10.2×" in friction.measured
+    assert "--friction" in friction.target and "≥ 10×" in friction.target
+    walls["hold"] = 1.3
+    assert sc.servo_command_targets()[0].met is False

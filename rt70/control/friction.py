@@ -21,7 +21,8 @@ creeps: under a torque τ with ``|τ| < F_s`` it moves at ω_ε·atanh(τ/F_s) (
 small ω_ε in integrator steps against that creep.
 
 :class:`AxisFriction` pushes the regularised law on one coordinate as a state component
-(:mod:`rt70.simulation.states`) and integrates the heat it dissipates. :func:`switched_rigid_axis`
+(:mod:`rt70.simulation.states`), integrates the heat it dissipates and gives the
+implicit methods its slope (:func:`friction_slope`). :func:`switched_rigid_axis`
 is the exact stick–slip motion of one rigid axis under the relay law (a switched model
 with events, no regularisation), the reference the regularisations are measured against.
 """
@@ -35,7 +36,7 @@ from typing import ClassVar, Protocol
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.simulation.states import MechanicsForces, StateComponent
+from rt70.simulation.states import MechanicsForces, Partials, StateComponent
 
 
 class DryFriction(Protocol):
@@ -90,6 +91,29 @@ def friction_torque(friction: DryFriction, speed, width: float, kind: str = "tan
         relay = np.clip(w / width, -1.0, 1.0)
     out = -friction.static_torque * relay - friction.slope * w
     return float(out) if out.ndim == 0 else out
+
+
+def friction_slope(friction: DryFriction, speed: float, width: float, kind: str = "tanh") -> float:
+    """``dτ_f/dω`` of :func:`friction_torque`, N·m·s/rad (the zone's at its edge).
+
+    Parameters
+    ----------
+    friction : DryFriction
+        F_s (``static_torque``), k (``slope``).
+    speed : float
+        ω, rad/s.
+    width : float
+        ω_ε, rad/s.
+    kind : {"tanh", "linear"}
+        The regularisation (module docstring).
+    """
+    check_width(width, kind)
+    ratio = float(speed) / width
+    if kind == "tanh":
+        zone = 1.0 - np.tanh(ratio) ** 2
+    else:
+        zone = 1.0 if abs(ratio) <= 1.0 else 0.0
+    return -friction.static_torque / width * zone - friction.slope
 
 
 def creep_speed(friction: DryFriction, torque: float, width: float, kind: str = "tanh") -> float:
@@ -220,6 +244,33 @@ class AxisFriction(StateComponent):
             The mechanics' forces at this evaluation (unused).
         """
         return np.array([-self.torque(qd) * qd[self.index]])
+
+    def partials(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> Partials:
+        """``∂τ_f/∂ω`` on the axis's row and the heat rate's ``−(τ_f + ω ∂τ_f/∂ω)``.
+
+        Given, not differenced: the zone at rest is narrower than a difference step
+        (:mod:`rt70.simulation.coupling`).
+
+        Parameters
+        ----------
+        t : float
+            Time, s (unused).
+        q : numpy.ndarray, shape (nv,)
+            Generalised coordinates, m or rad (unused).
+        qd : numpy.ndarray, shape (nv,)
+            Generalised velocities, m/s or rad/s; the axis's is ``qd[index]``.
+        s : numpy.ndarray, shape (1,)
+            The heat dissipated so far, J (unused).
+        """
+        w = float(qd[self.index])
+        slope = friction_slope(self.friction, w, self.width, self.kind)
+        one = np.ones(1)
+        column = np.array([self.n + self.index])
+        heat = -(self.torque(qd) + w * slope)
+        return Partials(
+            force=(np.array([self.index]), column, slope * one),
+            states=(np.zeros(1, dtype=int), column, heat * one),
+        )
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,9 @@ Servo closed
     The default ``hold`` is not used: at rest its error says nothing about accuracy,
     and LSODA at rtol ≤ 1e-10 on it did not finish within 200 s (measured), so it has
     no tight reference.
+Servo commands
+    ``rt70 simulate rt70_servo --scenario S`` for each scenario, and the hold with dry
+    friction, as a user runs them (:mod:`rt70.reports.servo_commands`).
 Gust record
     One Davenport record of :data:`GUST_DURATION_S` at 5 m/s (seed 1, elevation 45°,
     front wind) through the nonlinear model with both servos closed
@@ -43,15 +46,19 @@ Gust record
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
-import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rt70.reports.targets import COM_TARGET_M, REAL_TIME_TARGET, TRANSIENT_PROBLEM, TargetCheck
+from rt70.reports.servo_commands import servo_command_targets
+from rt70.reports.targets import (
+    COM_TARGET_M,
+    REAL_TIME_TARGET,
+    TRANSIENT_PROBLEM,
+    TargetCheck,
+    wall_times,
+)
 
 if TYPE_CHECKING:
     from rt70.model.scene import Scene
@@ -146,29 +153,7 @@ def command_seconds(method: str, rtol: float, repeats: int = COMMAND_REPEATS) ->
         If the command fails.
     """
     args = ["simulate", "rt70", "--t-end", "10", "--method", method, "--rtol", repr(rtol)]
-    return _wall_times(args, repeats)
-
-
-def _wall_times(args: list[str], repeats: int) -> list[float]:
-    """Wall times of ``rt70 ARGS`` (``python -m rt70``) run ``repeats`` times, s.
-
-    Raises
-    ------
-    Rt70Error
-        If a run fails: its exit code and the last line it printed on stderr.
-    """
-    from rt70.errors import Rt70Error
-
-    cmd = [sys.executable, "-m", "rt70", *args]
-    walls = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        walls.append(time.perf_counter() - start)
-        if done.returncode != 0:
-            tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
-            raise Rt70Error(f"{' '.join(cmd[1:])}: exit {done.returncode}: {tail}")
-    return walls
+    return wall_times(args, repeats)
 
 
 def command_target(win, repeats: int = COMMAND_REPEATS, quick: bool = False) -> TargetCheck:
@@ -210,7 +195,7 @@ def version_target(repeats: int = VERSION_REPEATS, quick: bool = False) -> Targe
     goal = f"start-up `rt70 --version` ≤ {VERSION_TARGET_S:g} s"
     if quick:
         return TargetCheck(goal, "— (not measured in a quick run)", None)
-    walls = _wall_times(["--version"], repeats)
+    walls = wall_times(["--version"], repeats)
     measured = f"{min(walls):.3f} s (best of {len(walls)}, wall)"
     return TargetCheck(goal, measured, min(walls) <= VERSION_TARGET_S)
 
@@ -436,7 +421,8 @@ def check(rows, quick: bool = False, progress: Say | None = None) -> list[Target
     -------
     list of TargetCheck
         Integration, whole command, start-up, right-hand side, Jacobian, servo closed,
-        gust record.
+        the servo scenarios' whole commands (:mod:`rt70.reports.servo_commands`), gust
+        record.
     """
     say = progress or _quiet
     integration, win = integration_target(rows)
@@ -444,14 +430,17 @@ def check(rows, quick: bool = False, progress: Say | None = None) -> list[Target
         command = command_target(None, quick=True)
         version = version_target(quick=True)
         servo = servo_target(None)
+        commands = servo_command_targets(quick=True)
         gust = gust_target(None)
     else:
         say("timing the whole command (subprocess, best of 3) and the start-up")
         command = command_target(win)
         version = version_target()
         servo = servo_target(servo_runs(progress=say))
+        say("timing the servo scenarios' whole commands (subprocess, best of 2)")
+        commands = servo_command_targets()
         say(f"running a {GUST_DURATION_S:g} s gust record through the nonlinear model")
         gust = gust_target()
     say("timing the right-hand side and Jacobian against Pinocchio's")
     kernels = kernel_targets(rounds=3, budget_s=0.01) if quick else kernel_targets()
-    return [integration, command, version, *kernels, servo, gust]
+    return [integration, command, version, *kernels, servo, *commands, gust]

@@ -1,7 +1,10 @@
-"""A benchmark target against the value measured in one run."""
+"""A benchmark target against the value measured in one run, and a command's wall time."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import time
 from dataclasses import dataclass
 
 
@@ -41,3 +44,25 @@ COM_TARGET_M = 1e-5
 
 #: Integration speed of the free-axes transient, × real time.
 REAL_TIME_TARGET = 50.0
+
+
+def wall_times(args: list[str], repeats: int) -> list[float]:
+    """Wall times of ``rt70 ARGS`` (``python -m rt70``) run ``repeats`` times, s.
+
+    Raises
+    ------
+    Rt70Error
+        If a run fails: its exit code and the last line it printed on stderr.
+    """
+    from rt70.errors import Rt70Error
+
+    cmd = [sys.executable, "-m", "rt70", *args]
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        walls.append(time.perf_counter() - start)
+        if done.returncode != 0:
+            tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
+            raise Rt70Error(f"{' '.join(cmd[1:])}: exit {done.returncode}: {tail}")
+    return walls

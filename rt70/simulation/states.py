@@ -16,9 +16,11 @@ and velocities of the mechanics, then the states ``s_i`` of every
 
 The analytic Jacobian of the implicit methods gets the couplings of the components that
 push a force — their rows, their states' columns, and the coordinates that reach them —
-by differences over those columns (:mod:`rt70.simulation.coupling`); the rows of the
-components that only watch (the energy audit) are zero: the solver's Newton iteration
-treats them explicitly.
+by differences over those columns (:mod:`rt70.simulation.coupling`), or from the
+component's own partial derivatives where it gives them (:meth:`StateComponent.partials`:
+a law steeper than any difference step can see, such as dry friction's zone at rest);
+the rows of the components that only watch (the energy audit) are zero: the solver's
+Newton iteration treats them explicitly.
 
 The first component is the energy audit (:class:`EnergyAudit`, (1.73)), which every
 simulation carries; drives with motor states come next. The simulation's result holds
@@ -34,6 +36,25 @@ from typing import ClassVar, NamedTuple
 import numpy as np
 
 from rt70.errors import Rt70Error, ShapeError
+
+
+class Partials(NamedTuple):
+    """A component's analytic partial derivatives, as ``(rows, columns, values)`` triplets.
+
+    The columns number the component's arguments ``[q (nv), q̇ (nv), s (its own states)]``;
+    an entry that appears twice is summed.
+
+    Attributes
+    ----------
+    force : tuple of numpy.ndarray
+        ``∂Q_s/∂(q, q̇, s)``: rows of the component's force (0 … nv − 1).
+    states : tuple of numpy.ndarray
+        ``∂ṡ/∂(q, q̇, s)``: rows of its states (0 … len(names) − 1), with the mechanics'
+        forces held fixed.
+    """
+
+    force: tuple[np.ndarray, np.ndarray, np.ndarray]
+    states: tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
 class MechanicsForces(NamedTuple):
@@ -106,6 +127,25 @@ class StateComponent(ABC):
 
         Added to the input force ``Q_u`` before the accelerations are computed. The
         default is None: the component only watches.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        q, qd : numpy.ndarray, shape (nv,)
+            The mechanics' coordinates (rad or m) and velocities (rad/s or m/s).
+        s : numpy.ndarray, shape (len(names),)
+            The component's states.
+        """
+        return None
+
+    def partials(self, t: float, q: np.ndarray, qd: np.ndarray, s: np.ndarray) -> Partials | None:
+        """The analytic partial derivatives of :meth:`force` and :meth:`derivative`, or None.
+
+        None (the default) leaves them to differences (:mod:`rt70.simulation.coupling`),
+        whose step ``√ε · max(|x_j|, 1)`` cannot see a law that changes over a smaller
+        width of its argument. A component that returns them is not differenced; its
+        derivatives must then not read the mechanics' forces.
 
         Parameters
         ----------
