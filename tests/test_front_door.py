@@ -101,6 +101,19 @@ def test_reading_a_scene_through_the_package_loads_no_pinocchio():
     assert out.splitlines()[-1] == "[]"
 
 
+def test_reading_a_scene_with_wind_elements_fits_no_spline():
+    """rt70_servo's wind elements name built-in coefficient tables; their splines (and
+    scipy.interpolate, which imports scipy.optimize) wait for the first wind load."""
+    out = _fresh(
+        "import sys, rt70\n"
+        "scene = rt70.load_scene('rt70_servo')\n"
+        "print(len(scene.description.winds))\n"
+        "print(sorted(m for m in ('scipy.interpolate', 'scipy.optimize') if m in sys.modules))\n"
+    )
+    count, loaded = out.splitlines()[-2:]
+    assert int(count) > 0 and loaded == "[]"
+
+
 # --- the README ----------------------------------------------------------------------------
 
 QUICK_START = (

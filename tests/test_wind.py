@@ -178,7 +178,7 @@ def test_ratios_are_smooth_through_both_ends(end):
         # within 5 θ² (an O(θ²) approach), or rounding of the table's size where that is less
         assert_close(r, at_end, rel=5.0 * x * x / size, scale=size, what=f"θ − end = {x:g}")
     # and the odd ratio is the derivative: C_N'(0) of the spline, −C_N'(π) at π
-    normal = table._splines[1]
+    normal = table.splines[1]
     derivative = (1.0 if end == 0.0 else -1.0) * float(normal(end, 1))
     assert_close(at_end[1], derivative, rel=1e-14)
 

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import math
 import stat
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -77,11 +78,14 @@ class CoefficientTable:
     axial: np.ndarray
     normal: np.ndarray
     moment: np.ndarray
-    _splines: tuple = field(init=False, repr=False)
-    _pieces: CubicPieces = field(init=False, repr=False)
 
-    def __post_init__(self) -> None:
-        from scipy.interpolate import CubicSpline  # only when a scene has wind elements
+    @cached_property
+    def _fitted(self) -> tuple[tuple[CubicSpline, ...], CubicPieces]:
+        """The periodic splines of C_A, C_N, C_M over 0 … 2π and their pieces in floats.
+
+        Fitted at the first evaluation, not when a scene with wind elements is read.
+        """
+        from scipy.interpolate import CubicSpline
 
         theta = np.radians(self.theta_deg)
         full = np.concatenate([theta, 2.0 * np.pi - theta[::-1][1:]])  # 0 … 2π
@@ -95,10 +99,8 @@ class CoefficientTable:
             extended(self.normal, -1.0),
             extended(self.moment, -1.0),
         )
-        object.__setattr__(self, "_splines", splines)
         # the same polynomials in plain floats: per interval, (C_A, C_N, C_M)'s four each
-        pieces = CubicPieces(full, np.stack([sp.c for sp in splines], axis=-1))
-        object.__setattr__(self, "_pieces", pieces)
+        return splines, CubicPieces(full, np.stack([sp.c for sp in splines], axis=-1))
 
     @classmethod
     def from_rows(cls, source: str, rows: np.ndarray) -> CoefficientTable:
@@ -212,9 +214,14 @@ class CoefficientTable:
             raise WindError(f"{path}: cannot read the coefficient table ({exc})") from None
         return cls.from_text(text, str(path))
 
+    @property
+    def splines(self) -> tuple[CubicSpline, ...]:
+        """The periodic splines (scipy) of C_A, C_N and C_M over θ in [0, 2π] (radians)."""
+        return self._fitted[0]
+
     def coefficients(self, theta: float) -> tuple[float, float, float]:
         """``(C_A, C_N, C_M)`` at θ (radians, in [0, π]) from the splines."""
-        axial, normal, moment = self._splines
+        axial, normal, moment = self._fitted[0]
         return float(axial(theta)), float(normal(theta)), float(moment(theta))
 
     def ratios(self, cos_theta: float, sin_theta: float) -> tuple[float, float, float]:
@@ -230,7 +237,8 @@ class CoefficientTable:
         theta = math.atan2(sin_theta, cos_theta)
         c_a, c_n, c_m = self._values(theta)
         m = len(self.theta_deg) - 1  # the interval [π, …] of the full circle
-        pieces, knots = self._pieces.pieces, self._pieces.knots
+        fitted = self._fitted[1]
+        pieces, knots = fitted.pieces, fitted.knots
         if sin_theta < SMALL_SINE:
             if cos_theta > 0.0:
                 _, normal, moment = pieces[0]
@@ -253,8 +261,9 @@ class CoefficientTable:
         The interval is scipy's (``x_i ≤ θ < x_{i+1}``, the last one closed); the
         polynomial is evaluated by Horner's rule, in plain floats (no array per call).
         """
-        i, dx = self._pieces.locate(theta)
-        return tuple(horner(c, dx) for c in self._pieces.pieces[i])
+        fitted = self._fitted[1]
+        i, dx = fitted.locate(theta)
+        return tuple(horner(c, dx) for c in fitted.pieces[i])
 
 
 def builtin_table(name: str) -> CoefficientTable:

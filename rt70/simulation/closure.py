@@ -13,7 +13,6 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.optimize
 
 from rt70.errors import LoopClosureError, Rt70Error
 from rt70.model.scene import Scene
@@ -130,6 +129,8 @@ def _descend(residual_jacobian, start: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
     None if Φ or B_c is not finite at the start.
     """
+    import scipy.optimize  # a closed loop's start only: not every run's import
+
     cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
     def evaluate(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # Φ and B_c in one pass

@@ -32,7 +32,6 @@ from rt70.model.outputs import Output, evaluate, evaluate_trajectory
 from rt70.model.scene import Scene
 from rt70.model.sides import refuses_backend
 from rt70.physics.baumgarte import DEFAULT_STABILIZATION, Baumgarte
-from rt70.simulation import compiled_run
 from rt70.simulation.backends import BACKENDS, Backend
 from rt70.simulation.closed_chains import constrained_start, residual_trajectory
 from rt70.simulation.coupling import Coupling
@@ -128,6 +127,8 @@ def simulate(
     t0, t1, t_eval = checked_request(side, method, rtol, atol, t_span, t_eval, events)
     if method == GENERALIZED_ALPHA:  # the compiled kernels (large models)
         extras = dict(components=components, events=events, outputs=(outputs, side))
+        from rt70.simulation import compiled_run  # numba's kernels: only this method loads them
+
         return compiled_run.run(scene, (t0, t1), x0, (rtol, atol), inputs, progress, t_eval, extras)
     backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
     evaluate(scene, q0, outputs, side)  # refuses an unknown link before the run

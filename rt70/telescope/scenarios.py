@@ -191,9 +191,9 @@ def run_scenario(
 def _start(scene: Scene, sc: Scenario, drives: DriveFactory) -> tuple:
     """``(q0, holding torques, rest)``: the start at the scenario's pointing.
 
-    The drive factory's own start if it has one (``rest(held)`` then gives its
-    equilibrium at another pointing), else the static equilibrium with the axes held by
-    torques on their coordinates (``rest`` None).
+    The drive factory's own start if it has one, else the static equilibrium with the
+    axes held by torques on their coordinates. ``rest(held)`` gives the same kind of
+    equilibrium at another pointing, and q0 at the start's own (a hold's reference).
     """
     names = scene.coordinate_names
     held = pointing(scene, sc.elevation_deg, sc.azimuth_deg)
@@ -202,10 +202,17 @@ def _start(scene: Scene, sc: Scenario, drives: DriveFactory) -> tuple:
         q0 = equilibrium(scene, held, tol=EQUILIBRIUM_TOL)
         Q0 = static_force(scene, q0)
         torques = {c: -float(Q0[names.index(c)]) for c in held}  # what the drives supply
-        return q0, torques, None
-    # a factory whose drives do not push on the coordinates alone
-    q0, torques = start(scene, held)
-    return q0, torques, (lambda held: start(scene, held)[0])
+
+        def solve(other: dict[str, float]) -> np.ndarray:
+            return equilibrium(scene, other, tol=EQUILIBRIUM_TOL)
+
+    else:  # a factory whose drives do not push on the coordinates alone
+        q0, torques = start(scene, held)
+
+        def solve(other: dict[str, float]) -> np.ndarray:
+            return start(scene, other)[0]
+
+    return q0, torques, (lambda other: q0 if other == held else solve(other))
 
 
 def _axis_references(scene: Scene, sc: Scenario, q0: np.ndarray) -> dict[str, Reference]:
@@ -317,13 +324,13 @@ def _record_series(result, reference_deg: dict, error: dict, sky, total) -> None
         result.series_units[f"pointing_error:{name}"] = "arcsec"
 
 
-def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
+def _target_axes(scene, q0, t, e_ref, a_ref, rest) -> np.ndarray:
     """The main mirror's axis in equilibrium at the reference pointing, per sample.
 
     Equilibria at the distinct reference pointings of a few knots (first, last, and
     where the reference changes), linearly interpolated in between and normalised.
-    ``rest(held)`` gives the equilibrium when the drive factory has its own start (the
-    drives' forces in it); default the axes held by torques on their coordinates.
+    ``rest(held)`` gives the equilibrium (:func:`_start`: the drive factory's, with the
+    drives' forces in it, or the axes held by torques on their coordinates).
     """
     out = mirror_axis_output(scene)
     knots = np.unique(np.r_[0, np.linspace(0, len(t) - 1, 5).astype(int), len(t) - 1])
@@ -333,7 +340,7 @@ def _target_axes(scene, q0, t, e_ref, a_ref, rest=None) -> np.ndarray:
         key = (round(float(e_ref[k]), 12), round(float(a_ref[k]), 12))
         if key not in cache:
             held = pointing(scene, *key)
-            q = equilibrium(scene, held, tol=EQUILIBRIUM_TOL) if rest is None else rest(held)
+            q = rest(held)
             cache[key] = evaluate(scene, q, [out], "reference")[MIRROR_AXIS]
         axes.append(cache[key])
     axes = np.array(axes)
