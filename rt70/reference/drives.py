@@ -158,8 +158,10 @@ def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Driv
     ``∂θ_d/∂q = (∂θ_d/∂P)ᵀ ∂P/∂q`` with P and ∂P/∂q from the compiled joint walk between
     the two links (:class:`rt70.reference.element_kernels.RelativePoints`) instead of
     two placements and two point Jacobians from Pinocchio per evaluation; the same
-    numbers (tested). A joint drive, mapped coordinates (mimic joints) or a path the
-    kernels do not support keep :func:`drive_force`.
+    numbers (tested). A joint drive on a model in Pinocchio's own coordinates reads its
+    coordinate, with the unit vector as gradient, as :func:`drive_force` gives them;
+    mapped coordinates (continuous or mimic joints) or a path the kernels do not
+    support keep :func:`drive_force`.
 
     Parameters
     ----------
@@ -172,6 +174,13 @@ def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Driv
     mesh : rt70.physics.loads.SectorMesh, optional
         The sector's pitch circle of :func:`sector_mesh`; computed once here when None.
     """
+    if drive.sector is None and model.identity_map:  # θ_d is the joint's coordinate
+        m = model.pin_model
+        k = m.joints[m.getJointId(drive.joint)].idx_q  # the book's order is Pinocchio's
+        unit = np.zeros(model.nv)
+        unit[k] = 1.0
+        unit.flags.writeable = False
+        return lambda q: (float(q[k]), unit)
     if drive.sector is None or not model.identity_map:
         return lambda q: drive_force(model, data, q, drive, 1.0, mesh)
     from rt70.reference.element_kernels import RelativePoints

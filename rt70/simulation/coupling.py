@@ -178,8 +178,8 @@ class Coupling:
             unique, where = np.unique(columns, return_inverse=True)
             summed = np.zeros((n, unique.size))
             np.add.at(summed.T, where, dQ.T)
-            mass = scipy.linalg.cho_factor(rhs.backend.mass_matrix(q))
-            J[n : 2 * n, unique] += scipy.linalg.cho_solve(mass, summed)
+            mass = scipy.linalg.cho_factor(rhs.backend.mass_matrix(q), check_finite=False)
+            J[n : 2 * n, unique] += scipy.linalg.cho_solve(mass, summed, check_finite=False)
         return J
 
     def _partials(self, J: np.ndarray, t: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -127,9 +127,7 @@ def simulate(
     t0, t1, t_eval = checked_request(side, method, rtol, atol, t_span, t_eval, events)
     if method == GENERALIZED_ALPHA:  # the compiled kernels (large models)
         extras = dict(components=components, events=events, outputs=(outputs, side))
-        from rt70.simulation import compiled_run  # numba's kernels: only this method loads them
-
-        return compiled_run.run(scene, (t0, t1), x0, (rtol, atol), inputs, progress, t_eval, extras)
+        return _compiled(scene, (t0, t1), x0, (rtol, atol), inputs, progress, t_eval, extras)
     backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
     evaluate(scene, q0, outputs, side)  # refuses an unknown link before the run
     energy_scale = _energy_scale(scene, backend, q0, qd0)
@@ -209,6 +207,13 @@ def _most_samples(
         check_time_series(t_eval.size, channels, "the output times", f"{scene.name}: t_eval")
         return None
     return time_series_samples(channels)
+
+
+def _compiled(*args) -> SimulationResult:
+    """:func:`rt70.simulation.compiled_run.run` of ``args``, imported for it (numba's kernels)."""
+    from rt70.simulation import compiled_run
+
+    return compiled_run.run(*args)
 
 
 class _RightHandSide:
