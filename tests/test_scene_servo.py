@@ -171,3 +171,16 @@ def test_cli_drives_option(capsys):
         assert main(argv) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("rt70: error:")
+
+
+def test_a_stopped_run_with_friction_names_what_to_try(servo_scene):
+    """CVODE stops where the elevation breaks away after sticking (docs/servo-scenarios.md):
+    the error says to try LSODA; without friction, or on LSODA, it adds nothing."""
+    from rt70.control.friction import AxisFriction
+    from rt70.scenes.rt70_drives import FRICTION
+
+    names = servo_scene.coordinate_names
+    friction = AxisFriction("f", names, "base_rx", FRICTION, 1e-9, "linear")
+    assert "try --method LSODA" in S._friction_hint([friction], "CVODE")
+    assert S._friction_hint([friction], "LSODA") == ""
+    assert S._friction_hint([], "CVODE") == ""

@@ -34,6 +34,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from rt70.control.friction import AxisFriction
 from rt70.errors import Rt70Error
 from rt70.guards.resources import check_time_series
 from rt70.linear.linearize import equilibrium, static_force
@@ -182,10 +183,21 @@ def run_scenario(
         progress=progress,
     )
     if not result.success:
-        raise Rt70Error(f"{scene.name}: scenario '{sc.name}': {result.message}")
+        hint = _friction_hint(components, result.method)
+        raise Rt70Error(f"{scene.name}: scenario '{sc.name}': {result.message}{hint}")
     run = _measured(scene, sc, result, refs, start, components)
     run.metrics = measure(run)
     return run
+
+
+def _friction_hint(components: Sequence[StateComponent], method: str) -> str:
+    """What to try when a run with dry friction stops (docs/servo-scenarios.md)."""
+    if method == "LSODA" or not any(isinstance(c, AxisFriction) for c in components):
+        return ""
+    return (
+        f" (dry friction: {method} can fail where an axis breaks away after sticking; "
+        "try --method LSODA, docs/servo-scenarios.md 'Dry friction')"
+    )
 
 
 def _start(scene: Scene, sc: Scenario, drives: DriveFactory) -> tuple:
