@@ -69,9 +69,11 @@ def test_integration_target_takes_the_fastest_run_to_the_accuracy():
     check, win = st.integration_target(rows)
     assert win is rows[2] and check.met is False
     assert check.measured.startswith("1.500 s, 6.7× real time (Radau, rtol 1e-07")
-    assert "≤ 1e-05 m: integration ≤ 0.2 s (≥ 50× real time)" in check.target
-    check, win = st.integration_target([_row("BDF", 1e-7, "ok", 9e-6, 0.19)])
-    assert check.met is True and win.time_s == 0.19
+    assert "≤ 1e-05 m: integration ≤ 0.1 s (≥ 100× real time)" in check.target
+    check, win = st.integration_target([_row("BDF", 1e-7, "ok", 9e-6, 0.099)])
+    assert check.met is True and win.time_s == 0.099
+    check, _ = st.integration_target([_row("BDF", 1e-7, "ok", 9e-6, 0.11)])
+    assert check.met is False  # 91× real time
     check, win = st.integration_target(rows[:1])
     assert check.met is False and win is None and "least error 2.2e-05 m" in check.measured
     check, _ = st.integration_target([])

@@ -42,8 +42,9 @@ TRANSIENT_PROBLEM = "rt70_10s"
 COM_TARGET_M = 1e-5
 
 
-#: Integration speed of the free-axes transient, × real time.
-REAL_TIME_TARGET = 50.0
+#: Integration speed of the free-axes transient, × real time (the speed issue's level;
+#: an earlier issue asked 50×).
+REAL_TIME_TARGET = 100.0
 
 
 def wall_times(args: list[str], repeats: int) -> list[float]:
