@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_coupling import _rhs  # the right-hand side with the audit and the components
 
 from rt70.control.friction import (
     AxisFriction,
@@ -16,9 +17,7 @@ from rt70.control.friction import (
 from rt70.errors import Rt70Error
 from rt70.model.scene import scene_from_text
 from rt70.scenes.rt70_drives import FRICTION, KGF_M
-from rt70.simulation.backends import BACKENDS
-from rt70.simulation.simulate import _RightHandSide, simulate
-from rt70.simulation.states import EnergyAudit, StateLayout
+from rt70.simulation.simulate import simulate
 from rt70.testing import assert_close
 
 TOP = FRICTION.top_speed
@@ -170,10 +169,7 @@ def test_the_implicit_methods_get_the_zones_slope_not_a_differenced_one():
     scene = _rotor(J, "revolute")
     width = 1e-9
     f = AxisFriction("f", scene.coordinate_names, "azimuth", FRICTION, width, "linear")
-    rhs = _RightHandSide(
-        BACKENDS["reference"](scene), StateLayout([EnergyAudit(1e-9), f], 1), None,
-        (0.0, 1.0), False,
-    )  # fmt: skip
+    rhs = _rhs(scene, [f])
     x = np.r_[0.2, 0.4 * width, 0.0, 0.0, 0.0]  # q, q̇, audit (2), heat
     Jac = rhs.jacobian(0.0, x)
     assert rhs.coupling.analytic and not rhs.coupling.coupled
