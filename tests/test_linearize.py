@@ -180,3 +180,24 @@ def test_no_equilibrium_names_the_coordinates_without_stiffness():
         lin.equilibrium(scene)
     q = lin.equilibrium(scene, {"slew": 0.3})  # held: the hinge's sag alone
     assert q[0] == 0.3 and q[1] != 0.0
+
+
+def test_newton_stiffness_is_the_stiffness_without_the_springs_preload_term(monkeypatch):
+    """Newton's matrix (gravity exact, springs Σ JᵀCJ) is the differenced K but for the
+    springs' geometric term, small on rt70_servo; it steers Newton, not the answer, and
+    a scene whose coordinates are not Pinocchio's gets the differenced K itself."""
+    servo = load_scene("rt70_servo")
+    held = rt70_state.rt70_pointing(30.0, 20.0)
+    q0 = lin.equilibrium(servo, held)
+    K = lin.stiffness_matrix(servo, q0)
+    K_newton = lin.newton_stiffness(servo, q0)
+    assert np.abs(K_newton - K).max() > 0.0  # the preload term is left out, not zero
+    assert_close(K_newton, K, rel=1e-6, scale=np.abs(K).max())
+    gear = load_scene("gear_reducer")
+    q = np.zeros(gear.textbook.nv)
+    assert reference.newton_stiffness(gear.reference, gear.reference_data, q) is None
+    np.testing.assert_array_equal(lin.newton_stiffness(gear, q), lin.stiffness_matrix(gear, q))
+    differenced = lambda scene, x, side="reference": lin.stiffness_matrix(scene, x, side=side)  # noqa: E731
+    monkeypatch.setattr(lin, "newton_stiffness", differenced)
+    q_differenced = lin.equilibrium(servo, held)
+    assert_close(q0, q_differenced, rel=1e-9, scale=1.0)

@@ -29,6 +29,7 @@ from rt70.reference.dynamics import (
     gravity_potential,
     kinetic_energy,
     mass_matrix,
+    newton_stiffness,
     weight_moment,
 )
 from rt70.reference.forces import (
@@ -53,6 +54,7 @@ __all__ = [
     "gravity_potential",
     "kinetic_energy",
     "mass_matrix",
+    "newton_stiffness",
     "spring_damper_force",
     "spring_damper_magnitudes",
     "spring_potential",

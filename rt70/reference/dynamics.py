@@ -12,7 +12,7 @@ import pinocchio as pin
 
 import rt70.reference.modal_nodes as modal_nodes
 from rt70.reference.coordinates import to_pinocchio
-from rt70.reference.forces import element_torques
+from rt70.reference.forces import element_gains, element_torques
 from rt70.reference.model import ReferenceData, ReferenceModel
 
 
@@ -78,6 +78,41 @@ def gravity_force(model: ReferenceModel, data: ReferenceData, q: np.ndarray) -> 
     qp, _, J, _ = to_pinocchio(model, q)
     g = pin.computeGeneralizedGravity(model.pin_model, data.pin_data, qp)
     return -g if J is None else -(J.T @ g)
+
+
+def newton_stiffness(
+    model: ReferenceModel, data: ReferenceData, q: np.ndarray
+) -> np.ndarray | None:
+    """Newton's matrix of a static equilibrium: ``∂g/∂q + Σ Jᵀ C J``, symmetrised.
+
+    The stiffness ``K = −∂(Q_g + Q_c)/∂q`` (formalism §4.4) without the springs'
+    geometric term (each element's force times the second derivative of its
+    deformation): gravity's part exact (Pinocchio's
+    ``computeGeneralizedGravityDerivatives``), the springs' part the Gauss–Newton
+    :func:`~rt70.reference.forces.element_gains`. It steers Newton's steps; the
+    equilibrium is decided by the residual, so the term left out slows the convergence
+    (a contraction by its ratio to K per step), not the answer.
+
+    Parameters
+    ----------
+    model : ReferenceModel
+        The reference model (Pinocchio's, mapped to the book's coordinates).
+    data : ReferenceData
+        Its work buffers (Pinocchio's ``Data``).
+    q : numpy.ndarray, shape (nv,)
+        Generalised coordinates, rad or m, in the book's order.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nv, nv), or None
+        N·m/rad or N/m per coordinate pair; None when the book's coordinates are not
+        Pinocchio's own (modal bodies, mimic joints, reordered or Euler-angle joints).
+    """
+    if not model.identity_map:
+        return None
+    dg = pin.computeGeneralizedGravityDerivatives(model.pin_model, data.pin_data, q)
+    K = dg + element_gains(model, data, q)[0]
+    return 0.5 * (K + K.T)
 
 
 def forward_dynamics(

@@ -16,7 +16,7 @@ import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.linear import linearize as lin
-from rt70.linear.linearize import STEP_TOL, equilibrium, static_force, stiffness_matrix
+from rt70.linear.linearize import STEP_TOL, equilibrium, newton_stiffness, static_force
 from rt70.model.couplings import SceneCoupling
 from rt70.model.scene import Scene
 
@@ -42,7 +42,7 @@ def scene_equilibrium(
     Solves ``R(q, K) = Q_g(q) + Q_c(q) + Q_l(q) + Σ_d K_d ∂θ_d/∂q = 0`` for the coordinates not
     held and the drives' reducer torques K_d (one per coupling): n equations, n unknowns
     when each held coordinate is a drive's joint. Newton's method with the stiffness
-    matrix (:func:`rt70.linear.linearize.stiffness_matrix`) and the columns ∂θ_d/∂q for
+    matrix (:func:`rt70.linear.linearize.newton_stiffness`) and the columns ∂θ_d/∂q for
     the K_d, leaving out the term ``K_d ∂²θ_d/∂q²`` (the sector's geometric stiffness,
     some 10⁻⁴ of the structure's: it slows the convergence, not the answer). ``Q_l`` is
     an external static load; its stiffness is left out of Newton's matrix likewise.
@@ -89,7 +89,7 @@ def scene_equilibrium(
     K = np.array([-float(Q[c.index]) for c in couplings])
     scale = _force_scale(scene, held)
     free = np.array([i for i in range(len(names)) if names[i] not in held])
-    S = stiffness_matrix(scene, q)
+    S = newton_stiffness(scene, q)
 
     def force(q: np.ndarray) -> np.ndarray:
         return static_force(scene, q) if load is None else static_force(scene, q) + load(q)
