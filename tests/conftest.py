@@ -9,6 +9,8 @@ only the first such test would move the fixture's cost to the next one. docs/tes
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 #: Module fixtures that take seconds to build: every test that uses one is slow.
@@ -20,3 +22,9 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         if SLOW_FIXTURES.intersection(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.slow)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Every ``rt70`` command a test starts runs in its own interpreter, even where a warm
+    process of this user runs (``rt70 warm``): the tests of the warm process start their own."""
+    os.environ["RT70_WARM"] = "0"

@@ -156,7 +156,9 @@ def test_servo_commands_are_judged_on_their_real_time_factor(monkeypatch):
     assert len(quick) == len(sc.CASES) and all(c.met is None for c in quick)
     walls = {"hold": 1.2, "track": 0.9, "step-elevation": 1.0, "step-azimuth": 0.7}
 
-    def fake(args, repeats):
+    def fake(args, repeats, env=None):
+        if env is not None:  # served warm: a tenth of the time
+            return [w / 10.0 for w in fake(args, repeats)]
         if "--friction" in args:
             return [6.1, 5.9]
         if args[3] == "step-azimuth":
@@ -173,3 +175,7 @@ def test_servo_commands_are_judged_on_their_real_time_factor(monkeypatch):
     assert "--friction" in friction.target and "≥ 10×" in friction.target
     walls["hold"] = 1.3
     assert sc.servo_command_targets()[0].met is False
+    both = sc.servo_command_targets(warm={"RT70_WARM_SOCKET": "w.sock"})
+    assert len(both) == 2 * len(sc.CASES)  # each case cold and warm, a failure each time
+    assert [c.target.rsplit(", ", 1)[1] for c in both[:2]] == ["cold", "warm process"]
+    assert both[0].met is False and both[1].met is True and "served by the warm" in both[1].measured

@@ -27,7 +27,7 @@ import os
 import sys
 import warnings
 
-from rt70.cli import options, session
+from rt70.cli import options, session, warm_client
 from rt70.cli.session import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 from rt70.errors import Rt70Error
 
@@ -46,6 +46,7 @@ COMMANDS = {
     "cart": ("cart", False),
     "new": ("new", False),
     "impact": ("impact", False),
+    "warm": ("warm", False),
 }
 
 
@@ -95,8 +96,24 @@ def command_of(argv: list[str]) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit code."""
+    """Run the command line; return the exit code.
+
+    In a worker of the warm process when one serves this request
+    (:mod:`rt70.cli.warm_client`), else here (:func:`run_here`).
+    """
     argv = sys.argv[1:] if argv is None else argv
+    code = warm_client.run(argv)
+    return run_here(argv) if code is None else code
+
+
+def run_here(argv: list[str]) -> int:
+    """Run the command line in this process; return the exit code.
+
+    Parameters
+    ----------
+    argv : list of str
+        The command's words (``sys.argv[1:]``).
+    """
     parser = build_parser(command_of(argv))
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
     guards = session.warning_guards(args.command)  # module docstring

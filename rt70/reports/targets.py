@@ -1,10 +1,14 @@
-"""A benchmark target against the value measured in one run, and a command's wall time."""
+"""A benchmark target against the value measured in one run; a command's wall time, cold or warm."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 
@@ -47,8 +51,18 @@ COM_TARGET_M = 1e-5
 REAL_TIME_TARGET = 100.0
 
 
-def wall_times(args: list[str], repeats: int) -> list[float]:
+def wall_times(args: list[str], repeats: int, env: dict[str, str] | None = None) -> list[float]:
     """Wall times of ``rt70 ARGS`` (``python -m rt70``) run ``repeats`` times, s.
+
+    Parameters
+    ----------
+    args : list of str
+        The command's words.
+    repeats : int
+        Runs of the command.
+    env : dict, optional
+        Its environment: :func:`warm_process`'s to time it served warm; default this
+        process's with ``RT70_WARM=0`` (each run in a fresh interpreter, start-up included).
 
     Raises
     ------
@@ -58,12 +72,42 @@ def wall_times(args: list[str], repeats: int) -> list[float]:
     from rt70.errors import Rt70Error
 
     cmd = [sys.executable, "-m", "rt70", *args]
+    env = {**os.environ, "RT70_WARM": "0"} if env is None else env
     walls = []
     for _ in range(repeats):
         start = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
         walls.append(time.perf_counter() - start)
         if done.returncode != 0:
             tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
             raise Rt70Error(f"{' '.join(cmd[1:])}: exit {done.returncode}: {tail}")
     return walls
+
+
+@contextmanager
+def warm_process() -> Iterator[dict[str, str]]:
+    """A warm process of its own (``rt70 warm start``, a temporary socket) for the block.
+
+    Yields the environment whose ``rt70`` commands it serves (for :func:`wall_times`);
+    stopped afterwards.
+
+    Raises
+    ------
+    Rt70Error
+        If it does not start: the last line it printed.
+    """
+    from rt70.errors import Rt70Error
+
+    with tempfile.TemporaryDirectory(prefix="rt70w") as directory:
+        env = {k: v for k, v in os.environ.items() if k != "RT70_WARM"}
+        env["RT70_WARM_SOCKET"] = os.path.join(directory, "w.sock")
+        cmd = [sys.executable, "-m", "rt70", "warm"]
+        done = subprocess.run([*cmd, "start", "--idle", "30"], env=env, capture_output=True,
+                              text=True, check=False)  # fmt: skip
+        if done.returncode != 0:
+            tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
+            raise Rt70Error(f"rt70 warm start: exit {done.returncode}: {tail}")
+        try:
+            yield env
+        finally:
+            subprocess.run([*cmd, "stop"], env=env, capture_output=True, check=False)

@@ -1,0 +1,94 @@
+"""Hand a command to the warm process, if one runs: the ``rt70`` command's first step.
+
+Standard library only. When a warm process (``rt70 warm start``,
+:mod:`rt70.cli.warm_server`) listens at :func:`~rt70.cli.warm_protocol.socket_path`,
+:func:`run` passes it this process's standard streams, words, working directory and
+environment; a worker forked from the warm process runs the command on them and sends
+back its exit code, and Ctrl-C or SIGTERM here is passed on to the worker. When none
+listens, or it cannot serve this request as this process would (rt70 changed since it
+started, other start-up variables), :func:`run` returns None and the command runs here.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import struct
+import sys
+
+from rt70.cli import warm_protocol as protocol
+
+#: What a command served warm exits with when its worker died without an exit code.
+EXIT_WORKER_LOST = 1
+
+FORWARDED_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def run(argv: list[str]) -> int | None:
+    """Run ``rt70 ARGV`` in a worker of the warm process; None: run it here instead.
+
+    Parameters
+    ----------
+    argv : list of str
+        The command's words (``sys.argv[1:]``).
+
+    Returns
+    -------
+    int or None
+        The worker's exit code; None when no warm process serves this request.
+    """
+    if os.environ.get(protocol.SWITCH_VARIABLE) == "0" or (argv[:1] == ["warm"]):
+        return None
+    path = protocol.socket_path()
+    if not path.exists() or not _streams_open():
+        return None
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    try:
+        sock.connect(str(path))
+        protocol.send(sock, b"R", protocol.request_body(argv), [0, 1, 2])
+        kind, payload, _ = protocol.receive(sock)
+        if kind != protocol.ANSWERS["pid"]:
+            return None  # "cold" (another rt70, other start-up variables) or no answer
+        return _wait(sock, struct.unpack("!i", payload)[0])
+    except OSError:
+        return None
+    finally:
+        sock.close()
+
+
+def _streams_open() -> bool:
+    """Whether standard input, output and error are open file descriptors."""
+    try:
+        for fd in (0, 1, 2):
+            os.fstat(fd)
+    except OSError:
+        return False
+    return True
+
+
+def _wait(sock: socket.socket, worker: int) -> int:
+    """The worker's exit code, passing it this process's SIGINT, SIGTERM and SIGHUP."""
+
+    def forward(signum: int, _frame) -> None:
+        try:
+            os.kill(worker, signum)
+        except ProcessLookupError:
+            pass
+
+    previous = {s: signal.signal(s, forward) for s in FORWARDED_SIGNALS}
+    try:
+        while True:
+            try:
+                kind, payload, _ = protocol.receive(sock)
+                break
+            except InterruptedError:
+                continue
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    if kind != protocol.ANSWERS["exit"]:
+        print(f"rt70: error: the warm process's worker {worker} ended without an exit code",
+              file=sys.stderr)  # fmt: skip
+        return EXIT_WORKER_LOST
+    return struct.unpack("!i", payload)[0]
