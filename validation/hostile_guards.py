@@ -399,6 +399,7 @@ def run_case(case: Case, timeout: float) -> tuple[str, str, float]:
         OPENBLAS_NUM_THREADS="1",
         MKL_NUM_THREADS="1",
         PYTHONWARNINGS="",
+        RT70_WARM="0",  # its own interpreter: the address-space limit is this process's
     )
 
     def limit() -> None:

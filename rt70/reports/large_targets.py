@@ -40,6 +40,9 @@ PLANT_TARGET_S = 10.0
 SIMULATE_TARGET_S = 30.0
 #: Peak resident memory of each command, GB (1e9 bytes).
 MEMORY_TARGET_GB = 4.0
+#: The commands' environment: each in its own interpreter (a warm process's worker would
+#: not be the process whose memory and time are measured).
+COLD = {**os.environ, "RT70_WARM": "0"}
 
 
 def run_command(args: list[str], cwd: Path) -> tuple[float, float, int, str]:
@@ -58,7 +61,7 @@ def run_command(args: list[str], cwd: Path) -> tuple[float, float, int, str]:
     with out.open("w") as fo, err.open("w") as fe:
         start = time.perf_counter()
         proc = subprocess.Popen([sys.executable, "-m", "rt70", *args], cwd=cwd, stdout=fo,
-                                stderr=fe)  # fmt: skip
+                                stderr=fe, env=COLD)  # fmt: skip
         _, status, usage = os.wait4(proc.pid, 0)
         wall = time.perf_counter() - start
     proc.returncode = os.waitstatus_to_exitcode(status)
