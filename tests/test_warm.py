@@ -127,3 +127,15 @@ def test_the_bench_times_commands_served_by_a_warm_process_of_its_own():
         assert len(wall_times(["--version"], 2, env)) == 2
         assert _served(env) == 2
     assert "no warm process at" in _rt70(env, "warm", "status", check_code=0).stdout
+
+
+def test_the_large_model_bench_times_a_command_served_warm(warm, tmp_path):
+    """``rt70 bench large``'s warm row: a served command's wall time judged, a failure not met."""
+    from rt70.reports import large_targets as lt
+
+    before = _served(warm)
+    ok = lt._judged_warm(["modes", "three_masses"], 1e9, tmp_path, warm)
+    assert _served(warm) == before + 1
+    failed = lt._judged_warm(["modes", "missing.urdf"], 1e9, tmp_path, warm)
+    assert failed.met is False and "exit 2" in failed.measured
+    assert ok.target.endswith("warm process") and "served by the warm process" in ok.measured
