@@ -156,9 +156,10 @@ def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Driv
 
     A gear sector's θ_d depends on its mesh point P in the stator's axes only, so
     ``∂θ_d/∂q = (∂θ_d/∂P)ᵀ ∂P/∂q`` with P and ∂P/∂q from the compiled joint walk between
-    the two links (:class:`rt70.reference.element_kernels.RelativePoints`) instead of
-    two placements and two point Jacobians from Pinocchio per evaluation; the same
-    numbers (tested). A joint drive on a model in Pinocchio's own coordinates reads its
+    the two links, angle and gradient in one compiled call
+    (:meth:`rt70.reference.element_kernels.RelativePoints.sector_angle`), instead of two
+    placements and two point Jacobians from Pinocchio per evaluation; the same numbers
+    (tested). A joint drive on a model in Pinocchio's own coordinates reads its
     coordinate, with the unit vector as gradient, as :func:`drive_force` gives them;
     mapped coordinates (continuous or mimic joints) or a path the kernels do not
     support keep :func:`drive_force`.
@@ -192,12 +193,5 @@ def drive_force_function(model: ReferenceModel, data: ReferenceData, drive: Driv
     points = RelativePoints.of(model, [stator], [mesh_point])
     if points is None:
         return lambda q: drive_force(model, data, q, drive, 1.0, mesh)
-    centre, u, v = mesh.centre, mesh.u, mesh.v
-
-    def angle_gradient(q: np.ndarray) -> tuple[float, np.ndarray]:
-        P, J = points(q)
-        d = P[0] - centre
-        x, y = float(u @ d), float(v @ d)
-        return float(np.arctan2(y, x)), ((x * v - y * u) / (x * x + y * y)) @ J[0]
-
-    return angle_gradient
+    centre, u, v = (np.ascontiguousarray(a, dtype=float) for a in (mesh.centre, mesh.u, mesh.v))
+    return lambda q: points.sector_angle(q, centre, u, v)

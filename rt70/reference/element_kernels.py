@@ -35,7 +35,7 @@ import numpy as np
 
 from rt70.errors import SingularConfigurationError
 from rt70.reference.element_tables import Tables, pack, paths, tables
-from rt70.reference.joint_walk import WORK_SMALL, evaluate_packed, relative_points
+from rt70.reference.joint_walk import WORK_SMALL, evaluate_packed, relative_points, sector_angle
 from rt70.reference.model import ReferenceModel
 
 
@@ -168,3 +168,25 @@ class RelativePoints:
         """``(r12, ∂r12/∂v)`` of every pair: shapes (n, 3) and (n, 3, nv)."""
         _, r, J = self.frames(qp)
         return r, J[:, :3]
+
+    def sector_angle(
+        self, qp: np.ndarray, centre: np.ndarray, u: np.ndarray, v: np.ndarray
+    ) -> tuple[float, np.ndarray]:
+        """A gear sector's ``(θ_d, ∂θ_d/∂v)`` from pair 0 (stator, mesh point), compiled.
+
+        ``θ_d = atan2(v·d, u·d)`` with ``d = r12 − centre`` (the pitch circle's centre and
+        in-plane axes ``u``, ``v`` in the stator's frame, :class:`rt70.physics.loads.SectorMesh`):
+        :func:`rt70.reference.joint_walk.sector_angle`.
+
+        Parameters
+        ----------
+        qp : numpy.ndarray, shape (nq,)
+            Pinocchio's configuration.
+        centre, u, v : numpy.ndarray, shape (3,)
+            The pitch circle's centre (m) and its in-plane unit axes, in the stator's frame.
+        """
+        c, r, gradient = np.empty((self.n, 3, 3)), np.empty((self.n, 3)), np.empty(self.nv)
+        qp = np.ascontiguousarray(qp, dtype=float)
+        angle = sector_angle(qp, self._work, *self._args, c, r, self._jac, self.v_index,
+                             centre, u, v, gradient)  # fmt: skip
+        return float(angle), gradient

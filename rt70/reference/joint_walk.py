@@ -221,6 +221,33 @@ def relative_points(
 
 
 @numba.njit(cache=True)
+def sector_angle(
+    qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R, frame_p,
+    c, r, jac, v_index, centre, u, v, gradient,
+):  # fmt: skip
+    """A gear sector's angle θ_d and ``∂θ_d/∂q̇`` from its mesh point in the stator.
+
+    Pair 0 of :func:`relative_points` is the stator's frame and the mesh point; with
+    ``d = r12 − centre``, ``x = u·d``, ``y = v·d`` the angle is ``atan2(y, x)`` and its
+    gradient ``((x v − y u)/(x² + y²))ᵀ ∂r12/∂q̇`` on the pair's joints
+    (:func:`rt70.reference.drives.drive_force_function`; the same numbers as its Python
+    form). ``gradient`` (nv,) is overwritten: zero but on those joints' columns
+    ``v_index``. The other arguments are :func:`relative_points`'.
+    """
+    relative_points(qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R,
+                    frame_p, c, r, jac)  # fmt: skip
+    d0, d1, d2 = r[0, 0] - centre[0], r[0, 1] - centre[1], r[0, 2] - centre[2]
+    x = u[0] * d0 + u[1] * d1 + u[2] * d2
+    y = v[0] * d0 + v[1] * d1 + v[2] * d2
+    h = x * x + y * y
+    g0, g1, g2 = (x * v[0] - y * u[0]) / h, (x * v[1] - y * u[1]) / h, (x * v[2] - y * u[2]) / h
+    gradient[:] = 0.0
+    for k in range(start[0], start[1]):
+        gradient[v_index[k]] = g0 * jac[k, 0] + g1 * jac[k, 1] + g2 * jac[k, 2]
+    return math.atan2(y, x)
+
+
+@numba.njit(cache=True)
 def evaluate(
     qp, vp, gains, tau_c, tau_d, K, D, work,
     start, split, kind, q_index, v_index, axis, place_R, place_p, frame_R, frame_p,
