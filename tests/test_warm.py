@@ -89,7 +89,9 @@ def test_ctrl_c_reaches_the_worker(warm):
         [*RT70, "simulate", "rt70", "--t-end", "500", "--no-plot"], env=warm,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
-    time.sleep(3.0)  # the worker runs by now (or the client is still starting: same outcome)
+    deadline = time.monotonic() + 120.0
+    while _served(warm) == before and time.monotonic() < deadline:
+        time.sleep(0.2)  # until the client has handed its command over (then it relays)
     client.send_signal(signal.SIGINT)
     _, err = client.communicate(timeout=120)
     assert client.returncode == 130, err
@@ -139,3 +141,20 @@ def test_the_large_model_bench_times_a_command_served_warm(warm, tmp_path):
     failed = lt._judged_warm(["modes", "missing.urdf"], 1e9, tmp_path, warm)
     assert failed.met is False and "exit 2" in failed.measured
     assert ok.target.endswith("warm process") and "served by the warm process" in ok.measured
+
+
+def test_a_signal_before_the_worker_is_known_reaches_it_then():
+    """The client relays a signal that came during the hand-over once the worker's pid
+    arrives (the worker then ends as the signal says)."""
+    from rt70.cli.warm_client import _Relay
+
+    worker = subprocess.Popen(["sleep", "60"])
+    with _Relay() as relay:
+        os.kill(os.getpid(), signal.SIGTERM)
+        deadline = time.monotonic() + 10.0
+        while not relay.pending and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert relay.pending == [signal.SIGTERM]
+        relay.worker = worker.pid
+        assert relay.pending == []
+    assert worker.wait(timeout=30) == -signal.SIGTERM

@@ -102,7 +102,11 @@ def main(argv: list[str] | None = None) -> int:
     (:mod:`rt70.cli.warm_client`), else here (:func:`run_here`).
     """
     argv = sys.argv[1:] if argv is None else argv
-    code = warm_client.run(argv)
+    try:
+        code = warm_client.run(argv)
+    except KeyboardInterrupt:  # Ctrl-C while asking the warm process, before any work
+        print("rt70: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     return run_here(argv) if code is None else code
 
 

@@ -44,17 +44,20 @@ def run(argv: list[str]) -> int | None:
     if not path.exists() or not _streams_open():
         return None
     sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    relay = _Relay()
     try:
         sock.connect(str(path))
-        protocol.send(sock, b"R", protocol.request_body(argv), [0, 1, 2])
-        kind, payload, _ = protocol.receive(sock)
-        if kind != protocol.ANSWERS["pid"]:
-            return None  # "cold" (another rt70, other start-up variables) or no answer
-        return _wait(sock, struct.unpack("!i", payload)[0])
+        with relay:
+            protocol.send(sock, b"R", protocol.request_body(argv), [0, 1, 2])
+            kind, payload, _ = protocol.receive(sock)
+            if kind == protocol.ANSWERS["pid"]:
+                relay.worker = struct.unpack("!i", payload)[0]
+                return _exit_code(sock, relay.worker)
     except OSError:
-        return None
+        pass
     finally:
         sock.close()
+    return None  # "cold" (another rt70, other start-up variables), or no warm process
 
 
 def _streams_open() -> bool:
@@ -67,26 +70,61 @@ def _streams_open() -> bool:
     return True
 
 
-def _wait(sock: socket.socket, worker: int) -> int:
-    """The worker's exit code, passing it this process's SIGINT, SIGTERM and SIGHUP."""
+class _Relay:
+    """Inside the block SIGINT, SIGTERM and SIGHUP go to the worker once it is known.
 
-    def forward(signum: int, _frame) -> None:
+    A signal that comes before the worker's process id is kept and passed on then; if no
+    worker takes the command, it is raised here again when the block ends, as if it had
+    come now.
+    """
+
+    def __init__(self) -> None:
+        self.pending: list[int] = []
+        self._worker: int | None = None
+        self._previous: dict = {}
+
+    @property
+    def worker(self) -> int | None:
+        return self._worker
+
+    @worker.setter
+    def worker(self, pid: int) -> None:
+        self._worker = pid
+        for signum in self.pending:
+            self._send(signum)
+        self.pending.clear()
+
+    def _send(self, signum: int) -> None:
         try:
-            os.kill(worker, signum)
+            os.kill(self._worker, signum)
         except ProcessLookupError:
             pass
 
-    previous = {s: signal.signal(s, forward) for s in FORWARDED_SIGNALS}
-    try:
-        while True:
-            try:
-                kind, payload, _ = protocol.receive(sock)
-                break
-            except InterruptedError:
-                continue
-    finally:
-        for s, handler in previous.items():
+    def _handle(self, signum: int, _frame) -> None:
+        if self._worker is None:
+            self.pending.append(signum)
+        else:
+            self._send(signum)
+
+    def __enter__(self) -> _Relay:
+        self._previous = {s: signal.signal(s, self._handle) for s in FORWARDED_SIGNALS}
+        return self
+
+    def __exit__(self, *_exc) -> None:
+        for s, handler in self._previous.items():
             signal.signal(s, handler)
+        for signum in self.pending:  # nobody took them: as if they came now
+            signal.raise_signal(signum)
+
+
+def _exit_code(sock: socket.socket, worker: int) -> int:
+    """The worker's exit code (its answer), or :data:`EXIT_WORKER_LOST`."""
+    while True:
+        try:
+            kind, payload, _ = protocol.receive(sock)
+            break
+        except InterruptedError:
+            continue
     if kind != protocol.ANSWERS["exit"]:
         print(f"rt70: error: the warm process's worker {worker} ended without an exit code",
               file=sys.stderr)  # fmt: skip
