@@ -76,7 +76,19 @@ def fingerprint() -> str:
 
 
 def send(sock: socket.socket, kind: bytes, payload: bytes = b"", fds: list[int] | None = None):
-    """One message: its kind (a letter of :data:`ANSWERS`, or ``R`` a request), length, payload."""
+    """One message: its kind, its payload's length, the payload; ``fds`` passed with it.
+
+    Parameters
+    ----------
+    sock : socket.socket
+        A connected Unix stream socket.
+    kind : bytes
+        One letter: of :data:`ANSWERS`, or ``R`` (a request), ``T`` (status), ``Q`` (stop).
+    payload : bytes
+        The body (JSON, a packed integer, or nothing).
+    fds : list of int, optional
+        File descriptors passed with it (``SCM_RIGHTS``): a request's standard streams.
+    """
     data = kind + _LENGTH.pack(len(payload)) + payload
     if fds:
         socket.send_fds(sock, [data], fds)

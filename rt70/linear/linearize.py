@@ -32,14 +32,13 @@ hold the two paths equal.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-import scipy.linalg
 
 from rt70.errors import Rt70Error
 from rt70.linear import compiled
+from rt70.linear.newton_step import factor
 from rt70.model.scene import Scene
 from rt70.model.sides import Side, check_side, side_of
 from rt70.physics.constraints import HolonomicMap, locking
@@ -54,10 +53,6 @@ FD_STEP = 1e-6
 #: :func:`equilibrium` keeps its stiffness matrix while each Newton step cuts the force
 #: residual at least this much (a factor 10).
 REUSE_RATIO = 0.1
-#: An eigenvalue of a singular stiffness below this fraction of its largest is in its null
-#: space (the coordinates an equilibrium error names; the stiffness is differenced to
-#: about 1e-8 of its scale, so its rounding floor is far above machine precision).
-NULL_RTOL = 1e-8
 
 
 def static_force(scene: Scene, q: np.ndarray, side: str = "textbook") -> np.ndarray:
@@ -137,6 +132,16 @@ def newton_stiffness(scene: Scene, q: np.ndarray, side: str = "reference") -> np
     :func:`rt70.reference.dynamics.newton_stiffness` where the book's coordinates are
     Pinocchio's own (the RT-70: 1 ms against 27 ms for the differenced K), else
     :func:`stiffness_matrix` on ``side``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (both sides built).
+    q : array_like, shape (nv,)
+        Generalised coordinates in the book's order, m or rad.
+    side : {"reference", "textbook"}
+        Whose matrix: the reference side's where it has one, else the differenced K of
+        this side's static forces.
     """
     if side == "reference":
         s = side_of(scene, side)
@@ -268,7 +273,7 @@ def _newton(scene: Scene, hold: HolonomicMap, q: np.ndarray, force, stiffness, t
         if solve is not None and size <= REUSE_RATIO * previous:
             previous = size  # the last K still converges fast: keep it (modified Newton)
         else:
-            solve, previous = _factor(scene, hold.reduce_matrix(stiffness(q)), hold.names), size
+            solve, previous = factor(scene.name, hold.reduce_matrix(stiffness(q)), hold.names), size
         step = solve(residual)
         q += hold.expand(step, offset=False)
         if float(np.max(np.abs(step), initial=0.0)) <= STEP_TOL * max(1.0, np.abs(q).max()):
@@ -288,44 +293,6 @@ def _free_residual(scene: Scene, hold: HolonomicMap, force: np.ndarray) -> tuple
             "way (a load or a number in the model beyond what its stiffness can hold?)"
         )
     return residual, size
-
-
-def _factor(scene: Scene, K: np.ndarray, names: tuple[str, ...]):
-    """Newton's step ``r ↦ K⁻¹ r`` on the free coordinates ``names``, K factorised once.
-
-    A K singular to working precision (reciprocal condition number below ε, the test of
-    :func:`scipy.linalg.solve`: no equilibrium) is a clear error naming the coordinates
-    of its null space.
-    """
-    if not np.isfinite(K).all():
-        raise Rt70Error(
-            f"{scene.name}: the stiffness matrix overflows (a stiffness or mass near the "
-            "largest floating-point number?)"
-        )
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
-        try:
-            lu = scipy.linalg.lu_factor(K)
-            rcond, info = scipy.linalg.lapack.dgecon(lu[0], np.linalg.norm(K, 1), norm="1")
-            if info == 0 and rcond >= np.finfo(float).eps:
-                return lambda r: scipy.linalg.lu_solve(lu, r)
-        except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
-            pass
-    raise Rt70Error(
-        f"{scene.name}: no static equilibrium: the free coordinates have no stiffness along "
-        f"{_null_coordinates(K, names)} (hold or lock them, or give them a spring)"
-    )
-
-
-def _null_coordinates(K: np.ndarray, names: tuple[str, ...]) -> str:
-    """The coordinates that K's (numerical) null space moves, as a quoted list."""
-    w, V = np.linalg.eigh(0.5 * (K + K.T))
-    null = V[:, np.abs(w) <= NULL_RTOL * max(float(np.abs(w).max()), np.finfo(float).tiny)]
-    if null.size == 0:
-        null = V[:, [int(np.argmin(np.abs(w)))]]
-    weight = np.linalg.norm(null, axis=1)
-    moved = [n for n, x in zip(names, weight, strict=True) if x >= 0.1 * weight.max()]
-    return ", ".join(f"'{n}'" for n in moved[:8]) + (" …" if len(moved) > 8 else "")
 
 
 @dataclass

@@ -231,8 +231,18 @@ def sector_angle(
     ``d = r12 − centre``, ``x = u·d``, ``y = v·d`` the angle is ``atan2(y, x)`` and its
     gradient ``((x v − y u)/(x² + y²))ᵀ ∂r12/∂q̇`` on the pair's joints
     (:func:`rt70.reference.drives.drive_force_function`; the same numbers as its Python
-    form). ``gradient`` (nv,) is overwritten: zero but on those joints' columns
-    ``v_index``. The other arguments are :func:`relative_points`'.
+    form).
+
+    Parameters
+    ----------
+    qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R, frame_p, c, r, jac
+        As :func:`relative_points` (pair 0: the stator's frame and the mesh point).
+    v_index : numpy.ndarray
+        int64 per joint entry: its column in Pinocchio's velocity.
+    centre, u, v : numpy.ndarray, shape (3,)
+        The pitch circle's centre (m) and its in-plane unit axes, in the stator's frame.
+    gradient : numpy.ndarray, shape (nv,)
+        Out: ``∂θ_d/∂q̇``, overwritten (zero but on the pair's joints' columns).
     """
     relative_points(qp, work, start, split, kind, q_index, axis, place_R, place_p, frame_R,
                     frame_p, c, r, jac)  # fmt: skip
