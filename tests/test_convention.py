@@ -42,6 +42,7 @@ def _calls(model: ReferenceModel, data: ReferenceData, q: np.ndarray, qd: np.nda
         "kinetic_energy": lambda: reference.kinetic_energy(model, data, q, qd),
         "gravity_potential": lambda: reference.gravity_potential(model, data, q),
         "weight_moment": lambda: reference.weight_moment(model, data, q),
+        "newton_stiffness": lambda: reference.newton_stiffness(model, data, q),
         "spring_damper_force": lambda: reference.spring_damper_force(model, data, q, qd),
         "spring_potential": lambda: reference.spring_potential(model, data, q),
         "spring_damper_magnitudes": lambda: reference.spring_damper_magnitudes(model, data, q, qd),

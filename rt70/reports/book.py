@@ -21,6 +21,7 @@ from rt70.model.scene import Scene, load_scene
 from rt70.plotting.modal import plot_bode
 from rt70.reports.book_azimuth import azimuth_section
 from rt70.reports.book_format import (
+    fixed,
     frequencies,
     markdown_table,
     relative_difference,
@@ -299,8 +300,8 @@ def sweep_section(scene: Scene, elevations=(0, 15, 30, 45, 60, 75, 90)) -> str:
                     [
                         f"{e}°",
                         s.body,
-                        *(f"{x:.3f}" for x in s.displacement_mm),
-                        f"{s.rotation_arcsec:.2f}",
+                        *(fixed(x, 3) for x in s.displacement_mm),
+                        fixed(s.rotation_arcsec, 2),
                     ]
                 )
     return f"""## The 42-DOF model against elevation (§4.2.3 listing)

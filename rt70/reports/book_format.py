@@ -19,6 +19,17 @@ def relative_difference(x: float, ref: float) -> str:
     return f"{abs(x - ref) / abs(ref):.1e}"
 
 
+def fixed(x: float, digits: int) -> str:
+    """``x`` with ``digits`` decimals, a value that rounds to zero written ``0`` unsigned.
+
+    A quantity zero by symmetry (the sideways sag of a structure pointed along its plane)
+    comes out as ±1e-12 of rounding, whose sign another CPU or solver may flip: the
+    report prints it the same either way.
+    """
+    text = f"{x:.{digits}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     """A GitHub markdown table of text cells."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
