@@ -216,11 +216,16 @@ class ReferenceData:
     ----------
     pin_data, pin_data_no_gravity : pinocchio.Data
         Pinocchio's buffers for ``model.pin_model`` and ``model.pin_model_no_gravity``.
+    placements : dict
+        Points located once: ``(link, xyz) ↦ (joint, placement)`` of
+        :func:`rt70.reference.points.link_point`, kept by
+        :func:`~rt70.reference.points.point_positions` for a trajectory's samples.
     """
 
     def __init__(self, model: ReferenceModel) -> None:
         self.pin_data = model.pin_model.createData()
         self.pin_data_no_gravity = model.pin_model_no_gravity.createData()
+        self.placements: dict[tuple, tuple[int, pin.SE3]] = {}
 
 
 def _attachment(bodies: dict, ref: FrameRef) -> tuple[int, pin.SE3]:

@@ -73,7 +73,7 @@ def point_positions(
     """Ground-axis positions (n, 3) of the points ``(link, xyz)`` at q, in m.
 
     One ``pin.forwardKinematics`` for all of them; each is ``(oMi[joint] · placement)``'s
-    translation.
+    translation, the placement located once per ``data`` (:func:`link_point`).
 
     Parameters
     ----------
@@ -87,7 +87,7 @@ def point_positions(
     points : sequence of (str, array_like)
         The points: a link's name and the point in the link's frame (m).
     """
-    located = [link_point(model, link, xyz) for link, xyz in points]
+    located = [_located(model, data, link, xyz) for link, xyz in points]
     qp, _, _, _ = to_pinocchio(model, q)
     d = data.pin_data
     pin.forwardKinematics(model.pin_model, d, qp)
@@ -95,6 +95,18 @@ def point_positions(
     for k, (joint, placement) in enumerate(located):
         out[k] = (d.oMi[joint] * placement).translation
     return out
+
+
+def _located(model: ReferenceModel, data: ReferenceData, link: str, xyz) -> tuple[int, pin.SE3]:
+    """:func:`link_point`, kept in ``data.placements`` (a point checked once is valid)."""
+    try:
+        key = (link, tuple(np.asarray(xyz, dtype=float).ravel().tolist()))
+    except (TypeError, ValueError):
+        return link_point(model, link, xyz)  # not numbers: its error names the point
+    found = data.placements.get(key)
+    if found is None:
+        found = data.placements[key] = link_point(model, link, xyz)
+    return found
 
 
 def point_position(

@@ -72,13 +72,12 @@ def predicted_settling(step_arcsec: float, gains: CascadeGains, band: float = BA
     # x = [e, ∫e]: ė = −(K_p e + K_i ∫e), from e_lin with the integral at zero
     system = np.array([[-w, -k_i], [1.0, 0.0]])
     t = np.arange(0.0, 40.0 / min(w, k_i / w) + 0.005, 0.005)
-    x = np.array([e_lin, 0.0])
-    propagate = scipy.linalg.expm(system * 0.005)
-    errors = np.empty(t.size)
-    for i in range(t.size):
-        errors[i] = x[0]
-        x = propagate @ x
-    return float(slew + settling_time(t, errors / RAD_PER_ARCSEC, band))
+    states = np.array([[e_lin], [0.0]])  # x(t_k) for k < m, then by doubling: P^m x(t_k)
+    power = scipy.linalg.expm(system * 0.005)
+    while states.shape[1] < t.size:
+        states = np.hstack([states, power @ states])
+        power = power @ power
+    return float(slew + settling_time(t, states[0, : t.size] / RAD_PER_ARCSEC, band))
 
 
 #: Metrics that are NaN when the run never settled (:func:`settling_time`) or the drive
