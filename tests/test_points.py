@@ -374,3 +374,21 @@ def test_root_link_not_named_world():
         Jv, Jw = module.point_jacobian(m, d, q, "arm", [1, 0, 0])
         assert_close(Jw[:, 0], [0, 0, 1], rel=MIN_REL)
         assert_close(Jv[:, 0], [-np.sin(0.4), np.cos(0.4), 0], rel=1e-14)
+
+
+def test_reference_points_are_located_once_per_data():
+    """point_positions keeps each point's (joint, placement) in data.placements: a second
+    call finds them and gives the same positions; a point that is not three numbers is
+    the same clear error every time, and is not kept."""
+    scene = load_scene("rt70")
+    ref, data = scene.reference, scene.reference_data
+    pts = [(p.link, p.xyz) for p in scene.description.optical_points]
+    q = 0.01 * np.random.default_rng(5).standard_normal(scene.textbook.nv)
+    first = ref_points.point_positions(ref, data, q, pts)
+    assert len(data.placements) == len(set((lk, tuple(x)) for lk, x in pts)) > 0
+    np.testing.assert_array_equal(ref_points.point_positions(ref, data, q, pts), first)
+    kept = len(data.placements)
+    for bad in ("abc", (1.0, 2.0)):
+        with pytest.raises(ShapeError, match="point of link"):
+            ref_points.point_positions(ref, data, q, [(pts[0][0], bad)])
+    assert len(data.placements) == kept
