@@ -159,3 +159,26 @@ def test_a_signal_before_the_worker_is_known_reaches_it_then():
         relay.worker = worker.pid
         assert relay.pending == []
     assert worker.wait(timeout=30) == -signal.SIGTERM
+
+
+def test_a_client_that_sends_nonsense_or_goes_away_does_not_stop_it(warm):
+    """Each connection is answered on its own: a truncated or malformed request, or a
+    client gone before its answer, leaves the warm process serving."""
+    import socket
+    import struct
+
+    path = warm["RT70_WARM_SOCKET"]
+    bad = b"{not json"
+    for junk, fds in ((b"", None), (b"R\x00\x00", None), (b"Z", None),
+                      (b"R" + struct.pack("!I", len(bad)) + bad, [0, 1, 2])):  # fmt: skip
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.connect(path)
+        if fds:
+            socket.send_fds(sock, [junk], fds)
+        else:
+            sock.sendall(junk)
+        sock.close()
+    before = _served(warm)
+    _rt70(warm, "--version", check_code=0)
+    assert _served(warm) == before + 1
+    assert "JSONDecodeError" in Path(path + ".log").read_text()  # the bad one was read, logged

@@ -21,15 +21,18 @@ budget: a run its method cannot integrate stops with one line (:mod:`rt70.simula
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import os
 import sys
 import warnings
+from typing import TYPE_CHECKING
 
-from rt70.cli import options, session, warm_client
+from rt70.cli import session, warm_client
 from rt70.cli.session import EXIT_BROKEN_PIPE, EXIT_CODES, EXIT_INTERRUPTED, EXIT_TERMINATED
 from rt70.errors import Rt70Error
+
+if TYPE_CHECKING:  # argparse itself is imported by the parser, not by a command served warm
+    import argparse
 
 #: Every command: its module of this folder (``add_parser(sub)``, ``run(args)``), in the
 #: order of ``rt70 --help``; those marked take the pointing arguments as a second argument.
@@ -60,6 +63,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         pays for what it uses); ``""``: of none (``rt70 --version``); None: of every
         command (``rt70 --help``, an unknown command's error).
     """
+    from rt70.cli import options  # here, not above: a command served warm never needs it
+
     parser = options.Parser(
         prog="rt70",
         description="Models of flexible structures, cross-checked against Pinocchio.",
@@ -118,6 +123,8 @@ def run_here(argv: list[str]) -> int:
     argv : list of str
         The command's words (``sys.argv[1:]``).
     """
+    from rt70.cli import options
+
     parser = build_parser(command_of(argv))
     args = parser.parse_args(argv)  # bad options: one line, exit 2 (options.Parser)
     guards = session.warning_guards(args.command)  # module docstring

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import io
 import json
 import os
@@ -77,6 +78,8 @@ class Server:
             with contextlib.redirect_stdout(null), contextlib.redirect_stderr(null):
                 for words in WARM_UP:
                     run_here(list(words))
+        gc.collect()
+        gc.freeze()  # the workers' collections skip what is here: fewer pages copied on write
         self.warm_up_s = time.perf_counter() - start
 
     def listen(self) -> None:
@@ -111,8 +114,14 @@ class Server:
             last = time.monotonic()
             with conn:
                 conn.settimeout(None)
-                if not self.answer(conn):
+                try:
+                    keep = self.answer(conn)
+                except Exception:  # one connection's trouble (a client gone) is not ours
+                    _log(traceback.format_exc().rstrip())
+                    keep = True
+                if not keep:
                     return
+        _log("idle: stopping" if self.owns_socket() else "the socket is not ours: stopping")
 
     def answer(self, conn: socket.socket) -> bool:
         """Answer one connection; False: stop serving."""
@@ -123,6 +132,7 @@ class Server:
                 return True
             if kind == b"Q":
                 protocol.send(conn, protocol.ANSWERS["stopping"])
+                _log("asked to stop: stopping")
                 return False
             if kind != b"R" or len(fds) != 3 or not _same_user(conn):
                 return True
@@ -130,6 +140,7 @@ class Server:
             reason = self.refusal(request)
             if reason is not None:
                 protocol.send(conn, protocol.ANSWERS["cold"], reason.encode())
+                _log(f"not served ({reason})" + (": stopping" if reason == STALE else ""))
                 return reason != STALE
             self.served += 1
             if os.fork() == 0:
@@ -163,6 +174,11 @@ class Server:
 
 #: The refusal that stops the warm process: its rt70 files changed since it started.
 STALE = "rt70 changed since the warm process started"
+
+
+def _log(line: str) -> None:
+    """One line (or a traceback) on the warm process's log (``<socket>.log``), timed."""
+    print(f"{time.strftime('%Y-%m-%d %H:%M:%S')} {line}", file=sys.stderr, flush=True)
 
 
 def _same_user(conn: socket.socket) -> bool:
@@ -265,6 +281,7 @@ def main(argv: list[str] | None = None) -> int:
     server.warm_up()
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # the workers are reaped by the system
     server.listen()
+    _log(f"pid {os.getpid()} ready at {server.path} (warm-up {server.warm_up_s:.2f} s)")
     try:
         server.loop()
     finally:
