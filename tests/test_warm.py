@@ -156,7 +156,7 @@ def test_a_signal_before_the_worker_is_known_reaches_it_then():
         while not relay.pending and time.monotonic() < deadline:
             time.sleep(0.01)
         assert relay.pending == [signal.SIGTERM]
-        relay.worker = worker.pid
+        relay.hand_over(worker.pid)
         assert relay.pending == []
     assert worker.wait(timeout=30) == -signal.SIGTERM
 

@@ -51,8 +51,9 @@ def run(argv: list[str]) -> int | None:
             protocol.send(sock, b"R", protocol.request_body(argv), [0, 1, 2])
             kind, payload, _ = protocol.receive(sock)
             if kind == protocol.ANSWERS["pid"]:
-                relay.worker = struct.unpack("!i", payload)[0]
-                return _exit_code(sock, relay.worker)
+                worker = struct.unpack("!i", payload)[0]
+                relay.hand_over(worker)
+                return _exit_code(sock, worker)
     except OSError:
         pass
     finally:
@@ -83,12 +84,8 @@ class _Relay:
         self._worker: int | None = None
         self._previous: dict = {}
 
-    @property
-    def worker(self) -> int | None:
-        return self._worker
-
-    @worker.setter
-    def worker(self, pid: int) -> None:
+    def hand_over(self, pid: int) -> None:
+        """From now on relay to the worker ``pid``, the signals kept so far first."""
         self._worker = pid
         for signum in self.pending:
             self._send(signum)
@@ -118,13 +115,12 @@ class _Relay:
 
 
 def _exit_code(sock: socket.socket, worker: int) -> int:
-    """The worker's exit code (its answer), or :data:`EXIT_WORKER_LOST`."""
-    while True:
-        try:
-            kind, payload, _ = protocol.receive(sock)
-            break
-        except InterruptedError:
-            continue
+    """The worker's exit code (its answer), or :data:`EXIT_WORKER_LOST`.
+
+    A relayed signal does not break the wait: the socket calls resume after a handler
+    that returns (PEP 475).
+    """
+    kind, payload, _ = protocol.receive(sock)
     if kind != protocol.ANSWERS["exit"]:
         print(f"rt70: error: the warm process's worker {worker} ended without an exit code",
               file=sys.stderr)  # fmt: skip

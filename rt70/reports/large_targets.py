@@ -28,7 +28,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from rt70.reports.targets import TargetCheck, warm_process
+from rt70.reports.targets import TargetCheck, run_kind, wall_times, warm_process
 
 #: Bodies of the chain the targets are judged on (6 coordinates each).
 BODIES = 334
@@ -112,15 +112,14 @@ def _judged_warm(args: list[str], limit: float, cwd: Path, env: dict[str, str]) 
 
     The peak memory is the cold run's: the worker is not the process that is waited for.
     """
+    from rt70.errors import Rt70Error
+
     goal = f"`rt70 {args[0]}` on a {6 * BODIES}-coordinate chain ≤ {limit:g} s, warm process"
-    start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "rt70", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, check=False)  # fmt: skip
-    wall = time.perf_counter() - start
-    if done.returncode != 0:
-        last = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
-        return TargetCheck(goal, f"exit {done.returncode}: {last}", False)
-    measured = f"{wall:.1f} s (wall, one run, served by the warm process; memory: the cold run's)"
+    try:
+        (wall,) = wall_times(args, 1, env, cwd=str(cwd))
+    except Rt70Error as exc:
+        return TargetCheck(goal, f"failed: {exc}", False)
+    measured = f"{wall:.1f} s (wall, one run, {run_kind(env)}; memory: the cold run's)"
     return TargetCheck(goal, measured, wall <= limit)
 
 

@@ -18,7 +18,7 @@ at a stated accuracy; these are the commands as run.
 
 from __future__ import annotations
 
-from rt70.reports.targets import TargetCheck, wall_times
+from rt70.reports.targets import TargetCheck, run_kind, wall_times
 
 #: Whole command, × real time, of the frictionless scenarios and of the hold with friction.
 SCENARIO_TARGET = 50.0
@@ -87,6 +87,6 @@ def _timed(goal: str, args: list[str], speed: tuple[float, float], repeats: int,
     except Rt70Error as exc:
         return TargetCheck(goal, f"failed: {exc}", False)
     factor = speed[0] / min(walls)
-    how = "start-up included" if env is None else "served by the warm process"
+    how = run_kind(env)
     measured = f"{min(walls):.2f} s (best of {len(walls)}, wall, {how}), {factor:.1f}× real time"
     return TargetCheck(goal, measured, factor >= speed[1])

@@ -57,6 +57,7 @@ from rt70.reports.targets import (
     REAL_TIME_TARGET,
     TRANSIENT_PROBLEM,
     TargetCheck,
+    run_kind,
     wall_times,
     warm_process,
 )
@@ -186,9 +187,8 @@ def command_target(
     if win is None:
         return TargetCheck(goal, "— (no run reached the accuracy)", None)
     walls = command_seconds(win.method, win.rtol, repeats, warm)
-    how = "start-up included" if warm is None else "served by the warm process"
     measured = (
-        f"{min(walls):.2f} s (best of {len(walls)}, wall, {how}; "
+        f"{min(walls):.2f} s (best of {len(walls)}, wall, {run_kind(warm)}; "
         f"--method {win.method} --rtol {win.rtol:g})"
     )
     return TargetCheck(goal, measured, min(walls) <= COMMAND_TARGET_S)

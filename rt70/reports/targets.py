@@ -51,7 +51,9 @@ COM_TARGET_M = 1e-5
 REAL_TIME_TARGET = 100.0
 
 
-def wall_times(args: list[str], repeats: int, env: dict[str, str] | None = None) -> list[float]:
+def wall_times(
+    args: list[str], repeats: int, env: dict[str, str] | None = None, cwd: str | None = None
+) -> list[float]:
     """Wall times of ``rt70 ARGS`` (``python -m rt70``) run ``repeats`` times, s.
 
     Parameters
@@ -63,6 +65,8 @@ def wall_times(args: list[str], repeats: int, env: dict[str, str] | None = None)
     env : dict, optional
         Its environment: :func:`warm_process`'s to time it served warm; default this
         process's with ``RT70_WARM=0`` (each run in a fresh interpreter, start-up included).
+    cwd : path, optional
+        Where it runs (its output files go there); default this process's directory.
 
     Raises
     ------
@@ -76,12 +80,21 @@ def wall_times(args: list[str], repeats: int, env: dict[str, str] | None = None)
     walls = []
     for _ in range(repeats):
         start = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env, cwd=cwd)
         walls.append(time.perf_counter() - start)
         if done.returncode != 0:
-            tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
-            raise Rt70Error(f"{' '.join(cmd[1:])}: exit {done.returncode}: {tail}")
+            raise Rt70Error(f"{' '.join(cmd[1:])}: exit {done.returncode}: {_last_line(done)}")
     return walls
+
+
+def run_kind(env: dict[str, str] | None) -> str:
+    """How :func:`wall_times` ran a command with ``env``, as the measured values say it."""
+    return "start-up included" if env is None else "served by the warm process"
+
+
+def _last_line(done: subprocess.CompletedProcess) -> str:
+    """The last line a failed command printed on stderr."""
+    return (done.stderr.strip().splitlines() or ["(no output)"])[-1]
 
 
 @contextmanager
@@ -105,8 +118,7 @@ def warm_process() -> Iterator[dict[str, str]]:
         done = subprocess.run([*cmd, "start", "--idle", "30"], env=env, capture_output=True,
                               text=True, check=False)  # fmt: skip
         if done.returncode != 0:
-            tail = (done.stderr.strip().splitlines() or ["(no output)"])[-1]
-            raise Rt70Error(f"rt70 warm start: exit {done.returncode}: {tail}")
+            raise Rt70Error(f"rt70 warm start: exit {done.returncode}: {_last_line(done)}")
         try:
             yield env
         finally:
