@@ -90,7 +90,9 @@ METHODS = tuple(m for m in _simulate.METHODS if m != "RK23")
 STIFF_METHODS = tuple(
     m
     for m in METHODS
-    if m in _simulate.IMPLICIT or m.startswith("CVODE") or m == _simulate.GENERALIZED_ALPHA
+    if m in _simulate.IMPLICIT
+    or m.startswith("CVODE")
+    or m in (_simulate.GENERALIZED_ALPHA, _simulate.COMPILED_BDF)
 )
 #: The tolerance ladder (relative tolerance; ``atol`` is the default of
 #: :func:`~rt70.simulation.simulate.simulate`).

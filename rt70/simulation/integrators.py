@@ -37,6 +37,8 @@ CVODE_METHODS = {"CVODE": "BDF", "CVODE_ADAMS": "Adams"}
 MIN_RTOL = 100 * np.finfo(float).eps
 #: The generalized-α method on the compiled kernels (:mod:`rt70.simulation.compiled_run`).
 GENERALIZED_ALPHA = "generalized-alpha"
+#: scipy's BDF compiled with the equations of a passive scene (:mod:`rt70.simulation.compiled_bdf`).
+COMPILED_BDF = "compiled-BDF"
 #: The methods integrating the first-order form (scipy's, then SUNDIALS').
 METHODS = SCIPY_METHODS + tuple(CVODE_METHODS)
 #: Largest number of CVODE steps between two output times (CVODE's default, 500, is
@@ -140,36 +142,62 @@ def budgeted(rhs: Rhs, span: float, limit: int | None = None, t0: float = 0.0) -
         Past the limit, or at the pace check (the run would keep more samples than
         memory holds).
     """
-    budget = _BUDGET.get()
-    limits = [x for x in (limit, None if budget is None else budget.limit(span)) if x is not None]
-    if not limits:
-
-        def stoppable(t: float, x: np.ndarray) -> np.ndarray:
-            stop.check()
-            return rhs(t, x)
-
-        return stoppable
-    most = min(limits)
-    calls = [0]
+    counter = EvaluationCounter(span, limit, t0)
 
     def counted(t: float, x: np.ndarray) -> np.ndarray:
+        counter.add(1, t)
+        return rhs(t, x)
+
+    return counted
+
+
+class EvaluationCounter:
+    """Evaluations counted against the limits of :func:`budgeted`, a stop checked at each count.
+
+    Parameters
+    ----------
+    span : float
+        The run's length ``t1 − t0``, s.
+    limit : int, optional
+        The most samples memory holds for the run (none: only the budget in force).
+    t0 : float
+        The run's start time, s (for the pace check).
+    """
+
+    def __init__(self, span: float, limit: int | None = None, t0: float = 0.0) -> None:
+        budget = _BUDGET.get()
+        self.budget, self.span, self.limit, self.t0 = budget, span, limit, t0
+        limits = [
+            x for x in (limit, None if budget is None else budget.limit(span)) if x is not None
+        ]
+        self.most = min(limits) if limits else None
+        self.calls = 0
+
+    def add(self, calls: int, t: float) -> None:
+        """Count ``calls`` more evaluations, the run having reached ``t``, s.
+
+        Raises
+        ------
+        SimulationError
+            Past the limit, or at the pace check (:func:`budgeted`).
+        """
         stop.check()
-        calls[0] += 1
-        if calls[0] == PACE_CHECK and limit is not None:
-            _check_pace(t - t0, span, limit)
-        if calls[0] > most:
+        if self.most is None:
+            return
+        before, self.calls = self.calls, self.calls + calls
+        if before < PACE_CHECK <= self.calls and self.limit is not None:
+            _check_pace(t - self.t0, self.span, self.limit)
+        if self.calls > self.most:
+            budget = self.budget
             why = (
                 "the memory this run may use for its samples (one per step)"
-                if limit is not None and most == limit
+                if self.limit is not None and self.most == self.limit
                 else f"{budget.minimum} + {budget.per_second:g} per simulated second: the "
                 "equations are too stiff or too fast for this method here (an explicit "
                 "method on stiff springs, a drive or element far stiffer or faster than "
                 "its parameters' usual range)"
             )
-            raise SimulationError(f"stopped after {most} right-hand-side evaluations ({why})")
-        return rhs(t, x)
-
-    return counted
+            raise SimulationError(f"stopped after {self.most} right-hand-side evaluations ({why})")
 
 
 def _check_pace(elapsed: float, span: float, limit: int) -> None:

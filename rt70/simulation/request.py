@@ -14,10 +14,10 @@ import numpy as np
 
 from rt70.errors import Rt70Error
 from rt70.model.sides import check_side
-from rt70.simulation.integrators import GENERALIZED_ALPHA, METHODS, MIN_RTOL
+from rt70.simulation.integrators import COMPILED_BDF, GENERALIZED_ALPHA, METHODS, MIN_RTOL
 
 #: Every method :func:`rt70.simulation.simulate.simulate` takes.
-ALL_METHODS = (*METHODS, GENERALIZED_ALPHA)
+ALL_METHODS = (*METHODS, GENERALIZED_ALPHA, COMPILED_BDF)
 
 Event = Callable[[float, np.ndarray, np.ndarray], float]
 

@@ -36,6 +36,7 @@ from rt70.simulation.backends import BACKENDS, Backend
 from rt70.simulation.closed_chains import constrained_start, residual_trajectory
 from rt70.simulation.coupling import Coupling
 from rt70.simulation.integrators import (
+    COMPILED_BDF,
     CVODE_METHODS,
     GENERALIZED_ALPHA,
     Integration,
@@ -100,8 +101,8 @@ def simulate(
         analytic (Pinocchio's) or differenced by the solver
         (:mod:`rt70.simulation.backends`).
     method : str
-        A method of :data:`METHODS` (scipy's, SUNDIALS': :mod:`~.integrators`) or
-        "generalized-alpha", on any side (:mod:`rt70.simulation.compiled_run`).
+        Of :data:`METHODS`: scipy's, SUNDIALS' (:mod:`~.integrators`); on the compiled
+        kernels, any side: generalized-alpha (:mod:`~.compiled_run`), compiled-BDF.
     rtol, atol : float
         Tolerances; ``atol`` defaults to ``1e-3 · rtol`` on q and q̇ (m, rad) and
         ``rtol`` of the initial energy scale on the two energy states.
@@ -112,8 +113,8 @@ def simulate(
     progress : bool
         Show a progress bar (tqdm) on stderr.
     outputs : sequence of rt70.model.outputs.Output
-        Quantities evaluated on the trajectory by ``side``, in
-        ``result.outputs`` by name, arrays (n_t, size); checked at the start first.
+        Quantities evaluated on the trajectory by ``side`` (checked at the start first), in
+        ``result.outputs`` by name, arrays (n_t, size).
     components : sequence of StateComponent
         Extra states integrated with the mechanics after the energy audit's
         (:mod:`rt70.simulation.states`), in ``result.states`` by name.
@@ -125,9 +126,9 @@ def simulate(
         ``direction``, for every method; their times in ``result.t_events``.
     """
     t0, t1, t_eval = checked_request(side, method, rtol, atol, t_span, t_eval, events)
-    if method == GENERALIZED_ALPHA:  # the compiled kernels (large models)
-        extras = dict(components=components, events=events, outputs=(outputs, side))
-        return _compiled(scene, (t0, t1), x0, (rtol, atol), inputs, progress, t_eval, extras)
+    if method in (GENERALIZED_ALPHA, COMPILED_BDF):  # the compiled kernels
+        extras = {"components": components, "events": events, "outputs": (outputs, side)}
+        return _compiled(method)(scene, t_span, x0, (rtol, atol), inputs, progress, t_eval, extras)
     backend, q0, qd0 = _initial_state(scene, side, x0, stabilization)
     evaluate(scene, q0, outputs, side)  # refuses an unknown link before the run
     energy_scale = _energy_scale(scene, backend, q0, qd0)
@@ -209,11 +210,19 @@ def _most_samples(
     return time_series_samples(channels)
 
 
-def _compiled(*args) -> SimulationResult:
-    """:func:`rt70.simulation.compiled_run.run` of ``args``, imported for it (numba's kernels)."""
-    from rt70.simulation import compiled_run
+def _compiled(method: str) -> Callable[..., SimulationResult]:
+    """The ``run`` of a method on the compiled kernels, its module imported for it (numba's).
 
-    return compiled_run.run(*args)
+    :func:`rt70.simulation.compiled_run.run` for the generalized-α method (large models),
+    :func:`rt70.simulation.compiled_bdf.run` for scipy's BDF compiled (passive scenes).
+    """
+    if method == GENERALIZED_ALPHA:
+        from rt70.simulation import compiled_run
+
+        return compiled_run.run
+    from rt70.simulation import compiled_bdf
+
+    return compiled_bdf.run
 
 
 class _RightHandSide:

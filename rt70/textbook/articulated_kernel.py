@@ -20,10 +20,12 @@ from rt70.textbook.motion_kernel import MotionData, _add_shifted_force, _placed,
 
 
 @numba.njit(cache=True)
-def _spd_inverse(D: np.ndarray, out: np.ndarray) -> bool:
-    """``out = D⁻¹`` by Cholesky (D = L Lᵀ); False unless D is symmetric positive definite."""
+def _spd_inverse(D: np.ndarray, out: np.ndarray, L: np.ndarray, y: np.ndarray) -> bool:
+    """``out = D⁻¹`` by Cholesky (D = L Lᵀ); False unless D is symmetric positive definite.
+
+    ``L`` (n × n or larger) and ``y`` (n or longer) are work buffers.
+    """
     n = D.shape[0]
-    L = np.zeros((n, n))
     for i in range(n):
         for k in range(i + 1):
             x = D[i, k]
@@ -36,7 +38,6 @@ def _spd_inverse(D: np.ndarray, out: np.ndarray) -> bool:
             else:
                 L[i, k] = x / L[k, k]
     for c in range(n):  # columns of D⁻¹: L y = e_c, then Lᵀ x = y
-        y = np.zeros(n)
         for i in range(n):
             x = 1.0 if i == c else 0.0
             for m in range(i):
@@ -51,6 +52,16 @@ def _spd_inverse(D: np.ndarray, out: np.ndarray) -> bool:
 
 
 @numba.njit(cache=True)
+def _zero(X: np.ndarray) -> bool:
+    """True if every entry of ``X`` is zero."""
+    for i in range(X.shape[0]):
+        for k in range(X.shape[1]):
+            if X[i, k] != 0.0:
+                return False
+    return True
+
+
+@numba.njit(cache=True)
 def _articulated_factor(parent, q_start, ndof, p, sl, I0, X, IA, U, Dinv) -> bool:
     """``Iᴬ``, ``U = Iᴬ σ`` and ``D_j⁻¹ = (σᵀ U + X_j)⁻¹`` from the leaves; False if singular.
 
@@ -58,8 +69,8 @@ def _articulated_factor(parent, q_start, ndof, p, sl, I0, X, IA, U, Dinv) -> boo
     moved to its parent's origin by ``Mᵀ I M``, ``M = [[1, −<d>], [0, 1]]``.
     """
     IA[:] = I0
-    Y, Ia = np.empty((6, 6)), np.empty((6, 6))
-    d = np.empty(3)
+    Y, Ia, D, L = np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6))
+    d, y = np.empty(3), np.empty(6)
     for j in range(parent.shape[0] - 1, -1, -1):
         s0, nd = q_start[j], ndof[j]
         for a in range(s0, s0 + nd):
@@ -68,7 +79,6 @@ def _articulated_factor(parent, q_start, ndof, p, sl, I0, X, IA, U, Dinv) -> boo
                 for n in range(6):
                     x += IA[j, m, n] * sl[a, n]
                 U[a, m] = x
-        D = np.empty((nd, nd))
         for a in range(nd):
             for b in range(nd):
                 x = X[j, a, b]
@@ -76,11 +86,11 @@ def _articulated_factor(parent, q_start, ndof, p, sl, I0, X, IA, U, Dinv) -> boo
                     x += sl[s0 + a, m] * U[s0 + b, m]
                 D[a, b] = x
         Di = Dinv[j, :nd, :nd]
-        if not _spd_inverse(D, Di):
+        if not _spd_inverse(D[:nd, :nd], Di, L, y):
             return False
         i = parent[j]
-        if i < 0:
-            continue
+        if i < 0 or (nd == 6 and _zero(X[j])):
+            continue  # a six-coordinate pair without X passes its parent Iᴬ − U D⁻¹ Uᵀ = 0
         for m in range(6):  # Y = U D⁻¹ (6 × nd), then Ia = Iᴬ_j − Y Uᵀ
             for b in range(nd):
                 x = 0.0

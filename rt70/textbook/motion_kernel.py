@@ -81,10 +81,19 @@ def _place(qf, arrays, work, I0, sl) -> None:
     ``sl[a] = [C v_a; C w_a]``: axis a at the origin ``p_j`` of its pair, in E0's axes;
     ``I0[j] = R Θ_j Rᵀ`` with ``R = diag(C_j, C_j)``: (4.77) about ``p_j`` instead of O.
     """
+    _place_from(qf, 0, arrays, work, I0, sl)
+
+
+@numba.njit(cache=True)
+def _place_from(qf, first, arrays, work, I0, sl) -> None:
+    """:func:`_place` of the pairs from index ``first`` on, the others placed already.
+
+    A pair's parent has a smaller index.
+    """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta = arrays[:8]
     C, p, _, sigma, m6, m3, v3 = work[:7]
     origin = np.zeros(3)
-    for j in range(parent.shape[0]):
+    for j in range(first, parent.shape[0]):
         place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma, m6[0], m3, v3)
         rows = m6[0]  # the pair's body-frame axes, as place_pair left them
         for a in range(ndof[j]):
@@ -176,38 +185,49 @@ def _newton_euler(v, acc, gravity, arrays, p, sl, I0, V, Ad, F, tmp, out, sums) 
 
 
 @numba.njit(cache=True)
+def _bushing_force(k, v, bushes, damping, paths, work, jac, out, sums) -> bool:
+    """``out −= Q_c + Q_d`` of bushing ``k`` alone, on its path; False at gimbal lock.
+
+    ``sums[0] += ½ δᵀ C δ``, ``sums[1] += δ̇ᵀ D δ̇``.
+    """
+    C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
+    body1, body2, r1, c1, r2, c2, Cb = bushes
+    cptr, ccol, csign = paths[2], paths[3], paths[4]
+    if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
+        return False
+    rate, f = rows[0], rows[1]
+    rate[:] = 0.0
+    for u in range(cptr[k], cptr[k + 1]):
+        _twist_rows(W, sigma[ccol[u]], csign[u], jac[u - cptr[k]])
+        for i in range(6):
+            rate[i] += jac[u - cptr[k], i] * v[ccol[u]]
+    for i in range(6):
+        x, y = 0.0, 0.0
+        for m in range(6):
+            x += Cb[k, i, m] * W[0, m]
+            y += damping[k, i, m] * rate[m]
+        sums[0] += 0.5 * W[0, i] * x
+        sums[1] += rate[i] * y
+        f[i] = x + y
+    for u in range(cptr[k], cptr[k + 1]):
+        x = 0.0
+        for i in range(6):
+            x += jac[u - cptr[k], i] * f[i]
+        out[ccol[u]] += x
+    return True
+
+
+@numba.njit(cache=True)
 def _elements(qf, v, bushes, damping, paths, scoord, sk, sd, work, jac, out, sums) -> int:
     """``out −= Q_c + Q_d`` of the bushings and joint springs; U_c and P_d into ``sums``.
 
     ``sums[0] = Σ ½ δᵀ C δ`` (J), ``sums[1] = Σ δ̇ᵀ D δ̇`` (W, the dampers' power).
     Returns −1, or the bushing at gimbal lock.
     """
-    C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
-    body1, body2, r1, c1, r2, c2, Cb = bushes
-    cptr, ccol, csign = paths[2], paths[3], paths[4]
     sums[0], sums[1] = 0.0, 0.0
-    for k in range(body1.shape[0]):
-        if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
+    for k in range(bushes[0].shape[0]):
+        if not _bushing_force(k, v, bushes, damping, paths, work, jac, out, sums):
             return k
-        rate, f = rows[0], rows[1]
-        rate[:] = 0.0
-        for u in range(cptr[k], cptr[k + 1]):
-            _twist_rows(W, sigma[ccol[u]], csign[u], jac[u - cptr[k]])
-            for i in range(6):
-                rate[i] += jac[u - cptr[k], i] * v[ccol[u]]
-        for i in range(6):
-            x, y = 0.0, 0.0
-            for m in range(6):
-                x += Cb[k, i, m] * W[0, m]
-                y += damping[k, i, m] * rate[m]
-            sums[0] += 0.5 * W[0, i] * x
-            sums[1] += rate[i] * y
-            f[i] = x + y
-        for u in range(cptr[k], cptr[k + 1]):
-            x = 0.0
-            for i in range(6):
-                x += jac[u - cptr[k], i] * f[i]
-            out[ccol[u]] += x
     for i in range(scoord.shape[0]):
         a = scoord[i]
         out[a] += sk[i] * qf[a] + sd[i] * v[a]

@@ -1,0 +1,299 @@
+"""Compiled forward dynamics ``q̈ = A⁻¹ (Q_g + Q_c + Q_d − B q̇)`` and its Jacobian, in O(nv).
+
+The right-hand side of an explicit first-order form ``ẋ = [q̇; q̈]`` of (1.73), (4.79),
+for an integrator whose loop is compiled as well
+(:mod:`rt70.simulation.bdf_kernel`): nothing here returns to Python.
+
+- **Accelerations** (:func:`_forward`). The residual ``r = A q̈ + B q̇ − Q_g − Q_c − Q_d``
+  at ``q̈ = 0`` by the recursive Newton–Euler algorithm with the bushings and joint
+  springs (:mod:`rt70.textbook.motion_kernel`), then ``q̈ = −A⁻¹ r`` by the articulated-body
+  algorithm at ``X = 0`` (:mod:`rt70.textbook.articulated_kernel`; Featherstone, *Rigid
+  Body Dynamics Algorithms*, 2008, §7.3). The same passes give T, U_g, U_c and the
+  dampers' power.
+- **Jacobian** (:func:`_jacobian`): ``∂q̈/∂x = −A⁻¹ ∂r/∂x`` at the accelerations held,
+  ``x = q`` and ``x = q̇``, the columns of ``∂r/∂x`` by forward differences of the
+  residual (a q column places the pairs again, a q̇ column does not) and ``A⁻¹`` applied
+  column by column with the one articulated factor. A difference step of
+  ``√ε · max(|x_j|, 1)`` leaves a relative error of about 1e-8: an implicit integrator's
+  Newton matrix needs no more.
+
+Both refuse what the motion kernel refuses (modal bodies, mimic joints): build the data
+with :meth:`ForwardData.of`, which gives None for such a model.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from rt70.errors import Rt70Error, SimulationError
+from rt70.guards.arrays import check_vector
+from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
+from rt70.textbook.model import Model
+from rt70.textbook.motion_kernel import (
+    MotionData,
+    _bushing_force,
+    _elements,
+    _newton_euler,
+    _place,
+    _place_from,
+)
+from rt70.textbook.static_kernel import _check
+
+#: Status of a kernel call: done.
+DONE = -1
+#: Status: an articulated inertia is not positive definite (the mass matrix is singular).
+SINGULAR = -2
+#: Status: the accelerations or a Jacobian column are not finite.
+NOT_FINITE = -3
+
+
+@numba.njit(cache=True)
+def _residual(q, v, acc, K, place, out, sums) -> int:
+    """``out = r(q, q̇, q̈)`` and ``sums = [T, U_g, U_c, P_d]``; the pairs placed at q if asked.
+
+    Returns :data:`DONE` or the bushing at gimbal lock.
+    """
+    gravity, arrays, work, bushes, damping, paths, scoord, sk, sd, jac = K[:10]
+    I0, sl, V, Ad, F, tmp = K[10:16]
+    if place:
+        _place(q, arrays, work, I0, sl)
+    _newton_euler(v, acc, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, out, sums)
+    return _elements(q, v, bushes, damping, paths, scoord, sk, sd, work, jac, out, sums[2:])
+
+
+@numba.njit(cache=True)
+def _solve(K, r, out) -> None:
+    """``out = A⁻¹ r`` with the articulated factor of :func:`_forward` (pairs placed there)."""
+    arrays, work, sl = K[1], K[2], K[11]
+    U, Dinv, pA, acc6, u = K[17], K[18], K[19], K[20], K[21]
+    _articulated_solve(arrays[0], arrays[2], arrays[3], work[1], sl, U, Dinv, r, pA, acc6, u, out)
+
+
+@numba.njit(cache=True)
+def _forward(q, v, K, acc, sums) -> int:
+    """``acc = q̈(q, q̇)`` and ``sums = [T, U_g, U_c, P_d]`` (module docstring).
+
+    Leaves the pairs placed at q and the articulated factor of ``A(q)``. Returns
+    :data:`DONE`, :data:`SINGULAR`, :data:`NOT_FINITE` or the bushing at gimbal lock.
+    """
+    arrays, work, I0, sl = K[1], K[2], K[10], K[11]
+    IA, U, Dinv, X0, zero, r = K[16], K[17], K[18], K[22], K[23], K[24]
+    bad = _residual(q, v, zero, K, True, r, sums)
+    if bad >= 0:
+        return bad
+    if not _articulated_factor(arrays[0], arrays[2], arrays[3], work[1], sl, I0, X0, IA, U, Dinv):
+        return SINGULAR
+    for i in range(r.shape[0]):
+        r[i] = -r[i]
+    _solve(K, r, acc)
+    for i in range(acc.shape[0]):
+        if not np.isfinite(acc[i]):
+            return NOT_FINITE
+    return DONE
+
+
+@numba.njit(cache=True)
+def _difference_column(j, h, v, K, ne0, base, buf, out) -> int:
+    """Column j of ``∂r/∂x`` into ``out`` by a forward difference of step h.
+
+    The pairs are placed at the perturbed q, ``v`` is the perturbed q̇. Returns
+    :data:`DONE` or the bushing at gimbal lock.
+    """
+    gravity, arrays, work, bushes, damping, paths = K[:6]
+    jac, I0, sl, V, Ad, F, tmp, acc = K[9], K[10], K[11], K[12], K[13], K[14], K[15], K[27]
+    cptr, ccol = paths[2], paths[3]
+    bptr, bush = K[25], K[26]
+    sums = np.empty(2)
+    _newton_euler(v, acc, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, buf, sums)
+    for i in range(buf.shape[0]):
+        out[i] = (buf[i] - ne0[i]) / h
+        buf[i] = 0.0
+    for m in range(bptr[j], bptr[j + 1]):  # the bushings whose path holds coordinate j
+        k = bush[m]
+        if not _bushing_force(k, v, bushes, damping, paths, work, jac, buf, sums):
+            return k
+        for u in range(cptr[k], cptr[k + 1]):
+            out[ccol[u]] += (buf[ccol[u]] - base[k, u - cptr[k]]) / h
+            buf[ccol[u]] = 0.0
+    return DONE
+
+
+@numba.njit(cache=True)
+def _bushing_baselines(v, K, base, buf) -> None:
+    """Each bushing's ``−(Q_c + Q_d)`` on its path's coordinates at the placed q, into ``base``."""
+    work, bushes, damping, paths, jac = K[2], K[3], K[4], K[5], K[9]
+    cptr, ccol = paths[2], paths[3]
+    sums = np.empty(2)
+    buf[:] = 0.0
+    for k in range(bushes[0].shape[0]):
+        _bushing_force(k, v, bushes, damping, paths, work, jac, buf, sums)
+        for u in range(cptr[k], cptr[k + 1]):
+            base[k, u - cptr[k]] = buf[ccol[u]]
+            buf[ccol[u]] = 0.0
+
+
+@numba.njit(cache=True)
+def _jacobian(q, v, K, acc, A, Rq, Rv) -> int:
+    """``A(q)``, ``R_q = ∂r/∂q`` and ``R_q̇ = ∂r/∂q̇`` at (q, q̇, q̈(q, q̇)); ``acc = q̈``.
+
+    ``∂q̈/∂x = −A⁻¹ R_x`` (module docstring). A's columns are Newton–Euler's at unit
+    accelerations without velocity or gravity; R's by forward differences, a bushing
+    differenced only in the coordinates of its path (its force depends on no other and
+    acts on no other). Returns the status of :func:`_forward`.
+    """
+    n = q.shape[0]
+    sums = np.empty(4)
+    status = _forward(q, v, K, acc, sums)
+    if status != DONE:
+        return status
+    gravity, arrays, work, scoord, sk, sd = K[0], K[1], K[2], K[6], K[7], K[8]
+    I0, sl, V, Ad, F, tmp, held = K[10], K[11], K[12], K[13], K[14], K[15], K[27]
+    held[:] = acc
+    ne0, buf, unit, col = np.empty(n), np.zeros(n), np.zeros(n), np.empty(n)
+    base = np.empty((K[3][0].shape[0], max(K[9].shape[0], 1)))
+    no_gravity = np.zeros_like(gravity)
+    for j in range(n):
+        unit[j] = 1.0
+        _newton_euler(K[23], unit, no_gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, col, sums)
+        unit[j] = 0.0
+        A[:, j] = col
+    _newton_euler(v, held, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, ne0, sums)
+    _bushing_baselines(v, K, base, buf)
+    y = v.copy()
+    for j in range(n):
+        h = 1.4901161193847656e-08 * max(abs(v[j]), 1.0)
+        y[j] = v[j] + h
+        h = y[j] - v[j]
+        _difference_column(j, h, y, K, ne0, base, buf, col)
+        y[j] = v[j]
+        Rv[:, j] = col
+    x, pair_of = q.copy(), K[28]
+    for j in range(n - 1, -1, -1):  # the pairs from j's on placed again: all moved before
+        h = 1.4901161193847656e-08 * max(abs(q[j]), 1.0)
+        x[j] = q[j] + h
+        h = x[j] - q[j]
+        _place_from(x, pair_of[j], arrays, work, I0, K[11])
+        status = _difference_column(j, h, v, K, ne0, base, buf, col)
+        x[j] = q[j]
+        if status != DONE:
+            return status
+        Rq[:, j] = col
+    _place_from(q, pair_of[0] if n else 0, arrays, work, I0, K[11])
+    for i in range(scoord.shape[0]):
+        a = scoord[i]
+        Rq[a, a] += sk[i]
+        Rv[a, a] += sd[i]
+    for i in range(n):
+        for j in range(n):
+            if not (np.isfinite(Rq[i, j]) and np.isfinite(Rv[i, j])):
+                return NOT_FINITE
+    return DONE
+
+
+class ForwardData:
+    """The motion kernel's data and this kernel's buffers, as one tuple the kernels take.
+
+    Build with :meth:`of`, which gives None for a model the kernels do not cover.
+
+    Attributes
+    ----------
+    motion : MotionData
+        The motion kernel's arrays and buffers.
+    arrays : tuple
+        What :func:`_forward` and :func:`_jacobian` take (``K``).
+    """
+
+    def __init__(self, motion: MotionData, nv: int) -> None:
+        self.motion = motion
+        st, m = motion.static, motion
+        X0 = np.zeros_like(m.X)
+        self.arrays = (
+            st.gravity, st.arrays, st.work, st.bushes, st.damping, st.paths, st.scoord, st.sk,
+            st.sd, st.jac, m.I0, m.sl, m.V, m.Ad, m.F, m.tmp, m.IA, m.U, m.Dinv, m.pA, m.acc6,
+            m.u, X0, np.zeros(nv), np.zeros(nv), *_bushings_of_coordinates(st.paths, nv),
+            np.zeros(nv), m.pair_of,
+        )  # fmt: skip
+
+    @classmethod
+    def of(cls, model: Model) -> ForwardData | None:
+        """The kernel's data for ``model``, or None with modal bodies or mimic joints."""
+        motion = MotionData.of(model)
+        return None if motion is None else cls(motion, model.nv)
+
+
+def _bushings_of_coordinates(paths, nv: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(bptr, bush)``: coordinate j's bushings are ``bush[bptr[j]:bptr[j + 1]]``.
+
+    The transpose of the paths' compressed rows: the bushings whose path holds j.
+    """
+    cptr, ccol = paths[2], paths[3]
+    owners = np.repeat(np.arange(cptr.size - 1, dtype=np.int64), np.diff(cptr))
+    order = np.argsort(ccol, kind="stable")
+    bptr = np.zeros(nv + 1, dtype=np.int64)
+    np.add.at(bptr, ccol + 1, 1)
+    return np.cumsum(bptr), np.ascontiguousarray(owners[order], dtype=np.int64)
+
+
+def raise_status(model: Model, data: ForwardData, status: int) -> None:
+    """Raise the error a kernel's ``status`` stands for (nothing for :data:`DONE`).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : ForwardData
+        Its kernel data.
+    status : int
+        What :func:`_forward` or :func:`_jacobian` returned.
+    """
+    if status == SINGULAR:
+        raise Rt70Error(
+            f"{model.name}: the articulated inertia of a pair is singular or not positive definite"
+        )
+    if status == NOT_FINITE:
+        raise SimulationError("the accelerations are not finite")
+    _check(data.motion.static, status)
+
+
+def accelerations(
+    model: Model, data: ForwardData, q: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(q̈, [T, U_g, U_c, P_d])`` at (q, q̇), new arrays.
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : ForwardData
+        ``ForwardData.of(model)``.
+    q, v : numpy.ndarray, shape (nv,)
+        Coordinates (rad or m) and velocities (rad/s or m/s) in the model's order.
+    """
+    q, v = (np.array(check_vector(s, x, model.nv), dtype=float) for s, x in (("q", q), ("v", v)))
+    acc, sums = np.empty(model.nv), np.empty(4)
+    raise_status(model, data, _forward(q, v, data.arrays, acc, sums))
+    data.motion.placed[:] = np.nan  # the motion kernel's placement cache no longer holds
+    return acc, sums
+
+
+def jacobian(
+    model: Model, data: ForwardData, q: np.ndarray, v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(∂q̈/∂q, ∂q̈/∂q̇)`` at (q, q̇) by the kernel's ``−A⁻¹ R``, new arrays (nv, nv).
+
+    Parameters
+    ----------
+    model : Model
+        The textbook model.
+    data : ForwardData
+        ``ForwardData.of(model)``.
+    q, v : numpy.ndarray, shape (nv,)
+        Coordinates and velocities in the model's order.
+    """
+    q, v = (np.array(check_vector(s, x, model.nv), dtype=float) for s, x in (("q", q), ("v", v)))
+    n = model.nv
+    A, Rq, Rv, acc = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty(n)
+    raise_status(model, data, _jacobian(q, v, data.arrays, acc, A, Rq, Rv))
+    data.motion.placed[:] = np.nan
+    return -np.linalg.solve(A, Rq), -np.linalg.solve(A, Rv)
