@@ -244,10 +244,11 @@ def add_parser(
     sim.add_argument(
         "--method",
         choices=ALL_METHODS,
-        help="integrator: a solve_ivp method, CVODE / CVODE_ADAMS (SUNDIALS), or "
-        "generalized-alpha on the compiled kernels, in O(nv) memory and work per step "
-        "(default BDF; generalized-alpha from 200 coordinates on where the kernels cover "
-        "the model; CVODE for the servo scenarios)",
+        help="integrator: a solve_ivp method, CVODE / CVODE_ADAMS (SUNDIALS), "
+        "generalized-alpha on the compiled kernels, in O(nv) memory and work per step, or "
+        "compiled-BDF: scipy's BDF with its loop compiled with the equations of a passive "
+        "scene (default BDF; generalized-alpha from 200 coordinates on where the kernels "
+        "cover the model; CVODE for the servo scenarios)",
     )
     options.add_side_argument(sim, what="q̈ and its Jacobian")
     sim.add_argument(
