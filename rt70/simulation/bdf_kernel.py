@@ -86,7 +86,12 @@ def _compute_R(order, factor):
 @numba.njit(cache=True)
 def _change_D(D, order, factor) -> None:
     """Rescale the backward differences ``D[:order + 1]`` to a step ``factor`` times as long."""
-    RU = _compute_R(order, factor) @ _compute_R(order, 1.0)
+    R, U = _compute_R(order, factor), _compute_R(order, 1.0)
+    RU = np.zeros((order + 1, order + 1))
+    for i in range(order + 1):  # loops: numba's @ calls BLAS, slow at this size
+        for j in range(order + 1):
+            for k in range(order + 1):
+                RU[i, j] += R[i, k] * U[k, j]
     old = D[: order + 1].copy()
     for i in range(order + 1):
         for k in range(D.shape[1]):
@@ -122,13 +127,35 @@ def _lu_factor(A, Rq, Rv, c, LU, piv) -> None:
 
 
 @numba.njit(cache=True)
-def _newton_solve(LU, piv, A, Rq, c, b, n, out) -> None:
-    """``out = (1 − c J)⁻¹ b`` by the reduction of the module docstring."""
+def _newton_residual(K, n, y, c, psi, d, acc, b, sums) -> int:
+    """The Newton residual ``c f(y) − ψ − d`` with its q̇ rows multiplied by A, into ``b``.
+
+    Returns the kernel's status.
+
+    The q̇ rows ask ``c q̈ = ψ + d``, i.e. the accelerations ``q̈* = (ψ + d) / c``; with r
+    linear in q̈, ``A (c q̈(q, q̇) − ψ − d) = −c r(q, q̇, q̈*)``: one residual, no solve.
+    """
+    for i in range(n):
+        acc[i] = (psi[n + i] + d[n + i]) / c
+    status = _residual(y[:n], y[n : 2 * n], acc, K, True, b[n : 2 * n], sums)
+    for i in range(n):
+        b[i] = c * y[n + i] - psi[i] - d[i]
+        b[n + i] *= -c
+        if not np.isfinite(b[n + i]):
+            return NOT_FINITE
+    for i in range(2 * n, y.shape[0]):
+        b[i] = c * sums[3] - psi[i] - d[i]
+    return status
+
+
+@numba.njit(cache=True)
+def _newton_solve(LU, piv, Rq, c, b, n, out) -> None:
+    """``out = (1 − c J)⁻¹ G`` by the module docstring's reduction; ``b = [G_q; A G_q̇; G_E]``."""
     x = out[n : 2 * n]
     for i in range(n):
-        s = 0.0
+        s = b[n + i]
         for j in range(n):
-            s += A[i, j] * b[n + j] - c * Rq[i, j] * b[j]
+            s -= c * Rq[i, j] * b[j]
         x[i] = s
     for k in range(n):
         p = piv[k]
@@ -151,23 +178,21 @@ def _newton_solve(LU, piv, A, Rq, c, b, n, out) -> None:
 def _solve_system(K, n, y_predict, c, psi, work, s, scale, tol):
     """Newton's iteration of one step: ``(converged, iterations, status)``.
 
-    ``work = (LU, piv, A, R_q, y, d, f, dy, rhs, sums)``: ``y`` the solution, ``d`` its
+    ``work = (LU, piv, A, R_q, y, d, acc, dy, rhs, sums)``: ``y`` the solution, ``d`` its
     correction from the prediction.
     """
-    LU, piv, A, Rq, y, d, f, dy, b, sums = work
+    LU, piv, A, Rq, y, d, acc, dy, b, sums = work
     y[:] = y_predict
     d[:] = 0.0
     old = -1.0
     for k in range(NEWTON_MAXITER):
-        status = _rhs(y, K, n, f, sums)
+        status = _newton_residual(K, n, y, c, psi, d, acc, b, sums)
         s[NFEV] += 1
         if status == NOT_FINITE:
             return False, k + 1, DONE
         if status != DONE:
             return False, k + 1, status
-        for i in range(y.shape[0]):
-            b[i] = c * f[i] - psi[i] - d[i]
-        _newton_solve(LU, piv, A, Rq, c, b, n, dy)
+        _newton_solve(LU, piv, Rq, c, b, n, dy)
         dy_norm = _norm(dy, scale)
         rate = -1.0 if old < 0.0 else dy_norm / old
         if rate >= 0.0 and (
@@ -257,6 +282,18 @@ def _converge(K, n, y_predict, c, psi, jac, work, s, scale, tol):
 
 
 @numba.njit(cache=True)
+def _prediction(D, order):
+    """``(y_predict, ψ)``: ``Σ_{j ≤ k} D_j`` and ``Σ_{1 ≤ j ≤ k} γ_j D_j / α_k`` at order k."""
+    y, psi = D[0].copy(), np.zeros(D.shape[1])
+    for j in range(1, order + 1):
+        w = GAMMA[j] / ALPHA[order]
+        for i in range(D.shape[1]):
+            y[i] += D[j, i]
+            psi[i] += w * D[j, i]
+    return y, psi
+
+
+@numba.njit(cache=True)
 def _attempt(K, n, t_bound, tolerances, D, jac, s, work) -> int:
     """Steps tried until one is accepted: scipy's ``BDF._step_impl`` up to the update of D.
 
@@ -280,9 +317,8 @@ def _attempt(K, n, t_bound, tolerances, D, jac, s, work) -> int:
             _change_D(D, order, abs(t_new - t) / h_abs)
             s[EQUAL], s[LU_OK] = 0, 0
         h_abs = abs(t_new - t)
-        y_predict = D[: order + 1].sum(axis=0)
+        y_predict, psi = _prediction(D, order)
         scale = atol + rtol * np.abs(y_predict)
-        psi = (GAMMA[1 : order + 1] @ D[1 : order + 1]) / ALPHA[order]
         c = h_abs / ALPHA[order]
         converged, n_iter, status = _converge(K, n, y_predict, c, psi, jac, work, s, scale,
                                               newton_tol)  # fmt: skip

@@ -113,7 +113,8 @@ class _Run:
         self.D = np.zeros((bk.MAX_ORDER + 3, size))
         self.jac = (np.empty((n, n)), np.zeros(n, dtype=np.int64), np.empty((n, n)),
                     np.empty((n, n)), np.empty((n, n)))  # fmt: skip
-        self.work = (*self.jac[:4], *(np.empty(size) for _ in range(5)), np.empty(4))
+        self.work = (*self.jac[:4], np.empty(size), np.empty(size), np.empty(n),
+                     np.empty(size), np.empty(size), np.empty(4))  # fmt: skip
         self.samples = (np.empty(cap), np.empty((cap, size)))
         f0, sums = np.empty(size), np.empty(4)
         forward_kernel.raise_status(model, data, bk._rhs(y0, self.K, n, f0, sums))

@@ -29,6 +29,7 @@ import numpy as np
 from rt70.errors import Rt70Error, SimulationError
 from rt70.guards.arrays import check_vector
 from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
+from rt70.textbook.mass_kernel import _composite_inertias, _ground_inertia, _mass_entries
 from rt70.textbook.model import Model
 from rt70.textbook.motion_kernel import (
     MotionData,
@@ -134,11 +135,24 @@ def _bushing_baselines(v, K, base, buf) -> None:
 
 
 @numba.njit(cache=True)
+def _mass(arrays, work, A) -> None:
+    """``A(q)`` of the placed pairs by the mass kernel's composite inertias (§4.3, (4.79))."""
+    parent, q_start, ndof, Theta = arrays[0], arrays[2], arrays[3], arrays[7]
+    C, p, sigma = work[0], work[1], work[3]
+    theta_c = np.empty((parent.shape[0], 6, 6))
+    L, T, F = np.empty((6, 6)), np.empty((6, 6)), np.empty(6)
+    for j in range(parent.shape[0]):
+        _ground_inertia(C[j], p[j], Theta[j], L, T, theta_c[j])
+    _composite_inertias(parent, theta_c)
+    _mass_entries(parent, q_start, ndof, theta_c, sigma, F, A)
+
+
+@numba.njit(cache=True)
 def _jacobian(q, v, K, acc, A, Rq, Rv) -> int:
     """``A(q)``, ``R_q = ∂r/∂q`` and ``R_q̇ = ∂r/∂q̇`` at (q, q̇, q̈(q, q̇)); ``acc = q̈``.
 
-    ``∂q̈/∂x = −A⁻¹ R_x`` (module docstring). A's columns are Newton–Euler's at unit
-    accelerations without velocity or gravity; R's by forward differences, a bushing
+    ``∂q̈/∂x = −A⁻¹ R_x`` (module docstring). A by the mass kernel's composite inertias;
+    R's columns by forward differences, a bushing
     differenced only in the coordinates of its path (its force depends on no other and
     acts on no other). Returns the status of :func:`_forward`.
     """
@@ -150,14 +164,9 @@ def _jacobian(q, v, K, acc, A, Rq, Rv) -> int:
     gravity, arrays, work, scoord, sk, sd = K[0], K[1], K[2], K[6], K[7], K[8]
     I0, sl, V, Ad, F, tmp, held = K[10], K[11], K[12], K[13], K[14], K[15], K[27]
     held[:] = acc
-    ne0, buf, unit, col = np.empty(n), np.zeros(n), np.zeros(n), np.empty(n)
+    ne0, buf, col = np.empty(n), np.zeros(n), np.empty(n)
     base = np.empty((K[3][0].shape[0], max(K[9].shape[0], 1)))
-    no_gravity = np.zeros_like(gravity)
-    for j in range(n):
-        unit[j] = 1.0
-        _newton_euler(K[23], unit, no_gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, col, sums)
-        unit[j] = 0.0
-        A[:, j] = col
+    _mass(arrays, work, A)
     _newton_euler(v, held, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, ne0, sums)
     _bushing_baselines(v, K, base, buf)
     y = v.copy()

@@ -41,7 +41,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from rt70.textbook.mass_kernel import _ground_inertia, place_pair
+from rt70.textbook.mass_kernel import place_pair
 from rt70.textbook.model import Model
 from rt70.textbook.static_kernel import (
     StaticData,
@@ -92,7 +92,6 @@ def _place_from(qf, first, arrays, work, I0, sl) -> None:
     """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta = arrays[:8]
     C, p, _, sigma, m6, m3, v3 = work[:7]
-    origin = np.zeros(3)
     for j in range(first, parent.shape[0]):
         place_pair(j, qf, parent, kind, q_start, ndof, axis, r_c, c_c, C, p, sigma, m6[0], m3, v3)
         rows = m6[0]  # the pair's body-frame axes, as place_pair left them
@@ -104,7 +103,28 @@ def _place_from(qf, first, arrays, work, I0, sl) -> None:
                     y += C[j, i, m] * rows[a, 3 + m]
                 sl[q_start[j] + a, i] = x
                 sl[q_start[j] + a, 3 + i] = y
-        _ground_inertia(C[j], origin, Theta[j], m6[1], m6[2], I0[j])
+        _rotated_inertia(C[j], Theta[j], m6[1], I0[j])
+
+
+@numba.njit(cache=True)
+def _rotated_inertia(Cj: np.ndarray, Theta_j: np.ndarray, T: np.ndarray, out: np.ndarray) -> None:
+    """``out = R Θ_j Rᵀ``, ``R = diag(C_j, C_j)``: (4.77) turned into E0's axes, block by block.
+
+    Each 3 × 3 block ``Θ_ab`` becomes ``C Θ_ab Cᵀ``; ``T`` (6 × 6) is scratch.
+    """
+    for a in range(6):  # T = R Θ: rows of each block row turned by C
+        r = 3 * (a // 3)
+        i = a - r
+        for b in range(6):
+            T[a, b] = (Cj[i, 0] * Theta_j[r, b] + Cj[i, 1] * Theta_j[r + 1, b]
+                       + Cj[i, 2] * Theta_j[r + 2, b])  # fmt: skip
+    for a in range(6):  # out = T Rᵀ (symmetric: the upper triangle, mirrored)
+        for b in range(a, 6):
+            c = 3 * (b // 3)
+            k = b - c
+            x = T[a, c] * Cj[k, 0] + T[a, c + 1] * Cj[k, 1] + T[a, c + 2] * Cj[k, 2]
+            out[a, b] = x
+            out[b, a] = x
 
 
 @numba.njit(cache=True)
