@@ -87,6 +87,22 @@ def test_jacobian_is_the_difference_of_the_accelerations(name):
         assert_close(J, central, rel=1e-5, scale=scale, what=f"{name} ∂q̈/∂{'qv'[which]}")
 
 
+@pytest.mark.parametrize("name", ("rt70", "tree3"))
+def test_newtons_jacobian_is_the_springs_material_gains(name):
+    from rt70.textbook.mass_kernel import KernelData, mass_matrix
+    from rt70.textbook.static_kernel import StaticData, element_gains
+
+    scene = _scene(name)
+    model = scene.textbook
+    q, v = _state(model.nv, 5)
+    Jq, Jv = forward_kernel.jacobian(model, forward_kernel.ForwardData.of(model), q, v, False)
+    A = mass_matrix(model, KernelData(model), q)
+    K, D = element_gains(model, StaticData.of(model), q)
+    for J, G, what in ((Jq, K, "∂q̈/∂q"), (Jv, D, "∂q̈/∂q̇")):
+        # −A⁻¹ G: the solve's rounding grows with A's condition number (1e6 on the RT-70)
+        assert_close(J, -np.linalg.solve(A, G), rel=1e-7, what=f"{name} material {what}")
+
+
 @pytest.fixture(scope="module")
 def chain():
     return scene_from_text(elastic_chain(5, hanging=True), "chain5")

@@ -41,6 +41,9 @@ GAMMA = np.concatenate(([0.0], np.cumsum(1.0 / np.arange(1, MAX_ORDER + 1))))
 ALPHA = (1.0 - KAPPA) * GAMMA
 ERROR_CONST = KAPPA * GAMMA + 1.0 / np.arange(1, MAX_ORDER + 2)
 
+#: Newton's matrix with ∂r/∂q by differences (True) or from the springs' material
+#: stiffness alone (False; :func:`rt70.textbook.forward_kernel._jacobian`).
+EXACT = False
 #: The scalars of a run, in ``s``: time, step, order, equal steps, LU valid, safety
 #: factor of the last step, evaluations, Jacobians, LU factorisations, steps, samples
 #: written, next output time's index, kernel status.
@@ -256,7 +259,7 @@ def _jacobian_at(K, n, y, jac, s) -> int:
     """A, R_q, R_q̇ at ``y`` into ``jac``; the status of the forward kernel's ``_jacobian``."""
     s[NJEV] += 1
     acc = np.empty(n)
-    return _jacobian(y[:n].copy(), y[n : 2 * n].copy(), K, acc, jac[2], jac[3], jac[4])
+    return _jacobian(y[:n].copy(), y[n : 2 * n].copy(), K, acc, jac[2], jac[3], jac[4], EXACT)
 
 
 @numba.njit(cache=True)
