@@ -40,9 +40,13 @@ def test_centres_of_mass_average_to_pinocchio_centre_of_mass():
 
 def test_methods_come_from_simulate():
     assert wp.METHODS == tuple(m for m in sim.METHODS if m != "RK23")
-    assert set(wp.STIFF_METHODS) == {"Radau", "BDF", "LSODA", "generalized-alpha", "compiled-BDF"} | {
-        m for m in sim.METHODS if m.startswith("CVODE")
-    }
+    assert set(wp.STIFF_METHODS) == {
+        "Radau",
+        "BDF",
+        "LSODA",
+        "generalized-alpha",
+        "compiled-BDF",
+    } | {m for m in sim.METHODS if m.startswith("CVODE")}
 
 
 def test_the_target_problem_is_the_commands_ten_second_transient():
