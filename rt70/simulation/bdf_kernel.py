@@ -29,7 +29,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from rt70.textbook.forward_kernel import DONE, NOT_FINITE, _forward, _jacobian, _residual
+from rt70.simulation.bdf_newton import factor, jacobian_at, solve
+from rt70.textbook.forward_kernel import DONE, NOT_FINITE, _forward, _residual
 
 MAX_ORDER = 5
 NEWTON_MAXITER = 4
@@ -41,15 +42,13 @@ GAMMA = np.concatenate(([0.0], np.cumsum(1.0 / np.arange(1, MAX_ORDER + 1))))
 ALPHA = (1.0 - KAPPA) * GAMMA
 ERROR_CONST = KAPPA * GAMMA + 1.0 / np.arange(1, MAX_ORDER + 2)
 
-#: Newton's matrix with ∂r/∂q by differences (True) or from the springs' material
-#: stiffness alone (False; :func:`rt70.textbook.forward_kernel._jacobian`).
-EXACT = False
-#: The scalars of a run, in ``s``: time, step, order, equal steps, LU valid, safety
-#: factor of the last step, evaluations, Jacobians, LU factorisations, steps, samples
-#: written, next output time's index, kernel status.
-T, H, ORDER, EQUAL, LU_OK, SAFETY, NFEV, NJEV, NLU, NSTEP, NOUT, NEXT, KSTATUS = range(13)
+#: The scalars of a run, in ``s``: time, step, order, equal steps, Newton's matrix
+#: factored, safety factor of the last step, evaluations, Jacobians, factorisations,
+#: steps, samples written, next output time's index, kernel status, Newton's matrix
+#: pair-local (1) or dense (0) (:mod:`rt70.simulation.bdf_newton`).
+T, H, ORDER, EQUAL, LU_OK, SAFETY, NFEV, NJEV, NLU, NSTEP, NOUT, NEXT, KSTATUS, LOCAL = range(14)
 #: Length of ``s``.
-SCALARS = 13
+SCALARS = 14
 #: What :func:`advance` returns.
 CHUNK_DONE, FINISHED, FULL, TOO_SMALL, KERNEL_ERROR = range(5)
 
@@ -105,31 +104,6 @@ def _change_D(D, order, factor) -> None:
 
 
 @numba.njit(cache=True)
-def _lu_factor(A, Rq, Rv, c, LU, piv) -> None:
-    """``LU = A + c R_q̇ + c² R_q`` factored in place with partial pivoting (rows in ``piv``)."""
-    n = LU.shape[0]
-    for i in range(n):
-        for j in range(n):
-            LU[i, j] = A[i, j] + c * Rv[i, j] + c * c * Rq[i, j]
-    for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(LU[i, k]) > abs(LU[p, k]):
-                p = i
-        piv[k] = p
-        if p != k:
-            for j in range(n):
-                LU[k, j], LU[p, j] = LU[p, j], LU[k, j]
-        if LU[k, k] == 0.0:
-            continue
-        for i in range(k + 1, n):
-            LU[i, k] /= LU[k, k]
-            m = LU[i, k]
-            for j in range(k + 1, n):
-                LU[i, j] -= m * LU[k, j]
-
-
-@numba.njit(cache=True)
 def _newton_residual(K, n, y, c, psi, d, acc, b, sums) -> int:
     """The Newton residual ``c f(y) − ψ − d`` with its q̇ rows multiplied by A, into ``b``.
 
@@ -152,39 +126,14 @@ def _newton_residual(K, n, y, c, psi, d, acc, b, sums) -> int:
 
 
 @numba.njit(cache=True)
-def _newton_solve(LU, piv, Rq, c, b, n, out) -> None:
-    """``out = (1 − c J)⁻¹ G`` by the module docstring's reduction; ``b = [G_q; A G_q̇; G_E]``."""
-    x = out[n : 2 * n]
-    for i in range(n):
-        s = b[n + i]
-        for j in range(n):
-            s -= c * Rq[i, j] * b[j]
-        x[i] = s
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
-    for i in range(n):
-        for j in range(i):
-            x[i] -= LU[i, j] * x[j]
-    for i in range(n - 1, -1, -1):
-        for j in range(i + 1, n):
-            x[i] -= LU[i, j] * x[j]
-        x[i] /= LU[i, i]
-    for i in range(n):
-        out[i] = b[i] + c * x[i]
-    for i in range(2 * n, b.shape[0]):
-        out[i] = b[i]
-
-
-@numba.njit(cache=True)
-def _solve_system(K, n, y_predict, c, psi, work, s, scale, tol):
+def _solve_system(K, n, y_predict, c, psi, newton, work, s, scale, tol):
     """Newton's iteration of one step: ``(converged, iterations, status)``.
 
-    ``work = (LU, piv, A, R_q, y, d, acc, dy, rhs, sums)``: ``y`` the solution, ``d`` its
-    correction from the prediction.
+    ``work = (y, d, acc, dy, rhs, sums)``: ``y`` the solution, ``d`` its correction from
+    the prediction.
     """
-    LU, piv, A, Rq, y, d, acc, dy, b, sums = work
+    y, d, acc, dy, b, sums = work
+    local = s[LOCAL] == 1
     y[:] = y_predict
     d[:] = 0.0
     old = -1.0
@@ -195,7 +144,7 @@ def _solve_system(K, n, y_predict, c, psi, work, s, scale, tol):
             return False, k + 1, DONE
         if status != DONE:
             return False, k + 1, status
-        _newton_solve(LU, piv, Rq, c, b, n, dy)
+        solve(K, newton, c, b, n, dy, local)
         dy_norm = _norm(dy, scale)
         rate = -1.0 if old < 0.0 else dy_norm / old
         if rate >= 0.0 and (
@@ -255,30 +204,25 @@ def initial_step(K, n, y0, f0, t_span, rtol, atol, s) -> float:
 
 
 @numba.njit(cache=True)
-def _jacobian_at(K, n, y, jac, s) -> int:
-    """A, R_q, R_q̇ at ``y`` into ``jac``; the status of the forward kernel's ``_jacobian``."""
-    s[NJEV] += 1
-    acc = np.empty(n)
-    return _jacobian(y[:n].copy(), y[n : 2 * n].copy(), K, acc, jac[2], jac[3], jac[4], EXACT)
-
-
-@numba.njit(cache=True)
-def _converge(K, n, y_predict, c, psi, jac, work, s, scale, tol):
+def _converge(K, n, y_predict, c, psi, newton, work, s, scale, tol):
     """Newton's iteration, the Jacobian taken again once if it fails.
 
     Returns ``(converged, iterations, status)`` (scipy's inner loop of ``BDF._step_impl``).
     """
-    LU, piv, A, Rq, Rv = jac
-    current = False
+    current, local = False, s[LOCAL] == 1
     while True:
         if s[LU_OK] == 0:
-            _lu_factor(A, Rq, Rv, c, LU, piv)
+            status = factor(K, newton, c, local)
+            if status != DONE:
+                return False, 0, status
             s[NLU] += 1
             s[LU_OK] = 1
-        converged, n_iter, status = _solve_system(K, n, y_predict, c, psi, work, s, scale, tol)
+        converged, n_iter, status = _solve_system(K, n, y_predict, c, psi, newton, work, s,
+                                                  scale, tol)  # fmt: skip
         if status != DONE or converged or current:
             return converged, n_iter, status
-        status = _jacobian_at(K, n, y_predict, jac, s)
+        s[NJEV] += 1
+        status = jacobian_at(K, n, y_predict, newton, s, local)
         if status != DONE:
             return False, n_iter, status
         s[LU_OK], current = 0, True
@@ -297,14 +241,14 @@ def _prediction(D, order):
 
 
 @numba.njit(cache=True)
-def _attempt(K, n, t_bound, tolerances, D, jac, s, work) -> int:
+def _attempt(K, n, t_bound, tolerances, D, newton, s, work) -> int:
     """Steps tried until one is accepted: scipy's ``BDF._step_impl`` up to the update of D.
 
     Returns :data:`CHUNK_DONE` with ``s[T]``, ``s[H]`` the new time and the step taken
     (``work`` holding y and d), or :data:`TOO_SMALL` or :data:`KERNEL_ERROR`.
     """
     rtol, atol, newton_tol = tolerances
-    y_new, d = work[4], work[5]
+    y_new, d = work[0], work[1]
     t, order = s[T], int(s[ORDER])
     min_step = 10 * abs(np.nextafter(t, np.inf) - t)
     h_abs = s[H]
@@ -323,7 +267,7 @@ def _attempt(K, n, t_bound, tolerances, D, jac, s, work) -> int:
         y_predict, psi = _prediction(D, order)
         scale = atol + rtol * np.abs(y_predict)
         c = h_abs / ALPHA[order]
-        converged, n_iter, status = _converge(K, n, y_predict, c, psi, jac, work, s, scale,
+        converged, n_iter, status = _converge(K, n, y_predict, c, psi, newton, work, s, scale,
                                               newton_tol)  # fmt: skip
         if status != DONE:
             s[KSTATUS] = status
@@ -358,7 +302,7 @@ def _accept(D, s, work, tolerances) -> None:
     scipy's ``BDF._step_impl`` after the step is accepted.
     """
     rtol, atol = tolerances[0], tolerances[1]
-    y_new, d = work[4], work[5]
+    y_new, d = work[0], work[1]
     order = int(s[ORDER])
     D[order + 2] = d - D[order + 1]
     D[order + 1] = d
@@ -428,7 +372,7 @@ def energies(K, n, states, out) -> int:
 
 
 @numba.njit(cache=True)
-def advance(K, n, t_bound, tolerances, D, jac, s, work, t_eval, samples, max_steps) -> int:
+def advance(K, n, t_bound, tolerances, D, newton, s, work, t_eval, samples, max_steps) -> int:
     """At most ``max_steps`` steps towards ``t_bound``, their samples into ``samples``.
 
     With ``t_eval`` empty every step is a sample, else the samples are at the times of
@@ -449,8 +393,9 @@ def advance(K, n, t_bound, tolerances, D, jac, s, work, t_eval, samples, max_ste
         ``(rtol, atol, newton_tol)``: scipy's BDF's, atol per state.
     D : numpy.ndarray, shape (MAX_ORDER + 3, 2 nv + 1)
         The backward differences.
-    jac : tuple
-        ``(LU, piv, A, R_q, R_q̇)``: the factored Newton matrix and the Jacobian's parts.
+    newton : tuple
+        Newton's matrix: the Jacobian's parts and their factor
+        (:func:`rt70.simulation.bdf_newton.buffers`).
     s : numpy.ndarray, shape (SCALARS,)
         The run's scalars (:data:`T` … :data:`KSTATUS`).
     work : tuple
@@ -474,7 +419,7 @@ def advance(K, n, t_bound, tolerances, D, jac, s, work, t_eval, samples, max_ste
             return FINISHED
         if every_step and s[NOUT] >= samples[0].shape[0]:
             return FULL
-        status = _attempt(K, n, t_bound, tolerances, D, jac, s, work)
+        status = _attempt(K, n, t_bound, tolerances, D, newton, s, work)
         if status != CHUNK_DONE:
             return status
         s[NSTEP] += 1

@@ -25,6 +25,7 @@ from rt70.guards.arrays import check_vector
 from rt70.guards.resources import time_series_samples
 from rt70.model.scene import Scene
 from rt70.simulation import bdf_kernel as bk
+from rt70.simulation import bdf_newton
 from rt70.simulation.integrators import COMPILED_BDF, EvaluationCounter
 from rt70.simulation.result import (
     DRIFT_FACTOR,
@@ -100,6 +101,24 @@ def _data(scene: Scene) -> forward_kernel.ForwardData:
     return data
 
 
+def pair_local(data: forward_kernel.ForwardData) -> bool:
+    """Newton's matrix in the pair-local form (:mod:`rt70.simulation.bdf_newton`).
+
+    Parameters
+    ----------
+    data : ForwardData
+        The scene's kernel data: the form is pair-local when every bushing acts across
+        one pair.
+    """
+    return data.motion.local
+
+
+def _work(size: int, n: int) -> tuple[np.ndarray, ...]:
+    """Newton's buffers (:func:`bk._solve_system`): y, d, q̈*, Δy, the residual, sums."""
+    return (np.empty(size), np.empty(size), np.empty(n), np.empty(size), np.empty(size),
+            np.empty(4))  # fmt: skip
+
+
 class _Run:
     """The compiled loop's state for one run: the arrays :func:`bk.advance` takes."""
 
@@ -109,26 +128,25 @@ class _Run:
         self.n, self.t_span, self.tolerances = n, t_span, tolerances
         self.K = data.arrays
         self.s = np.zeros(bk.SCALARS)
-        self.s[bk.T], self.s[bk.ORDER] = t_span[0], 1
+        local = pair_local(data)
+        self.s[bk.T], self.s[bk.ORDER], self.s[bk.LOCAL] = t_span[0], 1, local
         self.D = np.zeros((bk.MAX_ORDER + 3, size))
-        self.jac = (np.empty((n, n)), np.zeros(n, dtype=np.int64), np.empty((n, n)),
-                    np.empty((n, n)), np.empty((n, n)))  # fmt: skip
-        self.work = (*self.jac[:4], np.empty(size), np.empty(size), np.empty(n),
-                     np.empty(size), np.empty(size), np.empty(4))  # fmt: skip
+        self.newton = bdf_newton.buffers(n, model.nb, local)
+        self.work = _work(size, n)
         self.samples = (np.empty(cap), np.empty((cap, size)))
         f0, sums = np.empty(size), np.empty(4)
         forward_kernel.raise_status(model, data, bk._rhs(y0, self.K, n, f0, sums))
         rtol, atol = tolerances[0], tolerances[1]
         h0 = bk.initial_step(self.K, n, y0, f0, np.array(t_span), rtol, atol, self.s)
         forward_kernel.raise_status(model, data, int(self.s[bk.KSTATUS]) if h0 == 0 else -1)
-        self.s[bk.H], self.s[bk.NFEV] = h0, self.s[bk.NFEV] + 1
+        self.s[bk.H], self.s[bk.NFEV], self.s[bk.NJEV] = h0, self.s[bk.NFEV] + 1, 1
         self.D[0], self.D[1] = y0, f0 * h0
-        status = bk._jacobian_at(self.K, n, y0, self.jac, self.s)
+        status = bdf_newton.jacobian_at(self.K, n, y0, self.newton, self.s, local)
         forward_kernel.raise_status(model, data, status)
 
     def advance(self, t_eval: np.ndarray) -> int:
         """:func:`bk.advance` for :data:`CHUNK_STEPS` steps."""
-        return bk.advance(self.K, self.n, self.t_span[1], self.tolerances, self.D, self.jac,
+        return bk.advance(self.K, self.n, self.t_span[1], self.tolerances, self.D, self.newton,
                           self.s, self.work, t_eval, self.samples, CHUNK_STEPS)  # fmt: skip
 
     def collect(self) -> tuple[np.ndarray, np.ndarray]:
@@ -138,15 +156,14 @@ class _Run:
         return tuple(x[:m].copy() for x in self.samples)
 
 
-def _load(data: forward_kernel.ForwardData, size: int) -> None:
-    """Call the loop once without a step: numba loads its cached code (compiles it at first)."""
-    n = (size - 1) // 2
-    jac = (np.empty((n, n)), np.zeros(n, dtype=np.int64), *(np.empty((n, n)) for _ in range(3)))
-    work = (*jac[:4], np.empty(size), np.empty(size), np.empty(n), np.empty(size),
-            np.empty(size), np.empty(4))  # fmt: skip
-    s = np.zeros(bk.SCALARS)
-    bk.advance(data.arrays, n, 0.0, (1.0, np.ones(size), 1.0), np.zeros((bk.MAX_ORDER + 3, size)),
-               jac, s, work, np.empty(0), (np.empty(1), np.empty((1, size))), 0)  # fmt: skip
+def _load(scene: Scene, data: forward_kernel.ForwardData, y0: np.ndarray, tolerances) -> None:
+    """Set a run up and call its loop for no step, before the clock starts.
+
+    numba loads every kernel's cached code then (compiles it, the first time).
+    """
+    run = _Run(scene, data, y0, (0.0, 1.0), tolerances, 1)
+    bk.advance(run.K, run.n, 1.0, tolerances, run.D, run.newton, run.s, run.work, np.empty(0),
+               run.samples, 0)  # fmt: skip
 
 
 def simulate_bdf(
@@ -197,7 +214,7 @@ def simulate_bdf(
     shape = "{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]"
     bar = tqdm(total=t1 - t0, disable=not progress, bar_format=shape)
     try:
-        _load(data, y0.size)  # numba's compiled code loaded (or compiled): not timed
+        _load(scene, data, y0, (rtol, atol_vec, newton_tol))  # not timed
         start = time.perf_counter()
         state = _Run(scene, data, y0, (t0, t1), (rtol, atol_vec, newton_tol), cap)
         chunks, status = [], bk.CHUNK_DONE
