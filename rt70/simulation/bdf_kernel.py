@@ -1,4 +1,4 @@
-"""A compiled variable-order BDF (NDF) loop on the compiled forward dynamics.
+"""A compiled variable-order BDF (NDF) loop on the book's equations of motion.
 
 The method is scipy's ``BDF`` (Shampine and Reichelt, "The MATLAB ODE Suite", SIAM J.
 Sci. Comput. 18, 1997, §2: the numerical differentiation formulas of orders 1–5 with
@@ -6,19 +6,23 @@ Klopfenstein's κ, quasi-constant step size in the backward differences ``D``, a
 simplified Newton iteration and Jacobians taken again only when it fails to converge),
 written as plain loops compiled with numba so that a step never returns to Python. Its
 step-size and order rules, tolerances and dense output are scipy's, so a run takes the
-steps scipy's BDF takes on the same right-hand side, up to rounding: the tests compare
-the two (``tests/test_compiled_bdf.py``).
+steps scipy's BDF takes on the same equations, up to rounding: the tests compare the two
+(``tests/test_compiled_bdf.py``).
 
 The state is ``y = [q; q̇; E_ψ]`` of (1.73), (4.79) with the dissipated energy of the
 energy audit (:class:`rt70.simulation.states.EnergyAudit`), its derivative the dampers'
-power; the accelerations and their Jacobian come from
-:mod:`rt70.textbook.forward_kernel`. The Jacobian ``[[0, 1, 0], [J_q, J_q̇, 0],
-[0, 0, 0]]`` (the energy's row zero, as the other methods') makes Newton's matrix
-``1 − c J`` of size 2nv + 1 reducible to nv: with ``b = [b_q; b_q̇; b_E]``,
+power. Each Newton iterate evaluates scipy's ``G = c f(y) − ψ − d`` with its q̇ rows
+multiplied by A: those rows ask for the accelerations ``q̈* = (ψ + d)/c``, and
+``A (c q̈ − ψ − d) = −c r(q, q̇, q̈*)`` with r the residual of the equations
+(:mod:`rt70.textbook.forward_kernel`), so an iterate costs one Newton–Euler pass and no
+forward dynamics. The Jacobian ``[[0, 1, 0], [J_q, J_q̇, 0], [0, 0, 0]]`` (the energy's
+row zero, as the other methods') makes Newton's matrix ``1 − c J`` of size 2nv + 1
+reducible to nv: with ``G = [G_q; G_q̇; G_E]`` and ``J_x = −A⁻¹ R_x``,
 
-    (1 − c J_q̇ − c² J_q) Δq̇ = b_q̇ + c J_q b_q,   Δq = b_q + c Δq̇,   ΔE = b_E,
+    (A + c R_q̇ + c² R_q) Δq̇ = A G_q̇ − c R_q G_q,   Δq = G_q + c Δq̇,   ΔE = G_E,
 
-so the LU factorisation (partial pivoting) is of an nv × nv matrix.
+which :mod:`rt70.simulation.bdf_newton` factors (pair-local: the articulated-body
+algorithm in O(nv); otherwise LU).
 
 The loop runs in chunks (:func:`advance`): between two the caller checks the evaluation
 budget, a stop (Ctrl-C) and the progress bar, and empties the output buffer.
