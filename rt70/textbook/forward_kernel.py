@@ -49,7 +49,7 @@ from rt70.textbook.motion_kernel import (
     _place,
     _place_from,
 )
-from rt70.textbook.static_kernel import _bushing_rows, _check, _path_gain
+from rt70.textbook.static_kernel import _check, placed_gains
 
 #: Status of a kernel call: done.
 DONE = -1
@@ -164,24 +164,12 @@ def _material_stiffness(K, Rq, X, sk) -> int:
     With X the bushings' stiffness and sk the springs', the material stiffness alone: no
     geometric stiffness, gravity's or the inertial terms' derivatives (module docstring);
     with their dampings, the dampers' ``∂r/∂q̇``. Returns :data:`DONE` or the bushing at
-    gimbal lock.
+    gimbal lock (:func:`rt70.textbook.static_kernel.placed_gains`).
     """
-    work, bushes, paths, scoord = K[2], K[3], K[5], K[6]
-    C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
-    body1, body2, r1, c1, r2, c2, _ = bushes
-    cptr, ccol = paths[2], paths[3]
-    jac, block = K[9], np.empty((K[9].shape[0], K[9].shape[0]))
-    Rq[:] = 0.0
-    for k in range(body1.shape[0]):
-        if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
-            return k
-        cols = ccol[cptr[k] : cptr[k + 1]]
-        for u in range(_path_gain(k, X, paths, sigma, W, jac, rows, block)):
-            for v in range(cols.shape[0]):
-                Rq[cols[v], cols[u]] += block[v, u]
-    for i in range(scoord.shape[0]):
-        Rq[scoord[i], scoord[i]] += sk[i]
-    return DONE
+    jac = K[9]
+    block = np.empty((jac.shape[0], jac.shape[0]))
+    bad = placed_gains(K[3], X, K[5], K[6], sk, K[2], jac, block, Rq)
+    return DONE if bad < 0 else bad
 
 
 @numba.njit(cache=True)
@@ -326,6 +314,13 @@ def raise_status(model: Model, data: ForwardData, status: int) -> None:
     _check(data.motion.static, status)
 
 
+def _state(model: Model, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(q, q̇)`` checked against nv and copied as floats."""
+    return tuple(
+        np.array(check_vector(s, x, model.nv), dtype=float) for s, x in (("q", q), ("v", v))
+    )
+
+
 def accelerations(
     model: Model, data: ForwardData, q: np.ndarray, v: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -340,7 +335,7 @@ def accelerations(
     q, v : numpy.ndarray, shape (nv,)
         Coordinates (rad or m) and velocities (rad/s or m/s) in the model's order.
     """
-    q, v = (np.array(check_vector(s, x, model.nv), dtype=float) for s, x in (("q", q), ("v", v)))
+    q, v = _state(model, q, v)
     acc, sums = np.empty(model.nv), np.empty(4)
     raise_status(model, data, _forward(q, v, data.arrays, acc, sums))
     data.motion.placed[:] = np.nan  # the motion kernel's placement cache no longer holds
@@ -364,7 +359,7 @@ def jacobian(
         ∂q̈/∂q by differences (else from the springs' material stiffness alone, what
         Newton's matrix of :mod:`rt70.simulation.bdf_kernel` uses).
     """
-    q, v = (np.array(check_vector(s, x, model.nv), dtype=float) for s, x in (("q", q), ("v", v)))
+    q, v = _state(model, q, v)
     n = model.nv
     A, Rq, Rv, acc = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty(n)
     raise_status(model, data, _jacobian(q, v, data.arrays, acc, A, Rq, Rv, exact))

@@ -290,11 +290,21 @@ def _gains(qf, arrays, bushes, X, paths, scoord, sk, work, jac, block, out) -> i
     Into ``out`` (n, n); returns −1, or the bushing at gimbal lock.
     """
     parent, kind, q_start, ndof, axis, r_c, c_c, Theta, _, _ = arrays
-    C, p, theta_c, sigma, m6, m3, v3, W, rows, _ = work
-    body1, body2, r1, c1, r2, c2, _ = bushes
-    cptr, ccol = paths[2], paths[3]
+    C, p, theta_c, sigma, m6, m3, v3 = work[:7]
     forward_pass(qf, parent, kind, q_start, ndof, axis, r_c, c_c, Theta, C, p, theta_c,
                  sigma, m6, m3, v3, False)  # fmt: skip
+    return placed_gains(bushes, X, paths, scoord, sk, work, jac, block, out)
+
+
+@numba.njit(cache=True)
+def placed_gains(bushes, X, paths, scoord, sk, work, jac, block, out) -> int:
+    """:func:`_gains` at the placement ``work`` holds (C, p and σ of every pair).
+
+    Into ``out`` (n, n); returns −1, or the bushing at gimbal lock.
+    """
+    C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
+    body1, body2, r1, c1, r2, c2, _ = bushes
+    cptr, ccol = paths[2], paths[3]
     out[:] = 0.0
     for k in range(body1.shape[0]):
         if not _bushing_rows(k, body1, body2, r1, c1, r2, c2, C, p, W):
