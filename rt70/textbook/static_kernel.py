@@ -301,6 +301,19 @@ def placed_gains(bushes, X, paths, scoord, sk, work, jac, block, out) -> int:
     """:func:`_gains` at the placement ``work`` holds (C, p and σ of every pair).
 
     Into ``out`` (n, n); returns −1, or the bushing at gimbal lock.
+
+    Parameters
+    ----------
+    bushes, paths, scoord, work : tuple or numpy.ndarray
+        The kernel's arrays (:class:`StaticData`), ``work`` placed.
+    X : numpy.ndarray, shape (n_bushings, 6, 6)
+        Each bushing's gain: its stiffness (N/m, N·m/rad) or its damping.
+    sk : numpy.ndarray
+        The joint springs' gains of the same kind.
+    jac, block : numpy.ndarray
+        Scratch as long as the widest bushing path.
+    out : numpy.ndarray, shape (n, n)
+        ``Σ Jᵀ X J + diag(sk)``.
     """
     C, p, sigma, W, rows = work[0], work[1], work[3], work[7], work[8]
     body1, body2, r1, c1, r2, c2, _ = bushes
