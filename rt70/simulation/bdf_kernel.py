@@ -49,10 +49,12 @@ ERROR_CONST = KAPPA * GAMMA + 1.0 / np.arange(1, MAX_ORDER + 2)
 #: The scalars of a run, in ``s``: time, step, order, equal steps, Newton's matrix
 #: factored, safety factor of the last step, evaluations, Jacobians, factorisations,
 #: steps, samples written, next output time's index, kernel status, Newton's matrix
-#: pair-local (1) or dense (0) (:mod:`rt70.simulation.bdf_newton`).
-T, H, ORDER, EQUAL, LU_OK, SAFETY, NFEV, NJEV, NLU, NSTEP, NOUT, NEXT, KSTATUS, LOCAL = range(14)
+#: pair-local (1) or dense (0) (:mod:`rt70.simulation.bdf_newton`), run started.
+T, H, ORDER, EQUAL, LU_OK, SAFETY, NFEV, NJEV, NLU, NSTEP, NOUT, NEXT, KSTATUS, LOCAL, STARTED = (
+    range(15)
+)
 #: Length of ``s``.
-SCALARS = 14
+SCALARS = 15
 #: What :func:`advance` returns.
 CHUNK_DONE, FINISHED, FULL, TOO_SMALL, KERNEL_ERROR = range(5)
 
@@ -165,7 +167,7 @@ def _solve_system(K, n, y_predict, c, psi, newton, work, s, scale, tol):
 
 @numba.njit(cache=True)
 def initial_step(K, n, y0, f0, t_span, rtol, atol, s) -> float:
-    """The first step, as scipy's ``select_initial_step`` for order 1; 0 if the kernel fails.
+    """The first step, as scipy's ``select_initial_step`` for order 1; −1 if the kernel fails.
 
     Hairer, Nørsett and Wanner, *Solving Ordinary Differential Equations I*, §II.4.
 
@@ -198,7 +200,7 @@ def initial_step(K, n, y0, f0, t_span, rtol, atol, s) -> float:
     status = _rhs(y0 + h0 * f0, K, n, f1, sums)
     if status != DONE:
         s[KSTATUS] = status
-        return 0.0
+        return -1.0
     d2 = _norm(f1 - f0, scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -242,6 +244,29 @@ def _prediction(D, order):
             y[i] += D[j, i]
             psi[i] += w * D[j, i]
     return y, psi
+
+
+@numba.njit(cache=True)
+def _start(K, n, y0, t_span, tolerances, D, newton, s) -> int:
+    """A run's start (scipy's ``BDF.__init__``); :data:`DONE` or the kernel's status.
+
+    The first step, the differences ``D[0] = y0``, ``D[1] = h f(y0)`` and the first
+    Jacobian; :func:`advance` calls it at a run's first call (one compiled entry point:
+    numba compiles each entry with all it calls).
+    """
+    f0, sums = np.empty_like(y0), np.empty(4)
+    status = _rhs(y0, K, n, f0, sums)
+    if status != DONE:
+        return status
+    s[NFEV] += 1
+    h0 = initial_step(K, n, y0, f0, t_span, tolerances[0], tolerances[1], s)
+    if h0 < 0.0:
+        return int(s[KSTATUS])
+    s[H] = h0
+    D[0] = y0
+    D[1] = f0 * h0
+    s[NJEV] += 1
+    return jacobian_at(K, n, y0, newton, s, s[LOCAL] == 1)
 
 
 @numba.njit(cache=True)
@@ -383,7 +408,8 @@ def advance(K, n, t_bound, tolerances, D, newton, s, work, t_eval, samples, max_
     ``t_eval`` from ``s[NEXT]`` on, by the dense output. Returns :data:`CHUNK_DONE`,
     :data:`FINISHED`, :data:`FULL` (buffer full: empty it and call again; no sample is
     lost), :data:`TOO_SMALL` or :data:`KERNEL_ERROR` (the kernel's status in
-    ``s[KSTATUS]``).
+    ``s[KSTATUS]``). The first call of a run (``s[STARTED] == 0``, ``D[0]`` the initial
+    state, ``s[T]`` its time) starts it: the first step, ``D[1]`` and the first Jacobian.
 
     Parameters
     ----------
@@ -411,6 +437,12 @@ def advance(K, n, t_bound, tolerances, D, newton, s, work, t_eval, samples, max_
     max_steps : int
         The most steps of this call.
     """
+    if s[STARTED] == 0:  # the run's first call: D[0] holds y0
+        status = _start(K, n, D[0].copy(), np.array([s[T], t_bound]), tolerances, D, newton, s)
+        if status != DONE:
+            s[KSTATUS] = status
+            return KERNEL_ERROR
+        s[STARTED] = 1
     y = np.empty(D.shape[1])
     every_step = t_eval.shape[0] == 0
     for _ in range(max_steps):

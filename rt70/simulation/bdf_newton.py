@@ -11,7 +11,7 @@ at the state where the Jacobian was last taken (:func:`jacobian_at`). Two forms:
   (:mod:`rt70.textbook.articulated_kernel`, as the generalized-α method does), with the
   pairs' placement and inertias of the Jacobian's state kept beside the factor;
 - **dense** (a bushing across pairs): A and R as nv × nv arrays
-  (:func:`rt70.textbook.forward_kernel._jacobian`), M factored by LU with partial
+  (:func:`rt70.textbook.forward_kernel._material_jacobian`), M factored by LU with partial
   pivoting.
 
 The flag ``s[LOCAL]`` of the run chooses. ``newton = (dense, local)`` holds both
@@ -24,12 +24,8 @@ import numba
 import numpy as np
 
 from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
-from rt70.textbook.forward_kernel import DONE, SINGULAR, _jacobian
+from rt70.textbook.forward_kernel import DONE, SINGULAR, _material_jacobian
 from rt70.textbook.motion_kernel import _pair_gains, _place
-
-#: Newton's matrix with ∂r/∂q by differences (True) or from the springs' material
-#: stiffness alone (False; :func:`rt70.textbook.forward_kernel._jacobian`), dense form.
-EXACT = False
 
 
 def buffers(nv: int, nb: int, local: bool) -> tuple[tuple, tuple]:
@@ -97,8 +93,7 @@ def jacobian_at(K, n, y, newton, s, local) -> int:
     if local:
         return _pair_jacobian(y[:n].copy(), K, newton[1])
     dense = newton[0]
-    acc = np.empty(n)
-    return _jacobian(y[:n].copy(), y[n : 2 * n].copy(), K, acc, dense[2], dense[3], dense[4], EXACT)
+    return _material_jacobian(y[:n].copy(), K, dense[2], dense[3], dense[4])
 
 
 @numba.njit(cache=True)

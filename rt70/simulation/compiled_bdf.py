@@ -134,15 +134,7 @@ class _Run:
         self.newton = bdf_newton.buffers(n, model.nb, local)
         self.work = _work(size, n)
         self.samples = (np.empty(cap), np.empty((cap, size)))
-        f0, sums = np.empty(size), np.empty(4)
-        forward_kernel.raise_status(model, data, bk._rhs(y0, self.K, n, f0, sums))
-        rtol, atol = tolerances[0], tolerances[1]
-        h0 = bk.initial_step(self.K, n, y0, f0, np.array(t_span), rtol, atol, self.s)
-        forward_kernel.raise_status(model, data, int(self.s[bk.KSTATUS]) if h0 == 0 else -1)
-        self.s[bk.H], self.s[bk.NFEV], self.s[bk.NJEV] = h0, self.s[bk.NFEV] + 1, 1
-        self.D[0], self.D[1] = y0, f0 * h0
-        status = bdf_newton.jacobian_at(self.K, n, y0, self.newton, self.s, local)
-        forward_kernel.raise_status(model, data, status)
+        self.D[0] = y0  # the loop's first call starts the run from it
 
     def advance(self, t_eval: np.ndarray) -> int:
         """:func:`bk.advance` for :data:`CHUNK_STEPS` steps."""
@@ -154,6 +146,14 @@ class _Run:
         m = int(self.s[bk.NOUT])
         self.s[bk.NOUT] = 0
         return tuple(x[:m].copy() for x in self.samples)
+
+
+def _energies(model, data: forward_kernel.ForwardData, y: np.ndarray) -> np.ndarray:
+    """``[T, U_g, U_c, P_d]`` of each state ``y[i] = [q; q̇; E_ψ]`` (:func:`bk.energies`)."""
+    out = np.empty((y.shape[0], 4))
+    forward_kernel.raise_status(model, data, bk.energies(data.arrays, model.nv, y, out))
+    data.motion.placed[:] = np.nan
+    return out
 
 
 def _load(scene: Scene, data: forward_kernel.ForwardData, y0: np.ndarray, tolerances) -> None:
@@ -201,8 +201,10 @@ def simulate_bdf(
     q0, v0 = check_vector("initial state q0", q0, n), check_vector("initial state qd0", v0, n)
     check_euler_pairs(model, model.expand(q0))
     t0, t1 = map(float, t_span)
-    _, sums = forward_kernel.accelerations(model, data, q0, v0)
-    scale = initial_energy_scale(*sums[:3])
+    try:
+        scale = initial_energy_scale(*_energies(model, data, np.r_[q0, v0, 0.0][None])[0, :3])
+    except Rt70Error as exc:
+        raise type(exc)(f"{scene.name}: at the initial state: {exc}") from None
     rtol, atol = tolerances
     atol_vec = np.r_[np.full(2 * n, atol), rtol * scale]
     newton_tol = max(10 * np.finfo(float).eps / rtol, min(0.03, rtol**0.5))
@@ -242,10 +244,7 @@ def simulate_bdf(
                 f"{scene.name}: integration stopped at t = {reached:.6g} s: {exc}"
             ) from None
     t, y = (np.concatenate(c) for c in zip(*chunks, strict=True))
-    energies = np.empty((t.size, 4))
-    forward_kernel.raise_status(model, data, bk.energies(state.K, n, y, energies))
-    data.motion.placed[:] = np.nan
-    return _result(scene, state, (t, y, energies), (rtol, atol), (wall, status))
+    return _result(scene, state, (t, y, _energies(model, data, y)), (rtol, atol), (wall, status))
 
 
 def _result(scene: Scene, state: _Run, samples, tolerances, clock) -> SimulationResult:

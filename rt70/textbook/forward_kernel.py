@@ -173,30 +173,44 @@ def _material_stiffness(K, Rq, X, sk) -> int:
 
 
 @numba.njit(cache=True)
-def _jacobian(q, v, K, acc, A, Rq, Rv, exact) -> int:
-    """``A(q)``, ``R_q = ∂r/∂q`` and ``R_q̇ = ∂r/∂q̇`` at (q, q̇, q̈(q, q̇)); ``acc = q̈``.
+def _jacobian(q, v, K, acc, A, Rq, Rv) -> int:
+    """``A(q)``, ``R_q = ∂r/∂q`` and ``R_q̇ = ∂r/∂q̇`` by differences at (q, q̇, q̈(q, q̇)).
 
-    ``∂q̈/∂x = −A⁻¹ R_x`` (module docstring). A by the mass kernel's composite inertias.
-    If ``exact``, R's columns by forward differences, a bushing differenced only in the
-    coordinates of its path (its force depends on no other and acts on no other); else
-    the springs' and dampers' material gains ``Σ JᵀCJ``, ``Σ JᵀDJ``
-    (:func:`_material_stiffness`). Returns the status of :func:`_forward`.
+    ``∂q̈/∂x = −A⁻¹ R_x`` (module docstring); ``acc = q̈``. A by the mass kernel's
+    composite inertias; R's columns by forward differences, a bushing differenced only in
+    the coordinates of its path (its force depends on no other and acts on no other).
+    Returns the status of :func:`_forward`.
     """
-    n = q.shape[0]
     sums = np.empty(4)
     status = _forward(q, v, K, acc, sums)
     if status != DONE:
         return status
     _mass(K[1], K[2], A)
-    if exact:
-        status = _differences(q, v, K, acc, Rq, Rv)
-    else:
-        _material_stiffness(K, Rv, K[4], K[8])
+    status = _differences(q, v, K, acc, Rq, Rv)
+    return status if status != DONE else _finite(Rq, Rv)
+
+
+@numba.njit(cache=True)
+def _material_jacobian(q, K, A, Rq, Rv) -> int:
+    """``A(q)`` and the springs' and dampers' material gains ``Σ JᵀCJ``, ``Σ JᵀDJ`` at q.
+
+    The R of Newton's matrix (module docstring, :func:`_material_stiffness`); the pairs
+    are placed at q. Returns :data:`DONE`, :data:`NOT_FINITE` or the bushing at gimbal
+    lock.
+    """
+    _place(q, K[1], K[2], K[10], K[11])
+    _mass(K[1], K[2], A)
+    status = _material_stiffness(K, Rv, K[4], K[8])
+    if status == DONE:
         status = _material_stiffness(K, Rq, K[3][6], K[7])
-    if status != DONE:
-        return status
-    for i in range(n):
-        for j in range(n):
+    return status if status != DONE else _finite(Rq, Rv)
+
+
+@numba.njit(cache=True)
+def _finite(Rq, Rv) -> int:
+    """:data:`DONE` if every entry of both is finite, else :data:`NOT_FINITE`."""
+    for i in range(Rq.shape[0]):
+        for j in range(Rq.shape[1]):
             if not (np.isfinite(Rq[i, j]) and np.isfinite(Rv[i, j])):
                 return NOT_FINITE
     return DONE
@@ -362,6 +376,8 @@ def jacobian(
     q, v = _state(model, q, v)
     n = model.nv
     A, Rq, Rv, acc = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty(n)
-    raise_status(model, data, _jacobian(q, v, data.arrays, acc, A, Rq, Rv, exact))
+    K = data.arrays
+    status = _jacobian(q, v, K, acc, A, Rq, Rv) if exact else _material_jacobian(q, K, A, Rq, Rv)
+    raise_status(model, data, status)
     data.motion.placed[:] = np.nan
     return -np.linalg.solve(A, Rq), -np.linalg.solve(A, Rv)
