@@ -43,7 +43,6 @@ from rt70.cli import warm_protocol as protocol
 WARM_UP = (
     ("simulate", "rt70_servo", "--scenario", "hold", "--t-end", "0.2", "--no-plot"),
     ("simulate", "rt70", "--t-end", "0.01", "--no-plot"),
-    ("simulate", "rt70", "--t-end", "0.01", "--method", "compiled-BDF", "--no-plot"),
     ("modes", "double_pendulum"),
 )
 
