@@ -223,3 +223,49 @@ def test_centre_of_mass_error_beside_the_state_error(quick_rows, tmp_path):
         table[0]
     )
     assert "COM m" in wpr.format_table(quick_rows)
+
+
+class _FakeConn:
+    """The worker's end of the pipe: ``requests`` in, what the worker sends kept."""
+
+    def __init__(self, requests):
+        self.requests, self.sent = [*requests, None], []
+
+    def recv(self):
+        return self.requests.pop(0)
+
+    def send(self, msg):
+        self.sent.append(msg)
+
+
+def test_the_worker_loads_a_method_before_its_first_timed_run(monkeypatch):
+    """A method's first call on a problem (a compiled method's compile) happens before the
+    worker says "ready", outside the capped wait: once per (problem, method), a short
+    span; a failure there is left to the timed run, which reports it."""
+    import rt70.simulation.simulate as sim
+
+    pendulum = QUICK_PROBLEMS[1]
+    scene, x0, notes = build_problem(pendulum)
+    calls, events, original = [], [], sim.simulate
+
+    def simulate(scene, t_span, **kw):
+        calls.append((kw["method"], t_span[1], kw["rtol"]))
+        if t_span[1] < pendulum.t_end and kw["method"] == "LSODA":
+            raise RuntimeError("not in the loading run")
+        return original(scene, t_span, **kw)
+
+    monkeypatch.setattr(sim, "simulate", simulate)
+    monkeypatch.setattr(wpw, "_CACHE", {pendulum: (scene, x0, notes)})
+    monkeypatch.setattr(wpw, "_LOADED", set())
+    requests = [(pendulum, m, 1e-6, None) for m in ("BDF", "BDF", "LSODA")]
+    conn = _FakeConn(requests)
+    conn.send = lambda msg: events.append((msg[0], len(calls)))
+    wpw._serve(conn, "none")
+    short = wpw._LOAD_FRACTION * pendulum.t_end
+    assert calls == [
+        ("BDF", short, 1e-3), ("BDF", pendulum.t_end, 1e-6), ("BDF", pendulum.t_end, 1e-6),
+        ("LSODA", short, 1e-3), ("LSODA", pendulum.t_end, 1e-6),
+    ]  # fmt: skip
+    # "ready" after the loading run, the timed run after "ready"
+    assert events == [("ready", 1), ("result", 2), ("ready", 2), ("result", 3),
+                      ("ready", 4), ("result", 5)]  # fmt: skip

@@ -42,9 +42,11 @@ Time is the best of ``REPEATS`` (3) values of ``SimulationResult.wall_time_s`` (
 is timed once (the repeats guard short runs against the machine's noise; a run of
 seconds is far from every target, and repeating it would push the full report, with
 the RT-70's 10 s transient, past ten minutes). Every run happens in a worker process
-(:mod:`multiprocessing`, ``spawn``) that keeps its scenes; the parent waits for the
-result at most the cap plus a small allowance for the post-processing, then kills the
-worker (and starts a new one for the next run). A run over the cap is reported as
+(:mod:`multiprocessing`, ``spawn``) that keeps its scenes and, before a method's first
+run on a problem, runs it over a short span untimed (a compiled method's first call after
+an install compiles its kernels, for a minute or more); the parent waits for the result
+at most the cap plus a small allowance for the post-processing, then kills the worker
+(and starts a new one for the next run). A run over the cap is reported as
 ``over cap`` after one attempt, and the tighter tolerances of the same method on the
 same problem are not run (reported ``over cap (not run)``): a tighter tolerance is
 assumed to cost at least as much. The worker runs with BLAS and OpenMP pinned to one

@@ -34,7 +34,7 @@ import numba
 import numpy as np
 
 from rt70.simulation.bdf_newton import factor, jacobian_at, solve
-from rt70.textbook.forward_kernel import DONE, NOT_FINITE, _forward, _residual
+from rt70.textbook.forward_kernel import DONE, K_R, K_ZERO, NOT_FINITE, _forward, _residual
 
 MAX_ORDER = 5
 NEWTON_MAXITER = 4
@@ -120,7 +120,7 @@ def _newton_residual(K, n, y, c, psi, d, acc, b, sums) -> int:
     """
     for i in range(n):
         acc[i] = (psi[n + i] + d[n + i]) / c
-    status = _residual(y[:n], y[n : 2 * n], acc, K, True, b[n : 2 * n], sums)
+    status = _residual(y[:n], y[n : 2 * n], acc, K, b[n : 2 * n], sums)
     for i in range(n):
         b[i] = c * y[n + i] - psi[i] - d[i]
         b[n + i] *= -c
@@ -393,8 +393,8 @@ def energies(K, n, states, out) -> int:
         The energies, J, and the dampers' power, W.
     """
     for i in range(states.shape[0]):
-        status = _residual(states[i, :n].copy(), states[i, n : 2 * n].copy(), K[23], K, True,
-                           K[24], out[i])  # fmt: skip
+        q, v = states[i, :n].copy(), states[i, n : 2 * n].copy()
+        status = _residual(q, v, K[K_ZERO], K, K[K_R], out[i])
         if status != DONE:
             return status
     return DONE

@@ -24,7 +24,23 @@ import numba
 import numpy as np
 
 from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
-from rt70.textbook.forward_kernel import DONE, SINGULAR, _material_jacobian
+from rt70.textbook.forward_kernel import (
+    DONE,
+    K_ARRAYS,
+    K_BUSHES,
+    K_DAMPING,
+    K_I0,
+    K_JAC,
+    K_PAIR_OF,
+    K_PATHS,
+    K_SCOORD,
+    K_SD,
+    K_SK,
+    K_SL,
+    K_WORK,
+    SINGULAR,
+    _material_jacobian,
+)
 from rt70.textbook.motion_kernel import _pair_gains, _place
 
 
@@ -58,8 +74,9 @@ def buffers(nv: int, nb: int, local: bool) -> tuple[tuple, tuple]:
 def _pair_jacobian(q, K, local) -> int:
     """Each pair's blocks of the gains and the placement at q, into the local buffers."""
     Kp, Dp, _, I0J, _, slJ, pJ = local[:7]
-    arrays, work, bushes, damping, paths = K[1], K[2], K[3], K[4], K[5]
-    scoord, sk, sd, jac, I0, sl, pair_of = K[6], K[7], K[8], K[9], K[10], K[11], K[28]
+    arrays, work, bushes, damping = K[K_ARRAYS], K[K_WORK], K[K_BUSHES], K[K_DAMPING]
+    paths, scoord, sk, sd, jac = K[K_PATHS], K[K_SCOORD], K[K_SK], K[K_SD], K[K_JAC]
+    I0, sl, pair_of = K[K_I0], K[K_SL], K[K_PAIR_OF]
     _place(q, arrays, work, I0, sl)
     block = np.empty((jac.shape[0], jac.shape[0]))
     q_start = arrays[2]
@@ -116,7 +133,7 @@ def factor(K, newton, c, local) -> int:
         _lu_factor(A, Rq, Rv, c, LU, piv)
         return DONE
     Kp, Dp, X, I0J, IA, slJ, pJ, U, Dinv = newton[1][:9]
-    arrays = K[1]
+    arrays = K[K_ARRAYS]
     for j in range(X.shape[0]):
         for a in range(6):
             for b in range(6):
@@ -208,7 +225,7 @@ def _dense_solve(dense, c, b, n, x) -> None:
 def _local_solve(K, local, c, b, n, x) -> None:
     """``x = M⁻¹ (A G_q̇ − c R_q G_q)`` by the articulated-body solve, R_q by its pair blocks."""
     Kp, _, _, _, _, slJ, pJ, U, Dinv, pA, acc6, u, rhs = local
-    arrays = K[1]
+    arrays = K[K_ARRAYS]
     q_start, ndof = arrays[2], arrays[3]
     for j in range(q_start.shape[0]):
         s0, nd = q_start[j], ndof[j]

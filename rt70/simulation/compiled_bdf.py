@@ -27,6 +27,7 @@ from rt70.model.scene import Scene
 from rt70.simulation import bdf_kernel as bk
 from rt70.simulation import bdf_newton
 from rt70.simulation.integrators import COMPILED_BDF, EvaluationCounter
+from rt70.simulation.request import run_compiled, uncovered
 from rt70.simulation.result import (
     DRIFT_FACTOR,
     SimulationResult,
@@ -69,35 +70,18 @@ def run(
         ``components`` and ``events`` (refused unless empty) and ``outputs``:
         ``(outputs, side)``, the quantities evaluated on the trajectory by ``side``.
     """
-    from rt70.model.outputs import evaluate, evaluate_trajectory
-
-    asked = [name for name in ("components", "events") if len(extras[name])]
-    if inputs is not None:
-        asked.append("inputs")
-    if asked:
-        raise Rt70Error(
-            f"method '{METHOD}' integrates passive scenes: no input forces, extra state "
-            f"components (drives, servos) or events: {', '.join(asked)} given; use BDF or LSODA"
-        )
-    outputs, side = extras["outputs"]
-    if outputs:
-        evaluate(scene, np.zeros(scene.textbook.nv) if x0 is None else x0[0], outputs, side)
-    rtol, atol = tolerances
-    atol = 1e-3 * rtol if atol is None else atol
-    result = simulate_bdf(scene, t_span, x0, (rtol, atol), progress, t_eval)
-    result.outputs = evaluate_trajectory(scene, result.q, outputs, side)
-    result.output_units = {o.name: o.unit for o in outputs}
-    return result
+    refused = {"inputs": inputs, "components": extras["components"], "events": extras["events"]}
+    return run_compiled(
+        METHOD, scene, x0, tolerances, refused, extras["outputs"],
+        lambda tol: simulate_bdf(scene, t_span, x0, tol, progress, t_eval),
+    )  # fmt: skip
 
 
 def _data(scene: Scene) -> forward_kernel.ForwardData:
     """The scene's kernel data, refused for what the kernels do not cover."""
     data = forward_kernel.ForwardData.of(scene.textbook)
     if data is None or scene.description.loops:
-        raise Rt70Error(
-            f"{scene.name}: method '{METHOD}' runs on the compiled kernels, which do not "
-            "cover modal bodies, mimic joints or closed loops; use BDF or LSODA"
-        )
+        raise uncovered(scene, METHOD)
     return data
 
 
@@ -157,11 +141,12 @@ def _energies(model, data: forward_kernel.ForwardData, y: np.ndarray) -> np.ndar
 
 
 def _load(scene: Scene, data: forward_kernel.ForwardData, y0: np.ndarray, tolerances) -> None:
-    """Set a run up and call its loop for no step, before the clock starts.
+    """Call the loop for no step and no start, before the clock starts.
 
     numba loads every kernel's cached code then (compiles it, the first time).
     """
     run = _Run(scene, data, y0, (0.0, 1.0), tolerances, 1)
+    run.s[bk.STARTED] = 1
     bk.advance(run.K, run.n, 1.0, tolerances, run.D, run.newton, run.s, run.work, np.empty(0),
                run.samples, 0)  # fmt: skip
 

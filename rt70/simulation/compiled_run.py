@@ -30,6 +30,7 @@ from rt70.guards.resources import time_series_samples
 from rt70.model.scene import Scene
 from rt70.simulation.generalized_alpha import SPECTRAL_RADIUS, integrate
 from rt70.simulation.integrators import GENERALIZED_ALPHA, budgeted
+from rt70.simulation.request import run_compiled, uncovered
 from rt70.simulation.result import (
     DRIFT_FACTOR,
     SimulationResult,
@@ -55,10 +56,7 @@ class CompiledEquations:
         self.model = scene.textbook
         self.data = motion_kernel.MotionData.of(self.model)
         if self.data is None or scene.description.loops:
-            raise Rt70Error(
-                f"{scene.name}: method '{METHOD}' runs on the compiled kernels, which do not "
-                "cover modal bodies, mimic joints or closed loops; use BDF or LSODA"
-            )
+            raise uncovered(scene, METHOD)
         self.nv, self.inputs = self.model.nv, inputs
         self.count: Callable = lambda t, x: None  # the run's budget (simulate_compiled)
 
@@ -126,23 +124,11 @@ def run(
         ``components`` and ``events`` (refused unless empty) and ``outputs``:
         ``(outputs, side)``, the quantities evaluated on the trajectory by ``side``.
     """
-    from rt70.model.outputs import evaluate, evaluate_trajectory
-
-    asked = [name for name in ("components", "events") if len(extras[name])]
-    if asked:
-        raise Rt70Error(
-            f"method '{METHOD}' takes no extra state components (drives, servos) or events: "
-            f"{', '.join(asked)} given; use LSODA or BDF"
-        )
-    outputs, side = extras["outputs"]
-    if outputs:
-        evaluate(scene, np.zeros(scene.textbook.nv) if x0 is None else x0[0], outputs, side)
-    rtol, atol = tolerances
-    atol = 1e-3 * rtol if atol is None else atol
-    result = simulate_compiled(scene, t_span, x0, (rtol, atol), inputs, progress, t_eval)
-    result.outputs = evaluate_trajectory(scene, result.q, outputs, side)
-    result.output_units = {o.name: o.unit for o in outputs}
-    return result
+    refused = {"components": extras["components"], "events": extras["events"]}
+    return run_compiled(
+        METHOD, scene, x0, tolerances, refused, extras["outputs"],
+        lambda tol: simulate_compiled(scene, t_span, x0, tol, inputs, progress, t_eval),
+    )  # fmt: skip
 
 
 def simulate_compiled(

@@ -72,3 +72,88 @@ def checked_request(
         if np.any(np.diff(t_eval) <= 0.0):
             raise Rt70Error("t_eval must be increasing")
     return t0, t1, t_eval
+
+
+def uncovered(scene, method: str) -> Rt70Error:
+    """The error of a compiled method on a scene its kernels do not cover.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its name leads the message).
+    method : str
+        The compiled method (:data:`GENERALIZED_ALPHA` or :data:`COMPILED_BDF`).
+    """
+    return Rt70Error(
+        f"{scene.name}: method '{method}' runs on the compiled kernels, which do not "
+        "cover modal bodies, mimic joints or closed loops; use BDF or LSODA"
+    )
+
+
+def run_compiled(
+    method: str,
+    scene,
+    x0: tuple[np.ndarray, np.ndarray] | None,
+    tolerances: tuple[float, float | None],
+    refused: dict,
+    outputs: tuple,
+    integrate: Callable,
+):
+    """What the compiled methods do around their integration, the same for each.
+
+    Refuses what the method does not take (naming it), checks the outputs at the initial
+    state before any work, defaults ``atol`` to ``1e-3 rtol`` (as the other methods'),
+    integrates, and evaluates the outputs on the trajectory.
+
+    Parameters
+    ----------
+    method : str
+        The compiled method, named in the refusal.
+    scene : Scene
+        The scene.
+    x0 : (q0, q̇0) or None
+        Initial state (the outputs are checked at q0; default q = 0).
+    tolerances : (rtol, atol or None)
+        The request's tolerances.
+    refused : dict
+        The request's arguments the method does not take, by name (keys of
+        :data:`REFUSED`): each must be None or empty.
+    outputs : (outputs, side)
+        The quantities evaluated on the trajectory, and the side that evaluates them.
+    integrate : callable
+        ``integrate((rtol, atol)) -> SimulationResult``.
+    """
+    from rt70.model.outputs import evaluate, evaluate_trajectory
+
+    asked = [name for name, value in refused.items() if _given(value)]
+    if asked:
+        raise Rt70Error(
+            f"method '{method}' takes no {', '.join(REFUSED[name] for name in refused)}: "
+            f"{', '.join(asked)} given; use BDF or LSODA"
+        )
+    wanted, side = outputs
+    if wanted:
+        evaluate(scene, np.zeros(scene.textbook.nv) if x0 is None else x0[0], wanted, side)
+    rtol, atol = tolerances
+    result = integrate((rtol, 1e-3 * rtol if atol is None else atol))
+    result.outputs = evaluate_trajectory(scene, result.q, wanted, side)
+    result.output_units = {o.name: o.unit for o in wanted}
+    return result
+
+
+#: What each argument :func:`run_compiled` may refuse is, in its message.
+REFUSED = {
+    "inputs": "input forces",
+    "components": "extra state components (drives, servos)",
+    "events": "events",
+}
+
+
+def _given(value) -> bool:
+    """Whether a refused argument was given: neither None nor an empty sequence."""
+    if value is None:
+        return False
+    try:
+        return len(value) > 0
+    except TypeError:  # a callable
+        return True

@@ -58,27 +58,46 @@ SINGULAR = -2
 #: Status: the accelerations or a Jacobian column are not finite.
 NOT_FINITE = -3
 
+#: Positions in :attr:`ForwardData.arrays` (``K``), constants to numba: the static
+#: kernel's gravity, model arrays, work buffers, bushings, dampings, paths, springs'
+#: coordinates, stiffnesses and dampings, Jacobian buffer; the motion kernel's ground
+#: inertias, pair transforms, spatial velocities, accelerations, forces and scratch; the
+#: articulated factor's inertias, U, D⁻¹, bias forces, accelerations and joint forces u,
+#: its zero added inertia X₀; zero accelerations; the residual; each coordinate's
+#: bushings (pointers, indices); the held accelerations; each coordinate's pair.
+(
+    K_GRAVITY, K_ARRAYS, K_WORK, K_BUSHES, K_DAMPING, K_PATHS, K_SCOORD, K_SK, K_SD, K_JAC,
+    K_I0, K_SL, K_V, K_AD, K_F, K_TMP,
+    K_IA, K_U, K_DINV, K_PA, K_ACC6, K_U_FORCE, K_X0,
+    K_ZERO, K_R, K_BPTR, K_BUSH, K_HELD, K_PAIR_OF,
+) = range(29)  # fmt: skip
+
 
 @numba.njit(cache=True)
-def _residual(q, v, acc, K, place, out, sums) -> int:
-    """``out = r(q, q̇, q̈)`` and ``sums = [T, U_g, U_c, P_d]``; the pairs placed at q if asked.
+def _residual(q, v, acc, K, out, sums) -> int:
+    """``out = r(q, q̇, q̈)`` and ``sums = [T, U_g, U_c, P_d]``, the pairs placed at q.
 
     Returns :data:`DONE` or the bushing at gimbal lock.
     """
-    gravity, arrays, work, bushes, damping, paths, scoord, sk, sd, jac = K[:10]
-    I0, sl, V, Ad, F, tmp = K[10:16]
-    if place:
-        _place(q, arrays, work, I0, sl)
-    _newton_euler(v, acc, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, out, sums)
-    return _elements(q, v, bushes, damping, paths, scoord, sk, sd, work, jac, out, sums[2:])
+    _place(q, K[K_ARRAYS], K[K_WORK], K[K_I0], K[K_SL])
+    _inverse_dynamics(v, acc, K, out, sums)
+    return _elements(q, v, K[K_BUSHES], K[K_DAMPING], K[K_PATHS], K[K_SCOORD], K[K_SK],
+                     K[K_SD], K[K_WORK], K[K_JAC], out, sums[2:])  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _inverse_dynamics(v, acc, K, out, sums) -> None:
+    """``out = A q̈ + B q̇ − Q_g`` of the placed pairs, ``sums[:2] = [T, U_g]`` (Newton–Euler)."""
+    _newton_euler(v, acc, K[K_GRAVITY], K[K_ARRAYS], K[K_WORK][1], K[K_SL], K[K_I0], K[K_V],
+                  K[K_AD], K[K_F], K[K_TMP], out, sums)  # fmt: skip
 
 
 @numba.njit(cache=True)
 def _solve(K, r, out) -> None:
     """``out = A⁻¹ r`` with the articulated factor of :func:`_forward` (pairs placed there)."""
-    arrays, work, sl = K[1], K[2], K[11]
-    U, Dinv, pA, acc6, u = K[17], K[18], K[19], K[20], K[21]
-    _articulated_solve(arrays[0], arrays[2], arrays[3], work[1], sl, U, Dinv, r, pA, acc6, u, out)
+    arrays = K[K_ARRAYS]
+    _articulated_solve(arrays[0], arrays[2], arrays[3], K[K_WORK][1], K[K_SL], K[K_U],
+                       K[K_DINV], r, K[K_PA], K[K_ACC6], K[K_U_FORCE], out)  # fmt: skip
 
 
 @numba.njit(cache=True)
@@ -88,12 +107,12 @@ def _forward(q, v, K, acc, sums) -> int:
     Leaves the pairs placed at q and the articulated factor of ``A(q)``. Returns
     :data:`DONE`, :data:`SINGULAR`, :data:`NOT_FINITE` or the bushing at gimbal lock.
     """
-    arrays, work, I0, sl = K[1], K[2], K[10], K[11]
-    IA, U, Dinv, X0, zero, r = K[16], K[17], K[18], K[22], K[23], K[24]
-    bad = _residual(q, v, zero, K, True, r, sums)
+    arrays, r = K[K_ARRAYS], K[K_R]
+    bad = _residual(q, v, K[K_ZERO], K, r, sums)
     if bad >= 0:
         return bad
-    if not _articulated_factor(arrays[0], arrays[2], arrays[3], work[1], sl, I0, X0, IA, U, Dinv):
+    if not _articulated_factor(arrays[0], arrays[2], arrays[3], K[K_WORK][1], K[K_SL],
+                               K[K_I0], K[K_X0], K[K_IA], K[K_U], K[K_DINV]):  # fmt: skip
         return SINGULAR
     for i in range(r.shape[0]):
         r[i] = -r[i]
@@ -111,12 +130,11 @@ def _difference_column(j, h, v, K, ne0, base, buf, out) -> int:
     The pairs are placed at the perturbed q, ``v`` is the perturbed q̇. Returns
     :data:`DONE` or the bushing at gimbal lock.
     """
-    gravity, arrays, work, bushes, damping, paths = K[:6]
-    jac, I0, sl, V, Ad, F, tmp, acc = K[9], K[10], K[11], K[12], K[13], K[14], K[15], K[27]
+    bushes, damping, paths, work, jac = K[K_BUSHES], K[K_DAMPING], K[K_PATHS], K[K_WORK], K[K_JAC]
     cptr, ccol = paths[2], paths[3]
-    bptr, bush = K[25], K[26]
+    bptr, bush = K[K_BPTR], K[K_BUSH]
     sums = np.empty(2)
-    _newton_euler(v, acc, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, buf, sums)
+    _inverse_dynamics(v, K[K_HELD], K, buf, sums)
     for i in range(buf.shape[0]):
         out[i] = (buf[i] - ne0[i]) / h
         buf[i] = 0.0
@@ -133,7 +151,7 @@ def _difference_column(j, h, v, K, ne0, base, buf, out) -> int:
 @numba.njit(cache=True)
 def _bushing_baselines(v, K, base, buf) -> None:
     """Each bushing's ``−(Q_c + Q_d)`` on its path's coordinates at the placed q, into ``base``."""
-    work, bushes, damping, paths, jac = K[2], K[3], K[4], K[5], K[9]
+    work, bushes, damping, paths, jac = K[K_WORK], K[K_BUSHES], K[K_DAMPING], K[K_PATHS], K[K_JAC]
     cptr, ccol = paths[2], paths[3]
     sums = np.empty(2)
     buf[:] = 0.0
@@ -166,10 +184,9 @@ def _material_stiffness(K, Rq, X, sk) -> int:
     with their dampings, the dampers' ``∂r/∂q̇``. Returns :data:`DONE` or the bushing at
     gimbal lock (:func:`rt70.textbook.static_kernel.placed_gains`).
     """
-    jac = K[9]
+    jac = K[K_JAC]
     block = np.empty((jac.shape[0], jac.shape[0]))
-    bad = placed_gains(K[3], X, K[5], K[6], sk, K[2], jac, block, Rq)
-    return DONE if bad < 0 else bad
+    return placed_gains(K[K_BUSHES], X, K[K_PATHS], K[K_SCOORD], sk, K[K_WORK], jac, block, Rq)
 
 
 @numba.njit(cache=True)
@@ -185,7 +202,7 @@ def _jacobian(q, v, K, acc, A, Rq, Rv) -> int:
     status = _forward(q, v, K, acc, sums)
     if status != DONE:
         return status
-    _mass(K[1], K[2], A)
+    _mass(K[K_ARRAYS], K[K_WORK], A)
     status = _differences(q, v, K, acc, Rq, Rv)
     return status if status != DONE else _finite(Rq, Rv)
 
@@ -198,11 +215,11 @@ def _material_jacobian(q, K, A, Rq, Rv) -> int:
     are placed at q. Returns :data:`DONE`, :data:`NOT_FINITE` or the bushing at gimbal
     lock.
     """
-    _place(q, K[1], K[2], K[10], K[11])
-    _mass(K[1], K[2], A)
-    status = _material_stiffness(K, Rv, K[4], K[8])
+    _place(q, K[K_ARRAYS], K[K_WORK], K[K_I0], K[K_SL])
+    _mass(K[K_ARRAYS], K[K_WORK], A)
+    status = _material_stiffness(K, Rv, K[K_DAMPING], K[K_SD])
     if status == DONE:
-        status = _material_stiffness(K, Rq, K[3][6], K[7])
+        status = _material_stiffness(K, Rq, K[K_BUSHES][6], K[K_SK])
     return status if status != DONE else _finite(Rq, Rv)
 
 
@@ -220,12 +237,11 @@ def _finite(Rq, Rv) -> int:
 def _differences(q, v, K, acc, Rq, Rv) -> int:
     """``R_q``, ``R_q̇`` by forward differences at ``acc`` held (:func:`_jacobian`)."""
     n = q.shape[0]
-    gravity, arrays, work, scoord, sd = K[0], K[1], K[2], K[6], K[8]
-    I0, sl, V, Ad, F, tmp, held = K[10], K[11], K[12], K[13], K[14], K[15], K[27]
+    held, scoord, sd = K[K_HELD], K[K_SCOORD], K[K_SD]
     held[:] = acc
     sums, ne0, buf, col = np.empty(4), np.empty(n), np.zeros(n), np.empty(n)
-    base = np.empty((K[3][0].shape[0], max(K[9].shape[0], 1)))
-    _newton_euler(v, held, gravity, arrays, work[1], sl, I0, V, Ad, F, tmp, ne0, sums)
+    base = np.empty((K[K_BUSHES][0].shape[0], max(K[K_JAC].shape[0], 1)))
+    _inverse_dynamics(v, held, K, ne0, sums)
     _bushing_baselines(v, K, base, buf)
     y = v.copy()
     for j in range(n):
@@ -244,9 +260,16 @@ def _differences(q, v, K, acc, Rq, Rv) -> int:
 def _q_columns(q, v, K, ne0, base, Rq) -> int:
     """``R_q`` by forward differences (:func:`_jacobian`), the pairs placed at q after."""
     n = q.shape[0]
-    arrays, work, I0, sl, scoord, sk = K[1], K[2], K[10], K[11], K[6], K[7]
+    arrays, work, I0, sl, scoord, sk = (
+        K[K_ARRAYS],
+        K[K_WORK],
+        K[K_I0],
+        K[K_SL],
+        K[K_SCOORD],
+        K[K_SK],
+    )
     buf, col = np.zeros(n), np.empty(n)
-    x, pair_of = q.copy(), K[28]
+    x, pair_of = q.copy(), K[K_PAIR_OF]
     for j in range(n - 1, -1, -1):  # the pairs from j's on placed again: all moved before
         h = 1.4901161193847656e-08 * max(abs(q[j]), 1.0)
         x[j] = q[j] + h
