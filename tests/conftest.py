@@ -26,5 +26,8 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
 
 def pytest_configure(config: pytest.Config) -> None:
     """Every ``rt70`` command a test starts runs in its own interpreter, even where a warm
-    process of this user runs (``rt70 warm``): the tests of the warm process start their own."""
+    process of this user runs (``rt70 warm``): the tests of the warm process start their own,
+    without the later warm-up (a compile of a minute or more in the background when numba's
+    cache lacks the compiled BDF; ``tests/test_warm.py`` tests it with a short command)."""
     os.environ["RT70_WARM"] = "0"
+    os.environ["RT70_WARM_LATER"] = "0"

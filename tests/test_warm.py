@@ -182,3 +182,51 @@ def test_a_client_that_sends_nonsense_or_goes_away_does_not_stop_it(warm):
     _rt70(warm, "--version", check_code=0)
     assert _served(warm) == before + 1
     assert "JSONDecodeError" in Path(path + ".log").read_text()  # the bad one was read, logged
+
+
+def _later_ends(server, timeout_s: float = 240.0) -> None:
+    """Wait until the later warm-up's child has ended, then let the server finish it."""
+    import select
+
+    assert select.select([server.later], [], [], timeout_s)[0], "the child did not end"
+    server.finish_later()
+    os.waitpid(server.later_pid, 0)  # this test process does not ignore SIGCHLD
+
+
+def test_the_later_warm_up_runs_in_a_child_then_in_the_warm_process(monkeypatch, tmp_path):
+    """:data:`LATER` (here a short command) runs in a child while the process serves, then
+    in the process itself; a command that fails in the child is not run again."""
+    import gc
+
+    server = warm_server.Server(tmp_path / "w.sock", 10.0)
+    server.listen()
+    try:
+        monkeypatch.setattr(warm_server, "LATER", (("modes", "three_masses"),))
+        server.start_later()
+        assert server.status()["later"] == "compiling"
+        _later_ends(server)
+        assert server.later is None and server.status()["later"].startswith("loaded in")
+        monkeypatch.setattr(warm_server, "LATER", (("modes", "missing.urdf"),))
+        server.start_later()
+        _later_ends(server)
+        assert server.status()["later"] == "failed"
+    finally:
+        server.stop_later()
+        server.listener.close()
+        gc.unfreeze()
+
+
+def test_start_settle_waits_for_the_later_warm_up(tmp_path):
+    """``rt70 warm start --settle`` prints how the later warm-up ended (here: left out)."""
+    env = _env(tmp_path / "w.sock")
+    started = _rt70(env, "warm", "start", "--idle", "1", "--settle", check_code=0)
+    try:
+        assert "compiled BDF off (RT70_WARM_LATER=0)" in started.stdout
+    finally:
+        _rt70(env, "warm", "stop", check_code=0)
+
+
+def test_every_warm_up_command_succeeds(warm):
+    """A warm-up command that fails loads less than it should: the log names it."""
+    log = Path(warm["RT70_WARM_SOCKET"] + ".log").read_text()
+    assert "ready at" in log and "warm-up: " not in log, log

@@ -25,6 +25,8 @@ from rt70.errors import Rt70Error
 
 #: How long ``start`` waits for the warm-up, s.
 START_TIMEOUT_S = 180.0
+#: How long :func:`settled` waits for the later warm-up (a compile after an install), s.
+LATER_TIMEOUT_S = 600.0
 
 #: Idle time after which the warm process stops, minutes (``--idle``).
 DEFAULT_IDLE_MIN = 60.0
@@ -38,13 +40,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         description="A warm process imports rt70 and loads its compiled kernels once; "
         "while it runs, each rt70 command of this user runs in a worker forked from it "
         "(the same output and exit code, without the ~1.5 s start-up). RT70_WARM=0 "
-        "runs a command in its own interpreter; RT70_WARM_SOCKET sets the socket.",
+        "runs a command in its own interpreter; RT70_WARM_SOCKET sets the socket; "
+        "RT70_WARM_LATER=0 leaves the compiled BDF's kernels out of the warm process.",
     )
     warm.add_argument("action", choices=("start", "stop", "status"), help="what to do")
     warm.add_argument(
         "--idle", type=options.positive_float, default=DEFAULT_IDLE_MIN, metavar="MIN",
         help="start: stop after this many minutes without a command "
         f"(default {DEFAULT_IDLE_MIN:g})",
+    )  # fmt: skip
+    warm.add_argument(
+        "--settle", action="store_true",
+        help="start: also wait until the compiled BDF's kernels are loaded (their first "
+        f"compile after an install takes a minute or more; at most {LATER_TIMEOUT_S:g} s)",
     )  # fmt: skip
     warm.set_defaults(func=run)
     return warm
@@ -70,6 +78,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"rt70: already running: {_describe(status)}")
         return 0
     status = _start(path, args.idle * 60.0)
+    if args.settle:
+        status = settled(path) or status
     print(f"rt70: warm process ready: {_describe(status)}")
     return 0
 
@@ -119,12 +129,37 @@ def _ask(path: Path, kind: bytes) -> dict | None:
     return {} if answer == protocol.ANSWERS["stopping"] else None
 
 
+def settled(path: Path, timeout_s: float = LATER_TIMEOUT_S) -> dict | None:
+    """The warm process's status once its later warm-up has ended (or ``timeout_s`` passed).
+
+    Parameters
+    ----------
+    path : Path
+        Its socket.
+    timeout_s : float
+        The longest wait, s.
+
+    Returns
+    -------
+    dict or None
+        Its status (``later``: how the later warm-up ended, or ``compiling`` at the
+        timeout); None when no warm process answers there.
+    """
+    deadline = time.monotonic() + timeout_s
+    status = _ask(path, b"T")
+    while status and status.get("later") == "compiling" and time.monotonic() < deadline:
+        time.sleep(0.2)
+        status = _ask(path, b"T")
+    return status
+
+
 def _describe(status: dict) -> str:
-    """One line: pid, socket, age, commands served, warm-up time, memory."""
+    """One line: pid, socket, age, warm-up time and later warm-up, commands served, memory."""
     started = datetime.datetime.fromtimestamp(status["started"]).strftime("%Y-%m-%d %H:%M:%S")
     memory = f", {status['rss_mb']:g} MB resident" if status.get("rss_mb") else ""
     return (
         f"pid {status['pid']} at {status['socket']}, started {started} (warm-up "
-        f"{status['warm_up_s']:g} s), {status['served']} command(s) served, stops after "
+        f"{status['warm_up_s']:g} s; compiled BDF {status.get('later', 'not started')}), "
+        f"{status['served']} command(s) served, stops after "
         f"{status['idle_s'] / 60.0:g} min idle{memory}"
     )

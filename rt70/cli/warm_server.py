@@ -8,7 +8,10 @@ Unix socket (:func:`rt70.cli.warm_protocol.socket_path`, the owner alone may con
 Each request forks a worker, which takes the client's standard streams, working
 directory and environment and runs :func:`rt70.cli.main.run_here` on its words: the
 command sees what it would see in its own process, and nothing it changes reaches the
-warm process or the next command.
+warm process or the next command. Commands whose first run after an install compiles
+kernels for a minute or more (:data:`LATER`) are run once it serves: by a child first,
+which compiles what numba's cache lacks, then by the warm process itself, which loads
+the cache; until then a worker loads or compiles them as a cold command would.
 
 The warm process serves a request only as the client's own process would run it: the
 client's rt70 must be the same files (:func:`~rt70.cli.warm_protocol.fingerprint`; when
@@ -28,6 +31,7 @@ import gc
 import io
 import json
 import os
+import select
 import signal
 import socket
 import struct
@@ -43,8 +47,16 @@ from rt70.cli import warm_protocol as protocol
 WARM_UP = (
     ("simulate", "rt70_servo", "--scenario", "hold", "--t-end", "0.2", "--no-plot"),
     ("simulate", "rt70", "--t-end", "0.01", "--no-plot"),
-    ("modes", "double_pendulum"),
+    ("modes", "three_masses"),
 )
+
+#: Commands whose first run after an install compiles kernels for a minute or more (the
+#: compiled BDF's). A child forked once the warm process serves runs them, compiling what
+#: numba's cache lacks; then the warm process runs them itself, loading the cache (a
+#: fraction of a second), so that its workers inherit the kernels
+#: (:meth:`Server.start_later`, :meth:`Server.finish_later`). ``RT70_WARM_LATER=0`` leaves
+#: them out.
+LATER = (("simulate", "rt70", "--t-end", "0.01", "--method", "compiled-BDF", "--no-plot"),)
 
 #: Modules imported at start besides what :data:`WARM_UP` loads (python-control: the
 #: plant and servo commands; matplotlib with its file backend: the plots).
@@ -64,6 +76,8 @@ class Server:
         self.started, self.served, self.warm_up_s = time.time(), 0, 0.0
         self.listener: socket.socket | None = None
         self.inode = 0
+        self.later: int | None = None  # the read end of the LATER child's pipe
+        self.later_pid, self.later_state = 0, "not started"
 
     def warm_up(self) -> None:
         """Import :data:`MODULES` and run :data:`WARM_UP` (output to the null device)."""
@@ -72,15 +86,51 @@ class Server:
         for name in MODULES:
             with contextlib.suppress(ImportError):
                 __import__(name)
-        from rt70.cli.main import run_here
-
-        with open(os.devnull, "w") as null:
-            with contextlib.redirect_stdout(null), contextlib.redirect_stderr(null):
-                for words in WARM_UP:
-                    run_here(list(words))
+        _quietly(WARM_UP)
         gc.collect()
         gc.freeze()  # the workers' collections skip what is here: fewer pages copied on write
         self.warm_up_s = time.perf_counter() - start
+
+    def start_later(self) -> None:
+        """Fork the child that runs :data:`LATER`; it writes one byte when all succeeded."""
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            os.close(read)
+            self.listener.close()
+            code = 1
+            try:
+                if _quietly(LATER):
+                    os.write(write, b"1")
+                    code = 0
+            finally:
+                os._exit(code)
+        os.close(write)
+        self.later, self.later_pid, self.later_state = read, pid, "compiling"
+
+    def finish_later(self) -> None:
+        """The child has ended: run :data:`LATER` here if it succeeded (the cache loads)."""
+        ok = os.read(self.later, 1) == b"1"
+        os.close(self.later)
+        self.later = None
+        if not ok:
+            self.later_state = "failed"
+            _log("the later warm-up failed in its child: not loaded")
+            return
+        start = time.perf_counter()
+        ok = _quietly(LATER)
+        gc.collect()
+        gc.freeze()
+        self.later_state = f"loaded in {time.perf_counter() - start:.2f} s" if ok else "failed"
+        _log(f"later warm-up: {self.later_state}")
+
+    def stop_later(self) -> None:
+        """Stop the :data:`LATER` child if it still runs."""
+        if self.later is not None:
+            with contextlib.suppress(OSError):
+                os.kill(self.later_pid, signal.SIGTERM)
+            os.close(self.later)
+            self.later = None
 
     def listen(self) -> None:
         """Bind the socket, readable and writable by its owner alone."""
@@ -107,9 +157,15 @@ class Server:
         """Serve requests until idle, stopped, or the socket is no longer ours."""
         last = time.monotonic()
         while self.owns_socket() and time.monotonic() - last < self.idle_s:
+            waiting = [self.listener] + ([] if self.later is None else [self.later])
+            ready = select.select(waiting, [], [], TICK_S)[0]
+            if self.later is not None and self.later in ready:
+                self.finish_later()
+            if self.listener not in ready:
+                continue
             try:
                 conn, _ = self.listener.accept()
-            except TimeoutError:
+            except (TimeoutError, BlockingIOError):
                 continue
             last = time.monotonic()
             with conn:
@@ -167,6 +223,7 @@ class Server:
             "idle_s": self.idle_s,
             "served": self.served,
             "warm_up_s": round(self.warm_up_s, 3),
+            "later": self.later_state,
             "rss_mb": _rss_mb(),
             "fingerprint": self.fingerprint,
         }
@@ -174,6 +231,25 @@ class Server:
 
 #: The refusal that stops the warm process: its rt70 files changed since it started.
 STALE = "rt70 changed since the warm process started"
+
+
+def _quietly(commands) -> bool:
+    """Run each command here, its output to the null device; whether all exited 0.
+
+    A command that did not is logged (:func:`_log`).
+    """
+    from rt70.cli.main import run_here
+
+    failed = []
+    with open(os.devnull, "w") as null:
+        with contextlib.redirect_stdout(null), contextlib.redirect_stderr(null):
+            for words in commands:
+                code = run_here(list(words))
+                if code != 0:
+                    failed.append(f"'rt70 {' '.join(words)}' exited {code}")
+    for line in failed:
+        _log(f"warm-up: {line}")
+    return not failed
 
 
 def _log(line: str) -> None:
@@ -282,9 +358,14 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # the workers are reaped by the system
     server.listen()
     _log(f"pid {os.getpid()} ready at {server.path} (warm-up {server.warm_up_s:.2f} s)")
+    if os.environ.get("RT70_WARM_LATER", "1") != "0":
+        server.start_later()
+    else:
+        server.later_state = "off (RT70_WARM_LATER=0)"
     try:
         server.loop()
     finally:
+        server.stop_later()
         if server.owns_socket():
             server.path.unlink()
     return 0

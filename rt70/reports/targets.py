@@ -101,8 +101,9 @@ def _last_line(done: subprocess.CompletedProcess) -> str:
 def warm_process() -> Iterator[dict[str, str]]:
     """A warm process of its own (``rt70 warm start``, a temporary socket) for the block.
 
-    Yields the environment whose ``rt70`` commands it serves (for :func:`wall_times`);
-    stopped afterwards.
+    Yields the environment whose ``rt70`` commands it serves (for :func:`wall_times`)
+    once its compiled BDF is loaded as well (``rt70 warm start --settle``); stopped
+    afterwards.
 
     Raises
     ------
@@ -115,8 +116,8 @@ def warm_process() -> Iterator[dict[str, str]]:
         env = {k: v for k, v in os.environ.items() if k != "RT70_WARM"}
         env["RT70_WARM_SOCKET"] = os.path.join(directory, "w.sock")
         cmd = [sys.executable, "-m", "rt70", "warm"]
-        done = subprocess.run([*cmd, "start", "--idle", "30"], env=env, capture_output=True,
-                              text=True, check=False)  # fmt: skip
+        done = subprocess.run([*cmd, "start", "--idle", "30", "--settle"], env=env,
+                              capture_output=True, text=True, check=False)  # fmt: skip
         if done.returncode != 0:
             raise Rt70Error(f"rt70 warm start: exit {done.returncode}: {_last_line(done)}")
         try:
