@@ -23,6 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from rt70.guards import kernel_cache
 from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
 from rt70.textbook.forward_kernel import (
     DONE,
@@ -42,6 +43,8 @@ from rt70.textbook.forward_kernel import (
     _material_jacobian,
 )
 from rt70.textbook.motion_kernel import _pair_gains, _place
+
+kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
 
 
 def buffers(nv: int, nb: int, local: bool) -> tuple[tuple, tuple]:

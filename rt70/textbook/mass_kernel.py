@@ -30,9 +30,12 @@ import numba
 import numpy as np
 
 from rt70.errors import Rt70Error
+from rt70.guards import kernel_cache
 from rt70.guards.arrays import check_vector
 from rt70.textbook.model import Model
 from rt70.textbook.structured import _check_batch, _data_for
+
+kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
 
 #: Pair kinds as the kernel's integer codes (:data:`rt70.textbook.model.PAIR_KINDS`).
 KIND_CODE = {"euler6": 0, "revolute": 1, "prismatic": 2, "planar": 3}

@@ -42,10 +42,13 @@ import numba
 import numpy as np
 
 from rt70.errors import SingularConfigurationError
+from rt70.guards import kernel_cache
 from rt70.guards.arrays import check_vector
 from rt70.textbook.mass_kernel import KernelModel, forward_pass, place_pair
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import GIMBAL_LOCK_COS
+
+kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
 
 
 @numba.njit(cache=True)
