@@ -233,3 +233,27 @@ def test_the_command_line_runs_it(capsys):
     assert main(["simulate", "rt70", "--t-end", "0.5", "--method", METHOD, "--rtol", "1e-5"]) == 0
     out = capsys.readouterr().out
     assert "compiled-BDF (compiled kernels)" in out and ": ok" in out
+
+
+def test_a_long_load_says_the_kernels_compile_and_a_short_one_says_nothing(chain, monkeypatch,
+                                                                         capsys):  # fmt: skip
+    """The first run after an install compiles for about a minute: past a few seconds of
+    loading, one line on stderr says so (a stand-in loop takes the time here)."""
+    import time
+
+    from rt70.simulation import bdf_kernel
+
+    real = bdf_kernel.advance
+
+    def slow(*args):
+        time.sleep(1.0)
+        return real(*args)
+
+    monkeypatch.setattr(compiled_bdf, "COMPILE_NOTICE_S", 0.05)
+    monkeypatch.setattr(bdf_kernel, "advance", slow)
+    simulate(chain, (0.0, 0.01), method=METHOD)
+    said = capsys.readouterr().err
+    assert said.count("rt70: compiling the compiled-BDF kernels") == 1, said
+    monkeypatch.setattr(compiled_bdf, "COMPILE_NOTICE_S", 30.0)
+    simulate(chain, (0.0, 0.01), method=METHOD)
+    assert "compiling" not in capsys.readouterr().err

@@ -16,6 +16,8 @@ U_g and U_c of each sample and the dissipated energy integrated as a state.
 
 from __future__ import annotations
 
+import sys
+import threading
 import time
 
 import numpy as np
@@ -44,6 +46,8 @@ METHOD = COMPILED_BDF
 CHUNK_STEPS = 64
 #: Samples collected per return when every step is a sample.
 BUFFER_ROWS = 4096
+#: Seconds of loading the kernels after which a line on stderr says they compile.
+COMPILE_NOTICE_S = 3.0
 
 
 def run(
@@ -143,12 +147,29 @@ def _energies(model, data: forward_kernel.ForwardData, y: np.ndarray) -> np.ndar
 def _load(scene: Scene, data: forward_kernel.ForwardData, y0: np.ndarray, tolerances) -> None:
     """Call the loop for no step and no start, before the clock starts.
 
-    numba loads every kernel's cached code then (compiles it, the first time).
+    numba loads every kernel's cached code then, or compiles it: after an install or a
+    change to a kernel's source (:mod:`rt70.guards.kernel_cache`), which takes about a
+    minute. A load still going after :data:`COMPILE_NOTICE_S` says so on stderr.
     """
     run = _Run(scene, data, y0, (0.0, 1.0), tolerances, 1)
     run.s[bk.STARTED] = 1
-    bk.advance(run.K, run.n, 1.0, tolerances, run.D, run.newton, run.s, run.work, np.empty(0),
-               run.samples, 0)  # fmt: skip
+    notice = threading.Timer(COMPILE_NOTICE_S, _say_compiling)
+    notice.daemon = True
+    notice.start()
+    try:
+        bk.advance(run.K, run.n, 1.0, tolerances, run.D, run.newton, run.s, run.work,
+                   np.empty(0), run.samples, 0)  # fmt: skip
+    finally:
+        notice.cancel()
+
+
+def _say_compiling() -> None:
+    print(
+        f"rt70: compiling the {METHOD} kernels (once after an install or a change to a "
+        "kernel: about a minute)",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def simulate_bdf(
