@@ -218,14 +218,18 @@ def test_a_real_negative_moment_is_still_refused(smallest):
 
 def test_a_moment_zero_to_rounding_beside_real_ones_is_a_rod():
     """pybullet's cube_no_rotation: an exact rod in decimal (determinant 0) whose smallest
-    moment eigvalsh puts at +2.2e-18 — refused as a rod now, as its −2e-17 twin was."""
+    moment eigvalsh put at +2.2e-18 on the machine it was found on — refused as a rod, as
+    tensors whose smallest moment is zero to rounding are, whichever sign eigvalsh gives
+    it (the sign differs from one CPU to another: −2e-17 on one, +2.8e-17 on another for
+    the same tensor)."""
     rod = np.array([[0.2125, -0.005, 0.0225], [-0.005, 0.205, 0.045], [0.0225, 0.045, 0.0125]])
     moments = np.linalg.eigvalsh(rod)  # the smallest zero to rounding, of either sign
     assert_close(moments[0], 0.0, rel=MIN_REL, scale=moments[-1])
     assert "not positive definite" in inertia_defect(rod, 0.01, np.zeros(3))
-    twin = _noise_tensor((1e-18, 0.2, 0.2))
-    assert np.linalg.eigvalsh(twin)[0] < 0.0
-    assert "not positive definite" in inertia_defect(twin, 0.01, np.zeros(3))
+    for smallest in (1e-18, -1e-18, 0.0):
+        twin = _noise_tensor((smallest, 0.2, 0.2))
+        assert_close(np.linalg.eigvalsh(twin)[0], 0.0, rel=MIN_REL, scale=0.2)
+        assert "not positive definite" in inertia_defect(twin, 0.01, np.zeros(3))
 
 
 def test_triangle_inequality_beyond_rounding_is_refused():

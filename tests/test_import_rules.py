@@ -39,7 +39,8 @@ PACKAGE = ROOT / "rt70"
 #: Wrench value both sides turn into a generalised force; ``rt70.physics.aerodynamics``:
 #: the wind's Wrench on a body at a pose each side computes, from the coefficient tables
 #: of ``rt70.physics.coefficient_tables``; ``rt70.surface.pressure``:
-#: that Wrench spread over surface nodes each side places).
+#: that Wrench spread over surface nodes each side places; ``rt70.guards.kernel_cache``:
+#: numba's cache of every compiled kernel, either side's).
 SHARED = (
     "rt70.errors",
     "rt70.guards.arrays",
@@ -52,6 +53,7 @@ SHARED = (
     "rt70.physics.kkt",
     "rt70.physics.baumgarte",
     "rt70.surface.pressure",
+    "rt70.guards.kernel_cache",
 )
 
 #: layer (module prefix) → module prefixes it may import from rt70.
@@ -70,6 +72,7 @@ RULES = {
         "rt70.physics.cubic_pieces",
         "rt70.physics.baumgarte",
         "rt70.surface.pressure",
+        "rt70.guards.kernel_cache",
     ),
     "rt70.guards.resources": ("rt70.errors",),
     "rt70.physics.rotations": (),

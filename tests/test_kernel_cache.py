@@ -33,7 +33,7 @@ def test_every_module_with_kernels_is_a_source_and_installs_the_locators_first()
     assert all((kernel_cache.PACKAGE / name).is_file() for name in kernel_cache.SOURCES)
     for name in modules:
         text = (kernel_cache.PACKAGE / name).read_text(encoding="utf-8")
-        assert 0 < text.find("\nkernel_cache.install()") < KERNEL.search(text).start(), name
+        assert 0 < text.find("\nstamp_kernel_caches()") < KERNEL.search(text).start(), name
 
 
 def test_a_kernel_is_cached_under_the_digest_of_every_source():

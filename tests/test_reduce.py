@@ -23,24 +23,39 @@ def plants():
     return both["locked"], both["free"]
 
 
+def _untruncated(ss):
+    """``G_s + G_u`` of :func:`rt70.linear.reduce.additive_split` as one state space."""
+    split = rd.additive_split(ss)
+    A = np.block([[split.A_s, np.zeros((split.A_s.shape[0], split.A_u.shape[0]))],
+                  [np.zeros((split.A_u.shape[0], split.A_s.shape[0])), split.A_u]])  # fmt: skip
+    B, C = np.vstack([split.B_s, split.B_u]), np.hstack([split.C_s, split.C_u])
+    return control.ss(A, B, C, split.D)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("which", "order"), [(0, 4), (0, 8), (0, 16), (1, 8), (1, 16), (1, 24)])
 def test_balanced_truncation_error_lies_between_its_bounds(plants, which, order):
-    """σ_{k+1} ≤ ‖G − G_r‖∞ ≤ 2 Σ_{i>k} σ_i (Glover) over the stable part's σ_i.
+    """σ_{k+1} ≤ ‖G − G_r‖∞ ≤ 2 Σ_{i>k} σ_i (Glover) over the stable part's σ_i, to
+    within the computed error's own floor: the H∞ error of the additive split untruncated,
+    measured here (it is rounding, and it differs from one CPU to another).
 
     Measured, locked (mm or arcsec per kN): order 4: 0.60 (σ_5 = 0.30, bound 1.59);
     8: 0.0249 (0.0122, 0.112); 16: 2.58e-3 (1.35e-3, 8.09e-3). Free (arcsec or mm per
     MN·m; the rigid azimuth's 2 states kept whole): 8: 12.7 (5.65, 55.1); 16: 0.553
-    (0.343, 2.75); 24: 0.0278 (0.0111, 0.0490) — above the split's own floor of 0.028
-    (1.15e-10 of ‖G‖∞) only because of the principal coordinates of ``_conditioned``:
-    in the physical ones the floor was 24.7 and the bound failed from order 12 on.
+    (0.343, 2.75); 24: 0.0278 (0.0111, 0.0490). At order 24 the error is the floor, at
+    the 0.036 Hz elevation pendulum (ζ = 4e-5): 0.028 (1.15e-10 of ‖G‖∞) on one machine,
+    0.0615 (2.5e-10) on another, where order 24 gave 0.0607 and orders 30, 40 and 49
+    (bounds 2.9e-3 … 8.7e-7) 0.060. The floor is that low only in the principal
+    coordinates of ``_conditioned``: in the physical ones it was 24.7, and the bound
+    failed from order 12 on.
     """
     ss = plants[which]
     red = rd.balanced_truncation(ss, order)
     err = rd.hinf_error(ss, red.ss)
+    floor = rd.hinf_error(ss, _untruncated(ss)).peak
     assert red.order == red.ss.nstates == order and red.n_unstable == 2 * which
     k = order - red.n_unstable
-    assert red.hsv[k] <= err.peak <= red.bound
+    assert red.hsv[k] - floor <= err.peak <= red.bound + floor
     assert red.ss.input_labels == ss.input_labels
     assert red.ss.output_labels == ss.output_labels
 

@@ -7,12 +7,12 @@ after a ``git pull`` into an editable install, for example, the compiled BDF of
 ``rt70/simulation/bdf_kernel.py`` would keep the old Newton–Euler pass of
 ``rt70/textbook/motion_kernel.py``.
 
-:func:`install` puts cache locators in front of numba's own (numba 0.68's
+:func:`stamp_kernel_caches` puts cache locators in front of numba's own (numba 0.68's
 ``CacheImpl._locator_classes``) that take the same folders (``NUMBA_CACHE_DIR``, the
 package's ``__pycache__``, the user's cache) but stamp every rt70 kernel with
 :func:`digest`: the contents of every file of :data:`SOURCES` together. Any change to
 one of them makes every rt70 kernel compile again, once. Each module that defines
-kernels calls :func:`install` before its first ``numba.njit``.
+kernels calls :func:`stamp_kernel_caches` before its first ``numba.njit``.
 """
 
 from __future__ import annotations
@@ -70,7 +70,7 @@ class _KernelStamp:
         return super().from_function(py_func, py_file)
 
 
-def install() -> None:
+def stamp_kernel_caches() -> None:
     """Put the kernel locators in front of numba's, each before the one it extends.
 
     Idempotent. Raises ``AttributeError`` if numba's locator list is not where numba 0.68

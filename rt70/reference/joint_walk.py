@@ -19,11 +19,11 @@ import math
 
 import numba
 
-from rt70.guards import kernel_cache
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.reference.element_tables import CONTINUOUS, PRISMATIC
 from rt70.reference.forces import GIMBAL_LOCK_COS
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 #: Size of the kernels' fixed scratch (3×3 and 3-, 6-vectors) after the per-entry part.
 WORK_SMALL = 117

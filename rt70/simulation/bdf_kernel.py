@@ -33,11 +33,11 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from rt70.guards import kernel_cache
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.simulation.bdf_newton import factor, jacobian_at, solve
 from rt70.textbook.forward_kernel import DONE, K_R, K_ZERO, NOT_FINITE, _forward, _residual
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 MAX_ORDER = 5
 NEWTON_MAXITER = 4

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from rt70.guards import kernel_cache
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
 from rt70.textbook.forward_kernel import (
     DONE,
@@ -44,7 +44,7 @@ from rt70.textbook.forward_kernel import (
 )
 from rt70.textbook.motion_kernel import _pair_gains, _place
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 
 def buffers(nv: int, nb: int, local: bool) -> tuple[tuple, tuple]:

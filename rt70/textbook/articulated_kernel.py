@@ -15,11 +15,11 @@ import numba
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.guards import kernel_cache
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.textbook.model import Model
 from rt70.textbook.motion_kernel import MotionData, _add_shifted_force, _placed, _shift_motion
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 
 @numba.njit(cache=True)

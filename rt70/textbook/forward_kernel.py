@@ -37,8 +37,8 @@ import numba
 import numpy as np
 
 from rt70.errors import Rt70Error, SimulationError
-from rt70.guards import kernel_cache
 from rt70.guards.arrays import check_vector
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.textbook.articulated_kernel import _articulated_factor, _articulated_solve
 from rt70.textbook.mass_kernel import _composite_inertias, _ground_inertia, _mass_entries
 from rt70.textbook.model import Model
@@ -52,7 +52,7 @@ from rt70.textbook.motion_kernel import (
 )
 from rt70.textbook.static_kernel import _check, placed_gains
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 #: Status of a kernel call: done.
 DONE = -1

@@ -15,11 +15,9 @@ arithmetic instead of Python and numpy call overhead:
 4. ``A_la = σ_lᵀ Θᶜ_{body(a)} σ_a`` for ``body(l) ⪯ body(a)`` (and symmetric), walking
    from each body up its ancestors; 0 across branches.
 
-With mimic constraints the kernel reduces the full-coordinate matrix to
-``A = Gᵀ A_full G`` itself, with G in compressed rows (one entry per mimic row). The
-kernel is compiled on first use and cached on disk (``cache=True``), so a second process
-pays no compilation. It never runs threads of its own (no ``parallel=True``): a batch is
-a plain loop over configurations.
+With mimic constraints the kernel reduces ``A = Gᵀ A_full G`` itself (G in compressed
+rows, one entry per mimic row). Compiled on first use and cached on disk
+(:mod:`rt70.guards.kernel_cache`); no threads of its own: a batch is a plain loop.
 """
 
 from __future__ import annotations
@@ -30,12 +28,12 @@ import numba
 import numpy as np
 
 from rt70.errors import Rt70Error
-from rt70.guards import kernel_cache
 from rt70.guards.arrays import check_vector
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.textbook.model import Model
 from rt70.textbook.structured import _check_batch, _data_for
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 #: Pair kinds as the kernel's integer codes (:data:`rt70.textbook.model.PAIR_KINDS`).
 KIND_CODE = {"euler6": 0, "revolute": 1, "prismatic": 2, "planar": 3}

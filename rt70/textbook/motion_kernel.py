@@ -41,7 +41,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from rt70.guards import kernel_cache
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.textbook.mass_kernel import place_pair
 from rt70.textbook.model import Model
 from rt70.textbook.static_kernel import (
@@ -52,7 +52,7 @@ from rt70.textbook.static_kernel import (
     _twist_rows,
 )
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 
 @numba.njit(cache=True)

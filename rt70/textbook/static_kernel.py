@@ -32,8 +32,7 @@ O(nv · depth) work:
 - the joint springs' k on the diagonal.
 
 ``element_gains`` gives the exact ``Σ Jᵀ C J`` and ``Σ Jᵀ D J``. Models with modal bodies
-or mimic joints have no kernel (:meth:`StaticData.of` gives None). Compiled on first use
-and cached on disk.
+or mimic joints have no kernel (:meth:`StaticData.of` gives None).
 """
 
 from __future__ import annotations
@@ -42,13 +41,13 @@ import numba
 import numpy as np
 
 from rt70.errors import SingularConfigurationError
-from rt70.guards import kernel_cache
 from rt70.guards.arrays import check_vector
+from rt70.guards.kernel_cache import stamp_kernel_caches
 from rt70.textbook.mass_kernel import KernelModel, forward_pass, place_pair
 from rt70.textbook.model import Model
 from rt70.textbook.spatial import GIMBAL_LOCK_COS
 
-kernel_cache.install()  # before the first numba.njit (rt70.guards.kernel_cache)
+stamp_kernel_caches()  # before the first numba.njit
 
 
 @numba.njit(cache=True)
