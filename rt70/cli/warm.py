@@ -39,7 +39,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="start, stop or show the warm process that runs commands without start-up",
         description="A warm process imports rt70 and loads its compiled kernels once; "
         "while it runs, each rt70 command of this user runs in a worker forked from it "
-        "(the same output and exit code, without the ~1.5 s start-up). RT70_WARM=0 "
+        "(the same output and exit code, without the 0.7–1.5 s start-up). RT70_WARM=0 "
         "runs a command in its own interpreter; RT70_WARM_SOCKET sets the socket; "
         "RT70_WARM_LATER=0 leaves the compiled BDF's kernels out of the warm process.",
     )
