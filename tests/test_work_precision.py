@@ -226,16 +226,13 @@ def test_centre_of_mass_error_beside_the_state_error(quick_rows, tmp_path):
 
 
 class _FakeConn:
-    """The worker's end of the pipe: ``requests`` in, what the worker sends kept."""
+    """The worker's end of the pipe: ``requests`` in, each message sent to ``on_send``."""
 
-    def __init__(self, requests):
-        self.requests, self.sent = [*requests, None], []
+    def __init__(self, requests, on_send):
+        self.requests, self.send = [*requests, None], on_send
 
     def recv(self):
         return self.requests.pop(0)
-
-    def send(self, msg):
-        self.sent.append(msg)
 
 
 def test_the_worker_loads_a_method_before_its_first_timed_run(monkeypatch):
@@ -258,9 +255,7 @@ def test_the_worker_loads_a_method_before_its_first_timed_run(monkeypatch):
     monkeypatch.setattr(wpw, "_CACHE", {pendulum: (scene, x0, notes)})
     monkeypatch.setattr(wpw, "_LOADED", set())
     requests = [(pendulum, m, 1e-6, None) for m in ("BDF", "BDF", "LSODA")]
-    conn = _FakeConn(requests)
-    conn.send = lambda msg: events.append((msg[0], len(calls)))
-    wpw._serve(conn, "none")
+    wpw._serve(_FakeConn(requests, lambda msg: events.append((msg[0], len(calls)))), "none")
     short = wpw._LOAD_FRACTION * pendulum.t_end
     assert calls == [
         ("BDF", short, 1e-3), ("BDF", pendulum.t_end, 1e-6), ("BDF", pendulum.t_end, 1e-6),

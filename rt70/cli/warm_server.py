@@ -165,7 +165,7 @@ class Server:
                 continue
             try:
                 conn, _ = self.listener.accept()
-            except (TimeoutError, BlockingIOError):
+            except TimeoutError:
                 continue
             last = time.monotonic()
             with conn:

@@ -124,10 +124,10 @@ class _Run:
         self.samples = (np.empty(cap), np.empty((cap, size)))
         self.D[0] = y0  # the loop's first call starts the run from it
 
-    def advance(self, t_eval: np.ndarray) -> int:
-        """:func:`bk.advance` for :data:`CHUNK_STEPS` steps."""
+    def advance(self, t_eval: np.ndarray, max_steps: int = CHUNK_STEPS) -> int:
+        """:func:`bk.advance` for at most ``max_steps`` steps."""
         return bk.advance(self.K, self.n, self.t_span[1], self.tolerances, self.D, self.newton,
-                          self.s, self.work, t_eval, self.samples, CHUNK_STEPS)  # fmt: skip
+                          self.s, self.work, t_eval, self.samples, max_steps)  # fmt: skip
 
     def collect(self) -> tuple[np.ndarray, np.ndarray]:
         """The samples written since the last call, copied; the buffer emptied."""
@@ -157,8 +157,7 @@ def _load(scene: Scene, data: forward_kernel.ForwardData, y0: np.ndarray, tolera
     notice.daemon = True
     notice.start()
     try:
-        bk.advance(run.K, run.n, 1.0, tolerances, run.D, run.newton, run.s, run.work,
-                   np.empty(0), run.samples, 0)  # fmt: skip
+        run.advance(np.empty(0), max_steps=0)
     finally:
         notice.cancel()
 

@@ -263,14 +263,8 @@ def _differences(q, v, K, acc, Rq, Rv) -> int:
 def _q_columns(q, v, K, ne0, base, Rq) -> int:
     """``R_q`` by forward differences (:func:`_jacobian`), the pairs placed at q after."""
     n = q.shape[0]
-    arrays, work, I0, sl, scoord, sk = (
-        K[K_ARRAYS],
-        K[K_WORK],
-        K[K_I0],
-        K[K_SL],
-        K[K_SCOORD],
-        K[K_SK],
-    )
+    arrays, work, I0, sl = K[K_ARRAYS], K[K_WORK], K[K_I0], K[K_SL]
+    scoord, sk = K[K_SCOORD], K[K_SK]
     buf, col = np.zeros(n), np.empty(n)
     x, pair_of = q.copy(), K[K_PAIR_OF]
     for j in range(n - 1, -1, -1):  # the pairs from j's on placed again: all moved before
